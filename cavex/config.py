@@ -1,0 +1,98 @@
+"""Reading targets and projectiles from TOML (strict: unknown keys and wrong types are errors)."""
+
+import tomllib
+from importlib import resources
+
+from cavex.errors import CavexInputError, require
+from cavex.materials import Material, Projectile, Target
+
+LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c"}
+PROJECTILE_KEYS = {"r", "l", "R", "crh", "m", "V0"}
+TOP_KEYS = {"projectile", "layers"}
+
+
+def default_config_text():
+    """The text of the embedded default configuration (the paper's Table 1)."""
+    return resources.files("cavex").joinpath("data/runway.toml").read_text()
+
+
+def load_config(path=None):
+    """Read ``(target, projectile)`` from a TOML file, or the embedded default when ``path`` is None.
+
+    Raises
+    ------
+    CavexInputError
+        Unreadable or malformed TOML, unknown or missing keys, wrong types or out-of-range values.
+    """
+    text = default_config_text() if path is None else _read(path)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise CavexInputError(f"config '{path}' is not valid TOML: {exc}") from None
+    return parse_config(data)
+
+
+def _read(path):
+    try:
+        with open(path, encoding="utf-8") as handle:
+            return handle.read()
+    except OSError as exc:
+        raise CavexInputError(f"config '{path}' cannot be read: {exc.strerror}") from None
+
+
+def parse_config(data):
+    """Build ``(target, projectile)`` from an already parsed TOML mapping."""
+    _check_keys(data, TOP_KEYS, "", required=TOP_KEYS)
+    return parse_target(data["layers"]), parse_projectile(data["projectile"])
+
+
+def parse_target(layers):
+    """Build a :class:`Target` from a list of ``[[layers]]`` tables."""
+    require(isinstance(layers, list) and layers, "layers", "a non-empty array of tables", layers)
+    materials, thicknesses = [], []
+    for i, table in enumerate(layers):
+        where = f"layers[{i}]."
+        require(isinstance(table, dict), f"layers[{i}]", "a table", table)
+        last = i == len(layers) - 1
+        required = {"E", "nu", "rho", "lam"} | (set() if last else {"thickness"})
+        _check_keys(table, LAYER_KEYS, where, required=required)
+        if last and "thickness" in table:
+            raise CavexInputError(f"parameter '{where}thickness' must be absent: "
+                                  "the last layer is semi-infinite")
+        numbers = {k: _number(table[k], where + k) for k in table if k != "name"}
+        thickness = numbers.pop("thickness", None)
+        materials.append(_prefixed(Material, where, name=str(table.get("name", "")), **numbers))
+        if thickness is not None:
+            thicknesses.append(thickness)
+    return _prefixed(Target, "", materials, thicknesses)
+
+
+def parse_projectile(table):
+    """Build a :class:`Projectile` from the ``[projectile]`` table."""
+    require(isinstance(table, dict), "projectile", "a table", table)
+    _check_keys(table, PROJECTILE_KEYS, "projectile.", required={"r", "l", "m", "V0"})
+    numbers = {k: _number(v, "projectile." + k) for k, v in table.items()}
+    return _prefixed(Projectile, "projectile.", **numbers)
+
+
+def _prefixed(factory, where, *args, **kwargs):
+    """Call ``factory`` and prefix the parameter named in any input error with ``where``."""
+    try:
+        return factory(*args, **kwargs)
+    except CavexInputError as exc:
+        message = str(exc).replace("parameter '", f"parameter '{where}", 1)
+        raise CavexInputError(message) from None
+
+
+def _check_keys(table, allowed, where, required):
+    for key in table:
+        if key not in allowed:
+            raise CavexInputError(f"unknown key '{where}{key}' (accepted: {', '.join(sorted(allowed))})")
+    for key in sorted(required):
+        if key not in table:
+            raise CavexInputError(f"missing key '{where}{key}'")
+
+
+def _number(value, name):
+    require(isinstance(value, (int, float)) and not isinstance(value, bool), name, "a number", value)
+    return float(value)

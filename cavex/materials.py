@@ -1,0 +1,160 @@
+"""Materials, layered targets and projectiles (SI units, compression positive)."""
+
+import math
+from itertools import accumulate
+from dataclasses import dataclass, field
+
+from cavex.errors import require
+
+
+def _positive(name, value):
+    require(isinstance(value, (int, float)) and math.isfinite(value) and value > 0,
+            name, "a finite number > 0", value)
+
+
+@dataclass(frozen=True)
+class Material:
+    """Incompressible-idealised elastic-perfectly plastic Mohr-Coulomb material.
+
+    Yield in the paper's form ``sigma_r - sigma_theta = lam * sigma + tau`` with
+    ``tau = (3 - lam) sigma_c / 3`` (physics.md section 1).
+
+    Parameters
+    ----------
+    E : float
+        Young's modulus (Pa), > 0.
+    nu : float
+        Poisson's ratio in (-1, 0.5); used by the FE solver (the analytic model is incompressible).
+    rho : float
+        Density (kg/m^3), > 0.
+    lam : float
+        Pressure sensitivity lambda in [0, 3); 0 is Tresca.
+    tau : float, optional
+        Shear strength intercept (Pa), > 0. Derived from ``sigma_c`` when omitted.
+    name : str, optional
+    sigma_c : float, optional
+        Unconfined compressive strength (Pa), > 0, from which ``tau`` is derived.
+    """
+
+    E: float
+    nu: float
+    rho: float
+    lam: float
+    tau: float | None = None
+    name: str = ""
+    sigma_c: float | None = field(default=None, compare=False)
+
+    def __post_init__(self):
+        _positive("E", self.E)
+        _positive("rho", self.rho)
+        require(isinstance(self.nu, (int, float)) and -1.0 < self.nu < 0.5,
+                "nu", "in (-1, 0.5)", self.nu)
+        require(isinstance(self.lam, (int, float)) and 0.0 <= self.lam < 3.0,
+                "lam", "in [0, 3)", self.lam)
+        require(self.tau is not None or self.sigma_c is not None,
+                "tau", "given (or sigma_c given)", None)
+        if self.tau is None:
+            _positive("sigma_c", self.sigma_c)
+            object.__setattr__(self, "tau", (3.0 - self.lam) * self.sigma_c / 3.0)
+        _positive("tau", self.tau)
+
+    @property
+    def alpha(self):
+        """``alpha = 3 lam / (3 + 2 lam)``: plastic deviator ``alpha (sigma_r + tau/lam)``."""
+        return 3.0 * self.lam / (3.0 + 2.0 * self.lam)
+
+    @property
+    def yield_intercept(self):
+        """``k = alpha tau / lam = 3 tau / (3 + 2 lam)`` (finite as lam -> 0)."""
+        return 3.0 * self.tau / (3.0 + 2.0 * self.lam)
+
+    @property
+    def shear_modulus(self):
+        """``G = E / (2 (1 + nu))``."""
+        return self.E / (2.0 * (1.0 + self.nu))
+
+    @property
+    def bulk_modulus(self):
+        """``K = E / (3 (1 - 2 nu))``."""
+        return self.E / (3.0 * (1.0 - 2.0 * self.nu))
+
+    @property
+    def quasi_static_epsilon(self):
+        """``epsilon = a/b`` of the quasi-static convention, ``epsilon^3 = 3 tau / (2 E)``."""
+        return (1.5 * self.tau / self.E) ** (1.0 / 3.0)
+
+
+@dataclass(frozen=True)
+class Target:
+    """Plane layered target: ``layers[i]`` has ``thicknesses[i]``; the last is semi-infinite."""
+
+    layers: tuple
+    thicknesses: tuple
+
+    def __post_init__(self):
+        object.__setattr__(self, "layers", tuple(self.layers))
+        object.__setattr__(self, "thicknesses", tuple(float(h) for h in self.thicknesses))
+        require(len(self.layers) >= 1, "layers", "at least one layer", len(self.layers))
+        require(len(self.thicknesses) == len(self.layers) - 1, "thickness",
+                "given for every layer but the last (semi-infinite)", len(self.thicknesses))
+        for i, h in enumerate(self.thicknesses):
+            _positive(f"layers[{i}].thickness", h)
+
+    @property
+    def interface_depths(self):
+        """Depths ``H_1 < H_2 < ...`` of the layer interfaces below the free surface (m)."""
+        return tuple(accumulate(self.thicknesses))
+
+    def layer_at(self, depth):
+        """Index of the layer containing ``depth`` (interfaces belong to the deeper layer)."""
+        return sum(1 for H in self.interface_depths if depth >= H)
+
+    def single(self, index):
+        """The semi-infinite target made of layer ``index`` alone."""
+        return Target((self.layers[index],), ())
+
+
+@dataclass(frozen=True)
+class Projectile:
+    """Rigid ogive-nosed projectile.
+
+    Parameters
+    ----------
+    r : float
+        Shank radius (m).
+    l : float
+        Nose length used to place the cavity centre (m), as the paper's Table 1.
+    R : float
+        Ogive radius (m), ``R >= r``; give this or ``crh = R / (2 r)``.
+    m : float
+        Mass (kg).
+    V0 : float
+        Striking velocity (m/s), > 0.
+    """
+
+    r: float
+    l: float
+    m: float
+    V0: float
+    R: float | None = None
+    crh: float | None = field(default=None, compare=False)
+
+    def __post_init__(self):
+        for name in ("r", "l", "m", "V0"):
+            _positive(name, getattr(self, name))
+        require(self.R is not None or self.crh is not None, "R", "given (or crh given)", None)
+        if self.R is None:
+            _positive("crh", self.crh)
+            object.__setattr__(self, "R", 2.0 * self.r * self.crh)
+        _positive("R", self.R)
+        require(self.R >= self.r, "R", f">= r = {self.r} (ogive)", self.R)
+
+    @property
+    def psi(self):
+        """Calibre-radius-head ``psi = R / (2 r)``."""
+        return self.R / (2.0 * self.r)
+
+    @property
+    def ogive_length(self):
+        """Geometric nose length of a tangent ogive, ``sqrt(2 R r - r^2)`` (m)."""
+        return math.sqrt(2.0 * self.R * self.r - self.r ** 2)

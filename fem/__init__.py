@@ -1,0 +1,1 @@
+"""Spherically symmetric Lagrangian elastoplastic finite-element solver (scikit-fem)."""

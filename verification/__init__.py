@@ -1,0 +1,1 @@
+"""Verification reports, FE-tabulated resistance and batch sweeps."""
