@@ -1,0 +1,33 @@
+"""Shared fixtures for the cavex tests.
+
+The numbers here are typed in from the paper's Table 1 (She 2020; physics.md section 3), not read
+from ``cavex/data/runway.toml``, so that the embedded default can be checked against them.
+"""
+
+import pytest
+
+TABLE1_PROJECTILE = {"r": 0.0125, "l": 0.06, "R": 0.075, "m": 0.505, "V0": 1000.0}
+
+TABLE1_LAYERS = (
+    {"name": "concrete", "rho": 2500.0, "E": 25e9, "tau": 25e6, "lam": 0.15},
+    {"name": "macadam", "rho": 1800.0, "E": 10e9, "tau": 10e6, "lam": 0.35},
+    {"name": "soil", "rho": 1600.0, "E": 0.12e9, "tau": 6e6, "lam": 0.50},
+)
+
+TABLE1_INTERFACE_DEPTHS = (0.65, 1.1)
+
+
+@pytest.fixture
+def table1():
+    """The paper's Table 1: projectile, layer properties and interface depths ``H1, H2`` (m).
+
+    Returns
+    -------
+    dict
+        ``{"projectile": {...}, "layers": (dict, dict, dict), "interface_depths": (H1, H2)}``.
+    """
+    return {
+        "projectile": dict(TABLE1_PROJECTILE),
+        "layers": tuple(dict(layer) for layer in TABLE1_LAYERS),
+        "interface_depths": TABLE1_INTERFACE_DEPTHS,
+    }
