@@ -26,7 +26,10 @@ from dataclasses import dataclass
 
 from cavex.errors import require
 
-EPSILON_READINGS = ("quasi-static",)
+# eps^k = 3 tau/(2E): k = 3 spherical (physics.md, consistent with the printed A), k = 2 the
+# incompressible cylindrical cavity (the paper never defines eps; this reading reproduces Table 2).
+EPSILON_EXPONENTS = {"quasi-static": 3.0, "cylindrical": 2.0}
+EPSILON_READINGS = tuple(EPSILON_EXPONENTS)
 MAX_LAYERS = 3
 
 # (equation, state) for the concentric problem, by number of layers and response index.
@@ -74,10 +77,20 @@ def alpha_lambda(material):
 
 
 def layer_epsilon(material, epsilon="quasi-static"):
-    """``eps = a/b`` of a layer under the chosen reading; ``"quasi-static"``: ``3 tau/(2E)``."""
-    require(epsilon in EPSILON_READINGS, "epsilon", " or ".join(map(repr, EPSILON_READINGS)),
+    """``eps = a/b`` of a layer under a reading of the paper's undefined ``eps_i = V/c_i``.
+
+    Parameters
+    ----------
+    material : Material
+    epsilon : {"quasi-static", "cylindrical"}
+        ``"quasi-static"``: ``eps^3 = 3 tau/(2E)``, the spherical elastic zone's yield
+        (physics.md; the only reading consistent with the ``2/3`` of the printed ``A``).
+        ``"cylindrical"``: ``eps^2 = 3 tau/(2E)``, the incompressible cylindrical cavity's
+        ``(2E/3)(a/b)^2 = tau``; it reproduces the paper's Table 2 (docs/paper_model.md).
+    """
+    require(epsilon in EPSILON_EXPONENTS, "epsilon", " or ".join(map(repr, EPSILON_READINGS)),
             epsilon)
-    return (1.5 * material.tau / material.E) ** (1.0 / 3.0)
+    return (1.5 * material.tau / material.E) ** (1.0 / EPSILON_EXPONENTS[epsilon])
 
 
 def check_target(target):
@@ -108,7 +121,7 @@ def paper_phase_depths(target, projectile, epsilon="quasi-static"):
     target : Target
         At most three layers.
     projectile : Projectile
-    epsilon : {"quasi-static"}
+    epsilon : {"quasi-static", "cylindrical"}
         Reading of ``eps_i`` (see :func:`layer_epsilon`).
 
     Returns
@@ -154,8 +167,8 @@ def paper_coefficients(target, projectile, depth, epsilon="quasi-static"):
         ``r`` is the cavity radius, ``l`` places the cavity centre.
     depth : float
         Nose-tip depth ``L`` (m), >= 0.
-    epsilon : {"quasi-static"}
-        Reading of ``eps_i``.
+    epsilon : {"quasi-static", "cylindrical"}
+        Reading of ``eps_i`` (see :func:`layer_epsilon`).
 
     Returns
     -------

@@ -224,3 +224,20 @@ def test_bad_input_names_the_parameter(call, parameter):
         call(target, projectile)
     message = str(error.value)
     assert f"'{parameter}'" in message and "\n" not in message
+
+
+def test_cylindrical_reading_of_eps():
+    """eps^2 = 3 tau/(2E): L1 = H1 + l - r/sqrt(1.5e-3) ~ 0.387 m (Table 2 ends phase 2 at 0.40)."""
+    target, projectile = default()
+    d = paper_phase_depths(target, projectile, epsilon="cylindrical")
+    assert d["L1"] == pytest.approx(0.65 + 0.06 - 0.0125 / math.sqrt(1.5e-3), rel=1e-14)
+    assert d["L4"] == pytest.approx(1.1 + 0.06 - 0.0125 / math.sqrt(1.5 * 6e6 / 0.12e9), rel=1e-14)
+    states = [paper_coefficients(target, projectile, L, epsilon="cylindrical").state
+              for L in (0.3, 0.5, 0.7, 0.9, 1.05, 1.2)]
+    assert states == ["a", "c", "f", "g", "g", "single"]
+    # A keeps the printed 2/3, which presumes eps^3 = 3 tau/(2E): eq. 29 A with the other eps.
+    soil = target.layers[2]
+    e = math.sqrt(1.5 * soil.tau / soil.E)
+    p = 2 * soil.alpha
+    assert paper_single_coefficients(soil, "cylindrical").A == pytest.approx(
+        (2 / 3 + 1 / soil.lam) * e ** -p - 1 / soil.lam, rel=REL)
