@@ -15,7 +15,7 @@ radius ``a = r`` (the projectile radius; the paper's ``Vt`` and ``a``), interfac
 and 28 normalise by the *outermost yielded* layer, not by the layer at the wall).
 
 Case selection (the paper's text): with the nose tip above ``H1`` the three-layer Eqs. (19)-(25)
-apply by comparing ``L`` with ``L1 <= L2 < L3 <= L4`` (Eqs. 18, 20, 22, 24); from ``H1`` to
+apply by comparing ``L`` with ``L1``-``L4`` (Eqs. 18, 20, 22, 24), in that order; from ``H1`` to
 ``H2`` the two-layer Eqs. (26)-(28); below ``H2`` the single-medium Eq. (29). The layers switch
 when the nose *tip* crosses an interface (paper's choice). Targets with one or two layers use the
 same equations with the layers relabelled (Eqs. 26-28 for two, Eq. 29 for one).

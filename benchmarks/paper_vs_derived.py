@@ -35,6 +35,7 @@ VELOCITIES = (300.0, 600.0, 1000.0)
 DERIVED_VARIANTS = (("quasi-static", "nose-tip"), ("quasi-static", "cavity"),
                     ("dynamic", "nose-tip"), ("dynamic", "cavity"))
 LAYER_NAMES = ("concrete", "macadam", "soil")
+LABELS = {"quasi-static": "qs", "dynamic": "dyn"}
 
 
 def coverage_target():
@@ -138,7 +139,7 @@ def print_corrections():
 def print_comparison(target, projectile):
     print("Cavity-wall stress: paper model vs derived model, default target")
     print("  rel = paper/derived - 1; derived (boundary, switch); S_w = sigma_r/tau of wall layer")
-    header = "  ".join(f"{b[:3]}/{s[:4]:>9s}" for b, s in DERIVED_VARIANTS)
+    header = "  ".join(f"{LABELS[b] + '/' + s:>13s}" for b, s in DERIVED_VARIANTS)
     print(f"  {'L (m)':>5s} {'wall':8s} {'eq':>3s} {'st':>6s} {'V':>5s} {'sigma (MPa)':>11s} "
           f"{'S_w':>7s}  {header}")
     for depth in DEPTHS:
