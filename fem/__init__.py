@@ -1,1 +1,10 @@
-"""Spherically symmetric Lagrangian elastoplastic finite-element solver (scikit-fem)."""
+"""Spherically symmetric Lagrangian elastoplastic finite-element solver (scikit-fem).
+
+Public entry points: :func:`expand_cavity`, :func:`write_result`, :func:`compare_at_depth`.
+"""
+
+from cavex.fem.expansion import expand_cavity
+from cavex.fem.result import ExpansionResult
+from cavex.fem.settings import Numerics
+
+__all__ = ["ExpansionResult", "Numerics", "expand_cavity"]

@@ -1,0 +1,133 @@
+"""``expand_cavity``: a spherical cavity driven at constant velocity from a seed radius.
+
+The cavity wall (reference radius ``a0 = radius / seed_ratio``) moves outwards at ``velocity``
+until the cavity radius is ``radius``; the material starts at rest and unstressed. Time steps
+grow with the cavity (``da = growth_per_step * a``), so every step is a fixed fraction of the
+self-similar process. With ``velocity = 0`` the run is quasi-static.
+"""
+
+import math
+import time
+from dataclasses import asdict
+
+import numpy as np
+from cavex.analytic.cavity import check_problem
+from cavex.fem.discretisation import Discretisation
+from cavex.fem.fields import cauchy_stresses, current_point_radii, plastic_radius, wall_stress
+from cavex.fem.mesh import element_layers, reference_mesh
+from cavex.fem.result import ExpansionResult
+from cavex.fem.settings import make_numerics
+from cavex.fem.solver import RadialSolver
+
+from cavex.errors import CavexNumericalError
+
+
+def radius_schedule(radius, seed_radius, growth_per_step):
+    """Cavity radii of the step ends, geometric from ``seed_radius`` to ``radius``."""
+    n = max(1, math.ceil(math.log(radius / seed_radius) / math.log1p(growth_per_step) - 1e-9))
+    return seed_radius * (radius / seed_radius) ** (np.arange(1, n + 1) / n)
+
+
+def build_model(layers, interfaces, radius, numerics):
+    """Reference mesh and discretisation of the problem; also the interface vertex indices."""
+    seed = radius / numerics.seed_ratio
+    mesh, iface_vertices = reference_mesh(radius, seed, interfaces, numerics.outer_ratio * radius,
+                                          numerics.elements_per_decade)
+    disc = Discretisation(mesh, numerics.degree, element_layers(mesh, iface_vertices), layers,
+                          numerics.dilatancy_deg, numerics.tension_cutoff)
+    return disc, iface_vertices
+
+
+def run_expansion(layers, interfaces, velocity, radius, numerics):
+    """One run at the given settings; returns the result without an error estimate."""
+    started = time.perf_counter()
+    disc, iface_vertices = build_model(layers, interfaces, radius, numerics)
+    dynamic = numerics.dynamic and velocity > 0.0
+    solver = RadialSolver(disc, dynamic=dynamic, rho_inf=numerics.rho_inf, outer=numerics.outer,
+                          assembly=numerics.assembly, newton_tol=numerics.newton_tol,
+                          max_cutbacks=numerics.max_cutbacks,
+                          wall_velocity=velocity if dynamic else 0.0)
+    seed = disc.R_dofs[0]
+    radii = radius_schedule(radius, seed, numerics.growth_per_step)
+    history = {"time": [0.0], "radius": [seed], "wall_stress": [0.0], "plastic_radius": [seed]}
+    previous = seed
+    for a in radii:
+        dt = (a - previous) / velocity if dynamic else 1.0
+        try:
+            solver.advance(a - seed, dt)
+        except CavexNumericalError as exc:
+            raise CavexNumericalError(f"V = {velocity:g} m/s, step to cavity radius {a:.6g} m: "
+                                      f"{exc}") from None
+        previous = a
+        history["time"].append(solver.t if dynamic else 0.0)
+        history["radius"].append(a)
+        history["wall_stress"].append(wall_stress(disc, solver.u, solver.wall_force))
+        history["plastic_radius"].append(plastic_radius(disc, solver.u, solver.response,
+                                                        solver.state))
+    sigma_r, sigma_t = cauchy_stresses(disc, solver.u, solver.response)
+    r_nodes = disc.R_dofs + solver.u
+    fields = {"r": current_point_radii(disc, solver.u).ravel(), "sigma_r": sigma_r.ravel(),
+              "sigma_theta": sigma_t.ravel(), "plastic_strain": solver.state["eq_p"].ravel(),
+              "layer": disc.point_layer.ravel(), "r_nodes": r_nodes, "R_nodes": disc.R_dofs.copy(),
+              "u": solver.u.copy()}
+    ends = tuple(float(r_nodes[disc.degree * v]) for v in iface_vertices)
+    settings = {"layers": [asdict(m) for m in layers], "interfaces": [float(h) for h in interfaces],
+                "velocity": float(velocity), "radius": float(radius),
+                "numerics": numerics.as_dict()}
+    energy = {"work": solver.work, "kinetic": solver.kinetic_energy(),
+              "stored": solver.stored_energy(), "dissipated": solver.dissipated}
+    stats = {"elements": disc.n_elements, "dofs": disc.ndof, "steps": solver.steps,
+             "newton_iterations": solver.newton_iterations, "cutbacks": solver.cutbacks,
+             "seconds": time.perf_counter() - started}
+    return ExpansionResult(cavity_stress=float(history["wall_stress"][-1]),
+                           history={k: np.asarray(v) for k, v in history.items()},
+                           fields=fields, error_estimate=None,
+                           plastic_radius=float(history["plastic_radius"][-1]),
+                           interfaces_final=ends, settings=settings, energy=energy, stats=stats)
+
+
+def richardson_error(fine, coarse, order=2.0, refinement=2.0):
+    """Relative error of ``fine`` estimated from ``coarse`` (``refinement``-times coarser)."""
+    return abs(fine - coarse) / (refinement ** order - 1.0) / abs(fine)
+
+
+def expand_cavity(layers, interfaces, velocity, radius, **numerics):
+    """Expand a spherical cavity at constant velocity and return the FE solution.
+
+    Parameters
+    ----------
+    layers : sequence of Material
+        ``layers[0]`` surrounds the cavity; the last extends to the outer boundary.
+    interfaces : sequence of float
+        Interface radii (m) in the current configuration at the final radius, as for
+        :func:`cavex.analytic.cavity.cavity_stress`.
+    velocity : float
+        Constant cavity-wall velocity ``V`` (m/s), >= 0 (0: quasi-static).
+    radius : float
+        Final cavity radius ``a`` (m).
+    **numerics
+        Fields of :class:`cavex.fem.settings.Numerics`.
+
+    Returns
+    -------
+    ExpansionResult
+
+    Raises
+    ------
+    CavexInputError
+        Bad problem or numerics (the message names the parameter and its range).
+    CavexNumericalError
+        Newton failed even after step cut-backs (the message names V, the step and the radius).
+    """
+    layers = list(layers)
+    interfaces = [float(h) for h in interfaces]
+    check_problem(layers, interfaces, float(velocity), float(radius), "dynamic")
+    settings = make_numerics(**numerics)
+    result = run_expansion(layers, interfaces, float(velocity), float(radius), settings)
+    if settings.error_estimate:
+        coarse = run_expansion(layers, interfaces, float(velocity), float(radius),
+                               settings.coarsened())
+        result.error_estimate = richardson_error(result.cavity_stress, coarse.cavity_stress)
+        result.stats["coarse_cavity_stress"] = coarse.cavity_stress
+        result.stats["seconds"] += coarse.stats["seconds"]
+    return result
