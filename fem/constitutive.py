@@ -137,6 +137,70 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat):
     gamma = eps_r - eps_t
     J = np.exp(theta)
     K, G = mat.K, mat.G
+    P = -K * (theta - theta_p)
+    Q = -2.0 * G * (gamma - gamma_p)
+    positive = Q >= 0.0
+    sign = np.where(positive, 1.0, -1.0)
+    c_mc = np.where(positive, 1.0, 1.0 + mat.lam / 3.0)
+    tol = 1e-12 * mat.tau * J
+    f_mc = c_mc * sign * Q - mat.lam * P - mat.tau * J
+    with np.errstate(invalid="ignore"):
+        sigma_3 = np.where(positive, P - Q / 3.0, P + 2.0 * Q / 3.0)
+        f_tc = -sigma_3 - mat.tension * J
+    plastic = (f_mc > tol) | (f_tc > tol)
+    if np.any(f_tc > tol):
+        return _general_return(theta, gamma, J, theta_p, gamma_p, mat)
+    # Mohr-Coulomb alone (tension cut-off inactive everywhere): one multiplier per point
+    c_psi = np.where(positive, 1.0, 1.0 + mat.lam_psi / 3.0)
+    d_P, d_Q = -K * mat.lam_psi, 3.0 * G * c_psi * sign          # stress correction direction
+    g = -mat.lam * d_P + c_mc * sign * d_Q                       # a . d
+    dl = np.where(plastic, f_mc / g, 0.0)
+    P_new = P - dl * d_P
+    Q_new = Q - dl * d_Q
+    trial_ok = _tension_ok(P_new, Q_new, J, mat)
+    if not np.all(trial_ok | ~plastic):
+        return _general_return(theta, gamma, J, theta_p, gamma_p, mat)
+    th_p = theta_p + dl * mat.lam_psi
+    ga_p = gamma_p - dl * 1.5 * c_psi * sign
+    # tangent d(P, Q)/d(theta, gamma): E - d (a^T E - k J e_theta^T) / g on plastic points
+    pl = plastic / g
+    row_t = (mat.lam * K - mat.tau * J) * pl
+    row_g = (-2.0 * G * c_mc * sign) * pl
+    T = np.array([[-K - d_P * row_t, -d_P * row_g], [-d_Q * row_t, -2.0 * G - d_Q * row_g]])
+    return _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P_new, Q_new, T, plastic, J, mat)
+
+
+def _tension_ok(P, Q, J, mat):
+    with np.errstate(invalid="ignore"):
+        sigma_3 = np.where(Q >= 0.0, P - Q / 3.0, P + 2.0 * Q / 3.0)
+        return -sigma_3 - mat.tension * J <= 1e-12 * mat.tau * J
+
+
+def _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P, Q, T, plastic, J, mat):
+    """Principal Kirchhoff stresses, tangent in (eps_r, eps_t), energies, yield ratio."""
+    K, G = mat.K, mat.G
+    tau_r = -(P + 2.0 * Q / 3.0)
+    tau_t = -(P - Q / 3.0)
+    # d tau / d eps = TO_TAU . T . TO_INVARIANTS, written out
+    a_t = -T[0, 0] - (2.0 / 3.0) * T[1, 0]
+    a_g = -T[0, 1] - (2.0 / 3.0) * T[1, 1]
+    b_t = -T[0, 0] + T[1, 0] / 3.0
+    b_g = -T[0, 1] + T[1, 1] / 3.0
+    tangent = np.array([[a_t + a_g, 2.0 * a_t - a_g], [b_t + b_g, 2.0 * b_t - b_g]])
+    dissipation = -P * (th_p - theta_p) - (2.0 / 3.0) * Q * (ga_p - gamma_p)
+    energy = 0.5 * K * (theta - th_p) ** 2 + (2.0 / 3.0) * G * (gamma - ga_p) ** 2
+    c_mc = np.where(Q >= 0.0, 1.0, (3.0 + mat.lam) / 3.0)
+    strength = mat.lam * P + mat.tau * J
+    with np.errstate(divide="ignore", invalid="ignore"):
+        yield_ratio = np.where(strength > 0.0, c_mc * np.abs(Q) / strength, 1.0)
+    return PointResponse(tau_r=tau_r, tau_t=tau_t, tangent=tangent, theta_p=th_p,
+                         gamma_p=ga_p, plastic=plastic, dissipation=dissipation,
+                         energy=energy, yield_ratio=yield_ratio)
+
+
+def _general_return(theta, gamma, J, theta_p, gamma_p, mat):
+    """Multi-surface return (Mohr-Coulomb, tension cut-off, or their corner)."""
+    K, G = mat.K, mat.G
     P_tr = -K * (theta - theta_p)
     Q_tr = -2.0 * G * (gamma - gamma_p)
     sign = np.where(Q_tr >= 0.0, 1.0, -1.0)
@@ -144,19 +208,16 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat):
     d1 = np.array([-K * g1[0], -2.0 * G * g1[1]])
     d2 = np.array([-K * g2[0], -2.0 * G * g2[1]])
     s_tr = np.array([P_tr, Q_tr])
-    with np.errstate(invalid="ignore", over="ignore"):
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         f1 = (a1 * s_tr).sum(0) - k1 * J
         f2 = (a2 * s_tr).sum(0) - k2 * J
         g11, g12 = (a1 * d1).sum(0), (a1 * d2).sum(0)
         g21, g22 = (a2 * d1).sum(0), (a2 * d2).sum(0)
         tol = 1e-12 * mat.tau * J
-        # candidate 1: Mohr-Coulomb alone
         dl1 = f1 / g11
         ok1 = (dl1 > 0) & (f2 - g21 * dl1 <= tol)
-        # candidate 2: tension cut-off alone
         dl2 = f2 / g22
         ok2 = (dl2 > 0) & (f1 - g12 * dl2 <= tol)
-        # candidate 3: corner
         det = g11 * g22 - g12 * g21
         c1 = (g22 * f1 - g12 * f2) / det
         c2 = (g11 * f2 - g21 * f1) / det
@@ -169,46 +230,24 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat):
     m2 = np.where(use2, dl2, np.where(use3, c2, z))
     P = P_tr - m1 * d1[0] - m2 * d2[0]
     Q = Q_tr - m1 * d1[1] - m2 * d2[1]
-    theta_p_new = theta_p + m1 * g1[0] + m2 * g2[0]
-    gamma_p_new = gamma_p + m1 * g1[1] + m2 * g2[1]
-
-    # tangent d(P, Q)/d(theta, gamma) = E - D Ginv (A E - k J e_theta^T)
+    th_p = theta_p + m1 * g1[0] + m2 * g2[0]
+    ga_p = gamma_p + m1 * g1[1] + m2 * g2[1]
     E = np.array([[-K, z], [z, -2.0 * G]])
     T = E.copy()
-    for mask, rows in ((use1, ((a1, k1, d1, g11),)), (use2, ((a2, k2, d2, g22),))):
-        a, k, d, g = rows[0]
-        # single surface: T = E - d (a^T E - k J e_theta^T) / g
+    for mask, a, k, d, g in ((use1, a1, k1, d1, g11), (use2, a2, k2, d2, g22)):
         row = np.array([a[0] * E[0, 0] - k * J, a[1] * E[1, 1]])
-        with np.errstate(invalid="ignore", over="ignore"):
+        with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
             corr = d[:, None] * row[None, :] / g
         T = np.where(mask, E - corr, T)
     if np.any(use3):
-        with np.errstate(invalid="ignore", over="ignore"):
+        with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
             inv = np.array([[g22, -g12], [-g21, g11]]) / det
             A = np.array([[a1[0] * E[0, 0] - k1 * J, a1[1] * E[1, 1]],
                           [a2[0] * E[0, 0] - k2 * J, a2[1] * E[1, 1]]])
             D = np.array([[d1[0], d2[0]], [d1[1], d2[1]]])
             corr = np.einsum("ik...,kl...,lj...->ij...", D, inv, A)
         T = np.where(use3, E - corr, T)
-
-    # to principal Kirchhoff stresses (tension positive) and d tau / d eps
-    tau_r = -(P + 2.0 * Q / 3.0)
-    tau_t = -(P - Q / 3.0)
-    to_tau = np.array([[-1.0, -2.0 / 3.0], [-1.0, 1.0 / 3.0]])
-    tangent = np.einsum("ik,kl...,lj->ij...", to_tau, T, TO_INVARIANTS)
-    d_theta_p = theta_p_new - theta_p
-    d_gamma_p = gamma_p_new - gamma_p
-    dissipation = -P * d_theta_p - (2.0 / 3.0) * Q * d_gamma_p
-    theta_e = theta - theta_p_new
-    gamma_e = gamma - gamma_p_new
-    energy = 0.5 * K * theta_e ** 2 + (2.0 / 3.0) * G * gamma_e ** 2
-    c_mc = np.where(Q >= 0.0, 1.0, (3.0 + mat.lam) / 3.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        strength = mat.lam * P + mat.tau * J
-        yield_ratio = np.where(strength > 0.0, c_mc * np.abs(Q) / strength, 1.0)
-    return PointResponse(tau_r=tau_r, tau_t=tau_t, tangent=tangent, theta_p=theta_p_new,
-                         gamma_p=gamma_p_new, plastic=~elastic, dissipation=dissipation,
-                         energy=energy, yield_ratio=yield_ratio)
+    return _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P, Q, T, ~elastic, J, mat)
 
 
 def equivalent_plastic_strain(gamma_p, theta_p):

@@ -103,7 +103,7 @@ class Discretisation:
         tiny strains of the elastic verification problems.
         """
         ue = u[self.element_dofs]  # (nel, nb)
-        g_r = np.einsum("eb,ebq->eq", ue, self.dNdR)
+        g_r = (ue[:, :, None] * self.dNdR).sum(1)
         g_t = (ue @ self.N) / self.R_points
         return g_r, g_t
 
@@ -132,18 +132,16 @@ class Discretisation:
         W = self.weights
         Br = self.dNdR / lam_r[:, None, :]                       # (nel, nb, nq)
         Bt = self.N[None, :, :] / (self.R_points * lam_t)[:, None, :]
-        fe = np.einsum("eq,ebq->eb", W * resp.tau_r, Br) + np.einsum(
-            "eq,ebq->eb", 2.0 * W * resp.tau_t, Bt)
+        fe = ((W * resp.tau_r)[:, None, :] * Br + (2.0 * W * resp.tau_t)[:, None, :] * Bt).sum(2)
         f = np.bincount(self.element_dofs.ravel(), fe.ravel(), minlength=self.ndof)
         if not tangent:
             return f, None, resp
         C = resp.tangent
-        dtr = C[0, 0][:, None, :] * Br + C[0, 1][:, None, :] * Bt
-        dtt = C[1, 0][:, None, :] * Br + C[1, 1][:, None, :] * Bt
-        Ke = (np.einsum("eq,eaq,ebq->eab", W, Br, dtr)
-              + np.einsum("eq,eaq,ebq->eab", 2.0 * W, Bt, dtt)
-              - np.einsum("eq,eaq,ebq->eab", W * resp.tau_r, Br, Br)
-              - np.einsum("eq,eaq,ebq->eab", 2.0 * W * resp.tau_t, Bt, Bt))
+        # d tau_i / du_b minus the geometric term, then K_ab = sum_q W (Br_a X_b + 2 Bt_a Y_b)
+        X = C[0, 0][:, None, :] * Br + C[0, 1][:, None, :] * Bt - resp.tau_r[:, None, :] * Br
+        Y = C[1, 0][:, None, :] * Br + C[1, 1][:, None, :] * Bt - resp.tau_t[:, None, :] * Bt
+        Ke = (Br * W[:, None, :]) @ X.transpose(0, 2, 1) + (Bt * (2.0 * W)[:, None, :]) @ \
+            Y.transpose(0, 2, 1)
         return f, self._band(Ke), resp
 
     def _band(self, Ke):

@@ -47,17 +47,17 @@ class Numerics:
     """
 
     degree: int = 2
-    elements_per_decade: float = 40.0
+    elements_per_decade: float = 30.0
     outer_ratio: float = 1000.0
     seed_ratio: float = 20.0
-    growth_per_step: float = 0.02
-    rho_inf: float = 0.5
+    growth_per_step: float = 0.03
+    rho_inf: float = 0.0
     dynamic: bool = True
     outer: str = "fixed"
     assembly: str = "fast"
     dilatancy_deg: float = 0.0
     tension_cutoff: float | None = None
-    newton_tol: float = 1e-10
+    newton_tol: float = 1e-8
     max_cutbacks: int = 10
     error_estimate: bool = True
 

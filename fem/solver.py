@@ -98,6 +98,7 @@ class RadialSolver:
         self.work = 0.0
         self.wall_force = 0.0
         self.load = 0.0
+        self.previous_step = None
         self.newton_iterations = 0
         self.steps = 0
         self.cutbacks = 0
@@ -111,7 +112,10 @@ class RadialSolver:
         u = self.u.copy()
         if not self.pressure_control:
             u[0] = load
-        if self.dynamic:  # predictor: constant velocity on the free dofs
+        if self.previous_step is not None:  # predictor: scaled increment of the last step
+            du, dt_old = self.previous_step
+            u[self.free] = self.u[self.free] + (dt / dt_old) * du[self.free]
+        elif self.dynamic:
             u[self.free] = self.u[self.free] + dt * self.v[self.free]
         scale = None
         for iteration in range(1, self.max_iterations + 1):
@@ -168,6 +172,7 @@ class RadialSolver:
             end_force = f[0]
         self.work += mid_force * (u[0] - self.u[0])
         self.dissipated += float(np.sum(d.weights * resp.dissipation))
+        self.previous_step = (u - self.u, dt)
         self.u, self.v, self.a, self.f, self.response = u, v, a, f, resp
         self.state = {"theta_p": resp.theta_p, "gamma_p": resp.gamma_p,
                       "eq_p": self.state["eq_p"] + np.abs(resp.gamma_p - self.state["gamma_p"])
