@@ -80,7 +80,7 @@ class CavityState:
 
 
 def power_integral(p, x):
-    """``int_1^x t^(p-1) dt``: ``(x^p - 1)/p``, ``ln x`` at ``p = 0``; ``x`` may be ``inf`` if ``p < 0``."""
+    """``int_1^x t^(p-1) dt = (x^p - 1)/p`` (``ln x`` at ``p = 0``; ``x = inf`` needs ``p < 0``)."""
     if math.isinf(x):
         return -1.0 / p
     if p == 0.0:
@@ -104,8 +104,11 @@ def plastic_step(material, s_out, y_out, y_in, rho_v2):
 
 
 def yield_function(material, y, s, boundary):
-    """Elastic deviator minus yield deviator at ``y = a/r`` with radial stress ``s`` (>= 0: yield)."""
-    limit = material.tau if boundary == "quasi-static" else material.alpha * s + material.yield_intercept
+    """Elastic deviator minus yield deviator at ``y = a/r``, radial stress ``s`` (>= 0: yields)."""
+    if boundary == "quasi-static":
+        limit = material.tau
+    else:
+        limit = material.alpha * s + material.yield_intercept
     return (2.0 * material.E / 3.0) * y ** 3 - limit
 
 
@@ -136,7 +139,8 @@ def _dynamic_yield_root(material, s_out, y_out, y_in, rho_v2):
         if abs(step) <= 4e-16 * y:
             return max(y, y_out)
     raise CavexNumericalError(
-        f"dynamic elastic-plastic boundary did not converge (V={math.sqrt(rho_v2 / material.rho)})")
+        "dynamic elastic-plastic boundary did not converge "
+        f"(V={math.sqrt(rho_v2 / material.rho)} m/s)")
 
 
 def check_problem(layers, interfaces, velocity, radius, boundary):
@@ -176,18 +180,25 @@ def cavity_solution(layers, interfaces, velocity, radius, *, boundary="dynamic")
     CavityState
     """
     check_problem(layers, interfaces, velocity, radius, boundary)
+    return solve_checked(layers, interfaces, velocity, radius, boundary)
+
+
+def solve_checked(layers, interfaces, velocity, radius, boundary):
+    """:func:`cavity_solution` for an already validated problem (hot loops skip the checks)."""
     s, y_out, zones = 0.0, 0.0, []
     for i in range(len(layers) - 1, -1, -1):
         material = layers[i]
         rho_v2 = material.rho * velocity ** 2
-        y_in = radius / interfaces[i - 1] if i > 0 else 1.0
+        r_in = interfaces[i - 1] if i > 0 else radius
+        y_in = radius / r_in
         y_yield = yield_point(material, s, y_out, y_in, material.rho, velocity, boundary)
         if y_yield is None:
             s = elastic_step(material, s, y_out, y_in, rho_v2)
         else:
             s = elastic_step(material, s, y_out, y_yield, rho_v2)
             s = plastic_step(material, s, y_yield, y_in, rho_v2)
-            zones.append((i, radius / y_in, radius / y_yield))
+            r_yield = interfaces[i] if y_yield == y_out else radius / y_yield
+            zones.append((i, r_in, r_yield))
         y_out = y_in
     zones.reverse()
     b = zones[-1][2] if zones else radius

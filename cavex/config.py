@@ -17,7 +17,7 @@ def default_config_text():
 
 
 def load_config(path=None):
-    """Read ``(target, projectile)`` from a TOML file, or the embedded default when ``path`` is None.
+    """Read ``(target, projectile)`` from a TOML file (the embedded default if ``path`` is None).
 
     Raises
     ------
@@ -80,19 +80,20 @@ def _prefixed(factory, where, *args, **kwargs):
     try:
         return factory(*args, **kwargs)
     except CavexInputError as exc:
-        message = str(exc).replace("parameter '", f"parameter '{where}", 1)
-        raise CavexInputError(message) from None
+        raise CavexInputError(str(exc).replace("parameter '", f"parameter '{where}", 1)) from None
 
 
 def _check_keys(table, allowed, where, required):
     for key in table:
         if key not in allowed:
-            raise CavexInputError(f"unknown key '{where}{key}' (accepted: {', '.join(sorted(allowed))})")
+            accepted = ", ".join(sorted(allowed))
+            raise CavexInputError(f"unknown key '{where}{key}' (accepted: {accepted})")
     for key in sorted(required):
         if key not in table:
             raise CavexInputError(f"missing key '{where}{key}'")
 
 
 def _number(value, name):
-    require(isinstance(value, (int, float)) and not isinstance(value, bool), name, "a number", value)
+    is_number = isinstance(value, (int, float)) and not isinstance(value, bool)
+    require(is_number, name, "a number", value)
     return float(value)

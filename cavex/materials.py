@@ -1,8 +1,8 @@
 """Materials, layered targets and projectiles (SI units, compression positive)."""
 
 import math
-from itertools import accumulate
 from dataclasses import dataclass, field
+from itertools import accumulate
 
 from cavex.errors import require
 
@@ -133,7 +133,7 @@ class Projectile:
     """
 
     r: float
-    l: float
+    l: float  # noqa: E741 (the paper's name)
     m: float
     V0: float
     R: float | None = None

@@ -1,0 +1,44 @@
+r"""Axial force on a rigid ogive nose from the cavity-wall stress (paper Eqs. 3-14).
+
+A tangent ogive of shank radius ``r`` and ogive radius ``R`` is parametrised by the angle
+``phi`` from ``phi_0 = asin((R - r)/R)`` at the tip to ``pi/2`` at the shank. The normal stress
+on the nose is the cavity-wall stress at the normal expansion velocity ``V cos(phi)``, so
+
+.. math:: F(V) = 2\pi R^2 \int_{\phi_0}^{\pi/2}
+          \Big[\sin\phi - \frac{R - r}{R}\Big] \cos\phi \; \sigma_r(V\cos\phi)\, d\phi .
+
+For ``sigma_r = tau A + B rho V^2`` this is ``F = C_A + C_B V^2`` with ``C_A = pi r^2 tau A``
+and ``C_B = pi r^2 rho B (8 psi - 1)/(24 psi^2)``, ``psi = R/(2r)`` (Eqs. 12-14). For any other
+``sigma_r(V)`` the integral is evaluated by Gauss-Legendre quadrature in ``phi``; the integrand
+is smooth, so the rule converges exponentially (``test_nose`` measures it).
+"""
+
+import math
+
+import numpy as np
+
+QUADRATURE_POINTS = 8
+
+
+def ogive_coefficients(projectile, A, B, tau, rho):
+    """``(C_A, C_B)`` of Eqs. 13-14 for ``S = A + B rho V^2 / tau``."""
+    psi = projectile.psi
+    area = math.pi * projectile.r ** 2
+    return area * tau * A, area * rho * B * (8.0 * psi - 1.0) / (24.0 * psi ** 2)
+
+
+def nose_rule(projectile, points=QUADRATURE_POINTS):
+    """Quadrature ``(cos(phi_k), w_k)`` with ``F(V) = sum_k w_k sigma_r(V cos(phi_k))``."""
+    s0 = (projectile.R - projectile.r) / projectile.R
+    phi0 = math.asin(s0)
+    nodes, weights = np.polynomial.legendre.leggauss(points)
+    phi = phi0 + (0.5 * math.pi - phi0) * 0.5 * (nodes + 1.0)
+    jacobian = 0.5 * (0.5 * math.pi - phi0)
+    w = 2.0 * math.pi * projectile.R ** 2 * (np.sin(phi) - s0) * np.cos(phi) * weights * jacobian
+    return np.cos(phi), w
+
+
+def nose_force(projectile, wall_stress, velocity, points=QUADRATURE_POINTS):
+    """Axial nose force (N) for a cavity-wall stress law ``wall_stress(V) -> Pa``, by quadrature."""
+    cosines, weights = nose_rule(projectile, points)
+    return float(sum(w * wall_stress(velocity * c) for c, w in zip(cosines, weights, strict=True)))

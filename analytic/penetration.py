@@ -1,0 +1,196 @@
+r"""Rigid-projectile penetration: crater stage, then tunnel stages (paper Eqs. 15, 30-34).
+
+Crater (Eqs. 31-34): ``m L'' = -K L`` for ``0 <= L <= L_c``, so
+``L = V_0 sqrt(m/K) sin(sqrt(K/m) t)``, ``V = V_0 cos(sqrt(K/m) t)``. ``K`` and the exit velocity
+``V_c`` follow from energy, ``K L_c^2 = m (V_0^2 - V_c^2)``, and continuity of force with the
+single-medium tunnel resistance, ``K L_c = F_1(V_c)``; for ``F_1 = C_A + C_B V^2`` this is the
+paper's ``V_c^2 = (m V_0^2 - L_c C_A)/(m + L_c C_B)``. ``L_c = 4.5 r`` is the crater depth
+measured from the nose base (``crater="nose-base"``, the nose tip then at ``l + 4.5 r``) or from
+the nose tip (``crater="nose-tip"``).
+
+Tunnel: ``m dV/dt = -F(L, V)``, ``dL/dt = V`` with ``scipy.integrate.solve_ivp``; a phase ends
+(terminal event) where the response-state label of the resistance changes, where the nose tip
+crosses an interface depth ``H_i``, or where ``V = 0``.
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq
+
+from cavex.errors import CavexNumericalError, require
+
+CRATER_MODES = ("nose-base", "nose-tip")
+CRATER_RATIO = 4.5
+MAX_PHASE_DURATION = 10.0  # s; a phase that has not ended by then is a numerical failure
+
+
+@dataclass(frozen=True)
+class Phase:
+    """One phase of the trajectory: its label and where and when it ends."""
+
+    label: str
+    end_depth: float
+    end_velocity: float
+    end_time: float
+    end_reason: str
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Time, nose depth, velocity, deceleration and phase index at every output point."""
+
+    t: np.ndarray
+    depth: np.ndarray
+    velocity: np.ndarray
+    deceleration: np.ndarray
+    phase: np.ndarray
+    phases: tuple
+
+    def as_columns(self):
+        """Columns for CSV output, in SI units."""
+        return {"t_s": self.t, "depth_m": self.depth, "velocity_m_s": self.velocity,
+                "deceleration_m_s2": self.deceleration, "phase": self.phase}
+
+
+def crater_depth(projectile, crater="nose-base"):
+    """Nose-tip depth at the end of the crater stage (m)."""
+    require(crater in CRATER_MODES, "crater", " or ".join(map(repr, CRATER_MODES)), crater)
+    length = CRATER_RATIO * projectile.r
+    return length + projectile.l if crater == "nose-base" else length
+
+
+def crater_exit(projectile, force, depth):
+    """Exit velocity ``V_c`` and stiffness ``K`` of the crater: ``m (V0^2 - Vc^2) = L_c F(Vc)``."""
+    m, v0 = projectile.m, projectile.V0
+
+    def balance(v):
+        return m * (v0 ** 2 - v ** 2) - depth * force(v)
+
+    if balance(0.0) <= 0.0:
+        raise CavexNumericalError(
+            f"projectile stops inside the crater (V0={v0} m/s, crater depth {depth} m)")
+    vc = brentq(balance, 0.0, v0, xtol=1e-13, rtol=1e-15)
+    return vc, m * (v0 ** 2 - vc ** 2) / depth ** 2
+
+
+def crater_stage(projectile, force, depth, samples=50):
+    """Crater trajectory samples ``(t, L, V, a)`` and the exit ``(t_c, V_c)``."""
+    vc, stiffness = crater_exit(projectile, force, depth)
+    omega = math.sqrt(stiffness / projectile.m)
+    tc = math.acos(vc / projectile.V0) / omega
+    t = np.linspace(0.0, tc, samples)
+    depths = projectile.V0 / omega * np.sin(omega * t)
+    velocity = projectile.V0 * np.cos(omega * t)
+    return (t, depths, velocity, stiffness * depths / projectile.m), tc, vc
+
+
+def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=1e-10, atol=1e-12):
+    """Integrate the projectile through the target.
+
+    Parameters
+    ----------
+    target, projectile : Target, Projectile
+    resistance : object
+        Has ``force(depth, velocity)``, ``label(depth, velocity)`` and ``crater_force(velocity)``.
+    crater : {"nose-base", "nose-tip"}
+        Where the crater depth ``4.5 r`` is measured from; ``None`` skips the crater stage.
+
+    Returns
+    -------
+    Trajectory
+    """
+    columns = [[] for _ in range(5)]
+    phases = []
+    t0, depth0, v0 = 0.0, 0.0, projectile.V0
+    if crater is not None:
+        depth0 = crater_depth(projectile, crater)
+        samples, t0, v0 = crater_stage(projectile, resistance.crater_force, depth0)
+        _append(columns, *samples, 0)
+        phases.append(Phase("crater", depth0, v0, t0, "crater depth reached"))
+    return _tunnel(target, projectile, resistance, (t0, depth0, v0), columns, phases,
+                   rtol=rtol, atol=atol)
+
+
+def _tunnel(target, projectile, resistance, start, columns, phases, rtol, atol):
+    t0, depth0, v0 = start
+    m = projectile.m
+    label = resistance.label(depth0, v0)
+
+    def rhs(t, y):
+        return (y[1], -resistance.force(y[0], max(y[1], 0.0)) / m)
+
+    while v0 > 0.0:
+        events = _phase_events(target, resistance, depth0, label)
+        sol = solve_ivp(rhs, (t0, t0 + MAX_PHASE_DURATION), (depth0, v0),
+                        method="DOP853", events=[e for e, _ in events], dense_output=True,
+                        rtol=rtol, atol=atol)
+        if sol.status != 1:
+            raise CavexNumericalError(f"penetration integration failed at t={sol.t[-1]} s, "
+                                      f"depth {sol.y[0, -1]} m: {sol.message}")
+        which = next(i for i, te in enumerate(sol.t_events) if te.size)
+        t_end, (depth_end, v_end) = sol.t_events[which][0], sol.y_events[which][0]
+        v_end = 0.0 if events[which][1] == "projectile stopped" else v_end
+        _append_solution(columns, sol, t_end, rhs, len(phases))
+        phases.append(Phase(label, depth_end, v_end, t_end, events[which][1]))
+        t0, depth0, v0 = t_end, depth_end, v_end
+        if v0 > 0.0:
+            label = _next_label(resistance, sol, t_end, label)
+    return _trajectory(columns, phases)
+
+
+def _phase_events(target, resistance, depth, label):
+    """Terminal events of one tunnel phase, each with the reason it ends the phase."""
+
+    def stopped(t, y):
+        return y[1]
+
+    def state_changed(t, y):
+        return 1.0 if resistance.label(y[0], max(y[1], 0.0)) == label else -1.0
+
+    stopped.direction = state_changed.direction = -1.0
+    events = [(stopped, "projectile stopped"), (state_changed, "response state changed")]
+    for i, H in enumerate(target.interface_depths):
+        if H > depth:
+            events.append((_depth_event(H), f"nose tip reached interface {i + 1}"))
+    for event, _ in events:
+        event.terminal = True
+    return events
+
+
+def _depth_event(depth):
+    def reached(t, y):
+        return y[0] - depth
+
+    reached.direction = 1.0
+    return reached
+
+
+def _next_label(resistance, sol, t_end, label):
+    """Label just past a phase end (the event root may sit on either side of the jump)."""
+    for nudge in (0.0, 1e-13, 1e-11, 1e-9):
+        depth, v = sol.sol(t_end * (1.0 + nudge))
+        new = resistance.label(depth, max(v, 0.0))
+        if new != label:
+            return new
+    return label
+
+
+def _append(columns, t, depth, velocity, deceleration, phase):
+    for column, values in zip(columns, (t, depth, velocity, deceleration,
+                                        np.full(len(t), phase)), strict=True):
+        column.append(np.asarray(values, dtype=float))
+
+
+def _append_solution(columns, sol, t_end, rhs, phase):
+    t = np.append(sol.t[sol.t < t_end], t_end)
+    y = sol.sol(t)
+    deceleration = np.array([-rhs(ti, yi)[1] for ti, yi in zip(t, y.T, strict=True)])
+    _append(columns, t, y[0], np.maximum(y[1], 0.0), deceleration, phase)
+
+
+def _trajectory(columns, phases):
+    t, depth, velocity, deceleration, phase = (np.concatenate(c) for c in columns)
+    return Trajectory(t, depth, velocity, deceleration, phase.astype(int), tuple(phases))
