@@ -3,8 +3,10 @@
 Public entry points: :func:`expand_cavity`, :func:`write_result`, :func:`compare_at_depth`.
 """
 
+from cavex.fem.compare import compare_at_depth
 from cavex.fem.expansion import expand_cavity
+from cavex.fem.output import write_result
 from cavex.fem.result import ExpansionResult
 from cavex.fem.settings import Numerics
 
-__all__ = ["ExpansionResult", "Numerics", "expand_cavity"]
+__all__ = ["ExpansionResult", "Numerics", "compare_at_depth", "expand_cavity", "write_result"]

@@ -19,7 +19,7 @@ from cavex.fem.result import ExpansionResult
 from cavex.fem.settings import make_numerics
 from cavex.fem.solver import RadialSolver
 
-from cavex.errors import CavexNumericalError
+from cavex.errors import CavexNumericalError, require
 
 
 def radius_schedule(radius, seed_radius, growth_per_step):
@@ -28,10 +28,22 @@ def radius_schedule(radius, seed_radius, growth_per_step):
     return seed_radius * (radius / seed_radius) ** (np.arange(1, n + 1) / n)
 
 
+def seed_radius(radius, numerics):
+    """Seed cavity radius ``a0`` (m) of the settings."""
+    if numerics.seed_radius is not None:
+        return numerics.seed_radius
+    return radius / numerics.seed_ratio
+
+
+def outer_radius(radius, interfaces, numerics):
+    """Outer boundary (final configuration): ``outer_ratio * radius``, and >= 3x every interface."""
+    return max(numerics.outer_ratio * radius, 3.0 * max(interfaces, default=0.0))
+
+
 def build_model(layers, interfaces, radius, numerics):
     """Reference mesh and discretisation of the problem; also the interface vertex indices."""
-    seed = radius / numerics.seed_ratio
-    mesh, iface_vertices = reference_mesh(radius, seed, interfaces, numerics.outer_ratio * radius,
+    mesh, iface_vertices = reference_mesh(radius, seed_radius(radius, numerics), interfaces,
+                                          outer_radius(radius, interfaces, numerics),
                                           numerics.elements_per_decade)
     disc = Discretisation(mesh, numerics.degree, element_layers(mesh, iface_vertices), layers,
                           numerics.dilatancy_deg, numerics.tension_cutoff)
@@ -50,8 +62,10 @@ def run_expansion(layers, interfaces, velocity, radius, numerics):
     seed = disc.R_dofs[0]
     radii = radius_schedule(radius, seed, numerics.growth_per_step)
     history = {"time": [0.0], "radius": [seed], "wall_stress": [0.0], "plastic_radius": [seed]}
+    keep = set(np.linspace(0, len(radii) - 1, min(numerics.snapshots, len(radii))).astype(int))
+    snapshots = []
     previous = seed
-    for a in radii:
+    for step, a in enumerate(radii):
         dt = (a - previous) / velocity if dynamic else 1.0
         try:
             solver.advance(a - seed, dt)
@@ -64,12 +78,14 @@ def run_expansion(layers, interfaces, velocity, radius, numerics):
         history["wall_stress"].append(wall_stress(disc, solver.u, solver.wall_force))
         history["plastic_radius"].append(plastic_radius(disc, solver.u, solver.response,
                                                         solver.state))
+        if step in keep:
+            snapshots.append(snapshot(disc, solver))
     sigma_r, sigma_t = cauchy_stresses(disc, solver.u, solver.response)
     r_nodes = disc.R_dofs + solver.u
     fields = {"r": current_point_radii(disc, solver.u).ravel(), "sigma_r": sigma_r.ravel(),
               "sigma_theta": sigma_t.ravel(), "plastic_strain": solver.state["eq_p"].ravel(),
               "layer": disc.point_layer.ravel(), "r_nodes": r_nodes, "R_nodes": disc.R_dofs.copy(),
-              "u": solver.u.copy()}
+              "u": solver.u.copy(), "snapshots": snapshots}
     ends = tuple(float(r_nodes[disc.degree * v]) for v in iface_vertices)
     settings = {"layers": [asdict(m) for m in layers], "interfaces": [float(h) for h in interfaces],
                 "velocity": float(velocity), "radius": float(radius),
@@ -84,6 +100,14 @@ def run_expansion(layers, interfaces, velocity, radius, numerics):
                            fields=fields, error_estimate=None,
                            plastic_radius=float(history["plastic_radius"][-1]),
                            interfaces_final=ends, settings=settings, energy=energy, stats=stats)
+
+
+def snapshot(disc, solver):
+    """Element-averaged fields and nodal displacement of the current state (for output)."""
+    sigma_r, sigma_t = cauchy_stresses(disc, solver.u, solver.response)
+    return {"time": solver.t, "u": solver.u[::disc.degree].copy(),
+            "sigma_r": sigma_r.mean(axis=1), "sigma_theta": sigma_t.mean(axis=1),
+            "plastic_strain": solver.state["eq_p"].mean(axis=1)}
 
 
 def richardson_error(fine, coarse, order=2.0, refinement=2.0):
@@ -123,6 +147,8 @@ def expand_cavity(layers, interfaces, velocity, radius, **numerics):
     interfaces = [float(h) for h in interfaces]
     check_problem(layers, interfaces, float(velocity), float(radius), "dynamic")
     settings = make_numerics(**numerics)
+    require(settings.seed_radius is None or settings.seed_radius < radius, "seed_radius",
+            f"in (0, radius = {radius})", settings.seed_radius)
     result = run_expansion(layers, interfaces, float(velocity), float(radius), settings)
     if settings.error_estimate:
         coarse = run_expansion(layers, interfaces, float(velocity), float(radius),

@@ -24,6 +24,8 @@ class Numerics:
         > 1 and beyond every interface that matters.
     seed_ratio : float
         Final over seed cavity radius ``a/a0``, > 1.
+    seed_radius : float or None
+        Seed cavity radius ``a0`` (m), in (0, radius); overrides ``seed_ratio`` when given.
     growth_per_step : float
         Relative growth of the cavity radius per time step, ``da/a``, in (0, 1].
     rho_inf : float
@@ -44,12 +46,15 @@ class Numerics:
         Step halvings allowed before a Newton failure is reported, >= 0.
     error_estimate : bool
         Also run at half resolution (space and time) and Richardson-estimate the error.
+    snapshots : int
+        Number of field snapshots kept for output (evenly spread over the steps), >= 1.
     """
 
     degree: int = 2
     elements_per_decade: float = 30.0
     outer_ratio: float = 1000.0
     seed_ratio: float = 20.0
+    seed_radius: float | None = None
     growth_per_step: float = 0.03
     rho_inf: float = 0.0
     dynamic: bool = True
@@ -60,6 +65,7 @@ class Numerics:
     newton_tol: float = 1e-8
     max_cutbacks: int = 10
     error_estimate: bool = True
+    snapshots: int = 20
 
     def __post_init__(self):
         check_numerics(self)
@@ -105,6 +111,10 @@ def check_numerics(n):
             and n.max_cutbacks >= 0, "max_cutbacks", "an integer >= 0", n.max_cutbacks)
     require(isinstance(n.error_estimate, bool), "error_estimate", "True or False",
             n.error_estimate)
+    require(n.seed_radius is None or (_finite(n.seed_radius) and n.seed_radius > 0),
+            "seed_radius", "None or a finite number > 0 and < radius", n.seed_radius)
+    require(isinstance(n.snapshots, int) and not isinstance(n.snapshots, bool)
+            and n.snapshots >= 1, "snapshots", "an integer >= 1", n.snapshots)
 
 
 def make_numerics(**overrides):

@@ -1,0 +1,101 @@
+"""The public API: result contents, bad input, Newton failure, meshio output, compare_at_depth."""
+
+import json
+
+import meshio
+import numpy as np
+import pytest
+from cavex.fem import compare_at_depth, expand_cavity, write_result
+
+from cavex import load_config
+from cavex.errors import CavexInputError, CavexNumericalError
+from cavex.materials import Material
+
+CONCRETE = Material(E=25e9, nu=0.4999, rho=2500.0, lam=0.15, tau=25e6, name="concrete")
+SOIL = Material(E=0.12e9, nu=0.4999, rho=1600.0, lam=0.5, tau=6e6, name="soil")
+
+
+@pytest.fixture(scope="module")
+def default_run():
+    return expand_cavity([CONCRETE], [], 500.0, 0.0125)
+
+
+def test_result_has_history_fields_estimate_and_settings(default_run):
+    r = default_run
+    h = r.history
+    assert set(h) == {"time", "radius", "wall_stress", "plastic_radius"}
+    assert h["radius"][0] == pytest.approx(0.0125 / 20) and h["radius"][-1] == pytest.approx(0.0125)
+    assert h["time"][-1] == pytest.approx((0.0125 - 0.0125 / 20) / 500.0)
+    assert r.cavity_stress == h["wall_stress"][-1] > 0
+    assert r.fields["r"].shape == r.fields["sigma_r"].shape == r.fields["plastic_strain"].shape
+    assert r.fields["r_nodes"][0] == pytest.approx(0.0125, rel=1e-12)
+    # default run: estimated discretisation error <= 0.5 % (measured 0.15 %)
+    assert 0 < r.error_estimate < 0.005
+    assert r.plastic_radius > 5 * 0.0125
+    assert r.settings["numerics"]["elements_per_decade"] == 30.0
+    again = expand_cavity([CONCRETE], [], 500.0, 0.0125, **r.settings["numerics"])
+    assert again.cavity_stress == r.cavity_stress
+
+
+def test_interfaces_land_where_asked():
+    r = expand_cavity([CONCRETE, SOIL], [0.05], 300.0, 0.0125, error_estimate=False)
+    # incompressible placement R^3 = r^3 - a^3 + a0^3; nu = 0.4999 leaves a 1e-6 offset
+    assert r.interfaces_final[0] == pytest.approx(0.05, rel=1e-5)
+
+
+@pytest.mark.parametrize(("kwargs", "name"), [
+    ({"seed_ratio": 1.0}, "seed_ratio"), ({"seed_radius": 0.0125}, "seed_radius"),
+    ({"seed_radius": 0.02}, "seed_radius"), ({"growth_per_step": 0.0}, "growth_per_step"),
+    ({"growth_per_step": -0.1}, "growth_per_step"),
+    ({"elements_per_decade": 0}, "elements_per_decade"),
+    ({"degree": 3}, "degree"), ({"outer_ratio": 0.5}, "outer_ratio"), ({"rho_inf": 2.0}, "rho_inf"),
+    ({"outer": "open"}, "outer"), ({"bogus": 1}, "bogus"), ({"max_cutbacks": -1}, "max_cutbacks"),
+])
+def test_impossible_numerics_are_input_errors(kwargs, name):
+    with pytest.raises(CavexInputError, match=f"'{name}'") as info:
+        expand_cavity([CONCRETE], [], 500.0, 0.0125, **kwargs)
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(("args", "name"), [
+    (([CONCRETE], [], -1.0, 0.0125), "velocity"), (([CONCRETE], [], 500.0, 0.0), "radius"),
+    (([CONCRETE, SOIL], [], 500.0, 0.0125), "interfaces"),
+    (([CONCRETE, SOIL], [0.01], 500.0, 0.0125), "interfaces[0]"),
+    (([], [], 500.0, 0.0125), "layers"), (([CONCRETE], [], float("nan"), 0.0125), "velocity"),
+])
+def test_bad_problem_is_an_input_error(args, name):
+    with pytest.raises(CavexInputError, match=name.replace("[", r"\[")):
+        expand_cavity(*args)
+
+
+def test_newton_failure_names_velocity_step_and_radius():
+    with pytest.raises(CavexNumericalError, match=r"V = 500 m/s.*radius.*cut-backs"):
+        expand_cavity([CONCRETE], [], 500.0, 0.0125, newton_tol=1e-30, max_cutbacks=1,
+                      error_estimate=False)
+
+
+def test_write_result_is_a_paraview_time_series(default_run, tmp_path):
+    pvd = write_result(default_run, tmp_path / "run")
+    assert pvd.suffix == ".pvd" and "<DataSet" in pvd.read_text()
+    vtus = sorted(tmp_path.glob("run_*.vtu"))
+    assert len(vtus) == len(default_run.fields["snapshots"]) == 20
+    last = meshio.read(vtus[-1])
+    assert last.points[0, 0] == pytest.approx(0.0125, rel=1e-9)
+    assert np.all(last.cell_data["sigma_r"][0][:5] > 0)
+    history = np.loadtxt(tmp_path / "run_history.csv", delimiter=",", skiprows=1)
+    assert history[-1, 2] == pytest.approx(default_run.cavity_stress)
+
+
+def test_compare_at_depth_is_json_and_side_by_side():
+    target, projectile = load_config()
+    out = compare_at_depth(target, projectile, 0.5, 500.0, error_estimate=False)
+    json.dumps(out)
+    assert out["layers"] == ["concrete", "macadam", "soil"]
+    assert out["interfaces"] == pytest.approx([0.21, 0.66])
+    assert set(out["analytic_sigma_r"]) == {"dynamic", "quasi-static"}
+    diff = out["relative_difference"]["dynamic"]
+    assert diff == pytest.approx(out["fe_sigma_r"] / out["analytic_sigma_r"]["dynamic"] - 1)
+    # layered, nu = 0.4999: FE 1.4 % below the incompressible closed form (compressibility)
+    assert -0.03 < diff < 0
+    assert compare_at_depth(target, projectile, 0.5, 500.0, nu=0.49,
+                            error_estimate=False)["fe_sigma_r"] < out["fe_sigma_r"]
