@@ -40,6 +40,25 @@ def outer_radius(radius, interfaces, numerics):
     return max(numerics.outer_ratio * radius, 3.0 * max(interfaces, default=0.0))
 
 
+def wall_times(radii, seed, velocity, ramp):
+    """Times at which the wall reaches ``radii`` (m).
+
+    Constant velocity ``V`` from rest position ``seed``; with ``ramp > 0`` the wall velocity
+    first rises smoothly, ``V sin^2(pi t / (2 t_r))`` over ``t_r = ramp * seed / V``, so that
+    the seed's start does not launch a pressure pulse (a(t) = a0 + V (t/2 - t_r sin(pi t/t_r)
+    / (2 pi)) during the ramp, then ``V`` constant).
+    """
+    if ramp == 0:
+        return (np.asarray(radii) - seed) / velocity
+    t_r = ramp * seed / velocity
+    t = np.linspace(0.0, t_r, 2001)
+    a_ramp = seed + velocity * (t / 2 - t_r * np.sin(np.pi * t / t_r) / (2 * np.pi))
+    a_end = a_ramp[-1]
+    radii = np.asarray(radii)
+    return np.where(radii <= a_end, np.interp(radii, a_ramp, t),
+                    t_r + (radii - a_end) / velocity)
+
+
 def build_model(layers, interfaces, radius, numerics):
     """Reference mesh and discretisation of the problem; also the interface vertex indices."""
     mesh, iface_vertices = reference_mesh(radius, seed_radius(radius, numerics), interfaces,
@@ -58,15 +77,16 @@ def run_expansion(layers, interfaces, velocity, radius, numerics):
     solver = RadialSolver(disc, dynamic=dynamic, rho_inf=numerics.rho_inf, outer=numerics.outer,
                           assembly=numerics.assembly, newton_tol=numerics.newton_tol,
                           max_cutbacks=numerics.max_cutbacks,
-                          wall_velocity=velocity if dynamic else 0.0)
+                          wall_velocity=velocity if dynamic and numerics.start_ramp == 0 else 0.0)
     seed = disc.R_dofs[0]
     radii = radius_schedule(radius, seed, numerics.growth_per_step)
+    times = wall_times(radii, seed, velocity, numerics.start_ramp) if dynamic else None
     history = {"time": [0.0], "radius": [seed], "wall_stress": [0.0], "plastic_radius": [seed]}
     keep = set(np.linspace(0, len(radii) - 1, min(numerics.snapshots, len(radii))).astype(int))
     snapshots = []
     previous = seed
     for step, a in enumerate(radii):
-        dt = (a - previous) / velocity if dynamic else 1.0
+        dt = times[step] - solver.t if dynamic else 1.0
         try:
             solver.advance(a - seed, dt)
         except CavexNumericalError as exc:

@@ -48,6 +48,8 @@ class Numerics:
         Also run at half resolution (space and time) and Richardson-estimate the error.
     snapshots : int
         Number of field snapshots kept for output (evenly spread over the steps), >= 1.
+    start_ramp : float
+        Duration of a smooth velocity start, in units of ``a0/V`` (>= 0; 0 = sudden start).
     """
 
     degree: int = 2
@@ -66,6 +68,7 @@ class Numerics:
     max_cutbacks: int = 10
     error_estimate: bool = True
     snapshots: int = 20
+    start_ramp: float = 0.0
 
     def __post_init__(self):
         check_numerics(self)
@@ -113,6 +116,8 @@ def check_numerics(n):
             n.error_estimate)
     require(n.seed_radius is None or (_finite(n.seed_radius) and n.seed_radius > 0),
             "seed_radius", "None or a finite number > 0 and < radius", n.seed_radius)
+    require(_finite(n.start_ramp) and n.start_ramp >= 0, "start_ramp", "a finite number >= 0",
+            n.start_ramp)
     require(isinstance(n.snapshots, int) and not isinstance(n.snapshots, bool)
             and n.snapshots >= 1, "snapshots", "an integer >= 1", n.snapshots)
 
