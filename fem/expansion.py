@@ -84,7 +84,6 @@ def run_expansion(layers, interfaces, velocity, radius, numerics):
     history = {"time": [0.0], "radius": [seed], "wall_stress": [0.0], "plastic_radius": [seed]}
     keep = set(np.linspace(0, len(radii) - 1, min(numerics.snapshots, len(radii))).astype(int))
     snapshots = []
-    previous = seed
     for step, a in enumerate(radii):
         dt = times[step] - solver.t if dynamic else 1.0
         try:
@@ -92,7 +91,6 @@ def run_expansion(layers, interfaces, velocity, radius, numerics):
         except CavexNumericalError as exc:
             raise CavexNumericalError(f"V = {velocity:g} m/s, step to cavity radius {a:.6g} m: "
                                       f"{exc}") from None
-        previous = a
         history["time"].append(solver.t if dynamic else 0.0)
         history["radius"].append(a)
         history["wall_stress"].append(wall_stress(disc, solver.u, solver.wall_force))
