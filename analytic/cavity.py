@@ -88,19 +88,33 @@ def power_integral(p, x):
     return math.expm1(p * math.log(x)) / p
 
 
+def elastic_terms(material, y_out, y_in):
+    """``(1, static, inertial)``: elastic ``s_i = s_o + static + rho V^2 inertial``."""
+    return (1.0, (4.0 * material.E / 9.0) * (y_in ** 3 - y_out ** 3),
+            2.0 * ((y_in - y_out) - 0.25 * (y_in ** 4 - y_out ** 4)))
+
+
+def plastic_terms(material, y_out, y_in):
+    """``(x^(2 alpha), static, inertial)`` of a plastic piece, ``x = y_in / y_out``:
+    ``s_i = x^(2 alpha) s_o + static + rho V^2 inertial``, ``x = y_in / y_out``.
+    """
+    two_alpha = 2.0 * material.alpha
+    x = y_in / y_out
+    return (x ** two_alpha, 2.0 * material.yield_intercept * power_integral(two_alpha, x),
+            2.0 * (y_in * power_integral(two_alpha - 1.0, x)
+                   - y_in ** 4 * power_integral(two_alpha - 4.0, x)))
+
+
 def elastic_step(material, s_out, y_out, y_in, rho_v2):
     """``sigma_r`` at ``y_in`` from its value ``s_out`` at ``y_out`` through elastic material."""
-    return (s_out + (4.0 * material.E / 9.0) * (y_in ** 3 - y_out ** 3)
-            + 2.0 * rho_v2 * ((y_in - y_out) - 0.25 * (y_in ** 4 - y_out ** 4)))
+    _, static, inertial = elastic_terms(material, y_out, y_in)
+    return s_out + static + rho_v2 * inertial
 
 
 def plastic_step(material, s_out, y_out, y_in, rho_v2):
     """``sigma_r`` at ``y_in`` from its value ``s_out`` at ``y_out`` through plastic material."""
-    two_alpha = 2.0 * material.alpha
-    x = y_in / y_out
-    return (x ** two_alpha * s_out + 2.0 * material.yield_intercept * power_integral(two_alpha, x)
-            + 2.0 * rho_v2 * (y_in * power_integral(two_alpha - 1.0, x)
-                              - y_in ** 4 * power_integral(two_alpha - 4.0, x)))
+    amplification, static, inertial = plastic_terms(material, y_out, y_in)
+    return amplification * s_out + static + rho_v2 * inertial
 
 
 def yield_function(material, y, s, boundary):
@@ -185,6 +199,15 @@ def cavity_solution(layers, interfaces, velocity, radius, *, boundary="dynamic")
 
 def solve_checked(layers, interfaces, velocity, radius, boundary):
     """:func:`cavity_solution` for an already validated problem (hot loops skip the checks)."""
+    s, zones = wall_stress(layers, interfaces, velocity, radius, boundary)
+    b = zones[-1][2] if zones else radius
+    return CavityState(stress=s, S=s / layers[0].tau, radius=radius, velocity=velocity,
+                       plastic_radius=b, plastic_zones=tuple(zones),
+                       state=response_state(zones, interfaces, radius), boundary=boundary)
+
+
+def wall_stress(layers, interfaces, velocity, radius, boundary):
+    """``(sigma_r(a), plastic zones)`` of a validated problem: the outside-in walk."""
     s, y_out, zones = 0.0, 0.0, []
     for i in range(len(layers) - 1, -1, -1):
         material = layers[i]
@@ -197,14 +220,31 @@ def solve_checked(layers, interfaces, velocity, radius, boundary):
         else:
             s = elastic_step(material, s, y_out, y_yield, rho_v2)
             s = plastic_step(material, s, y_yield, y_in, rho_v2)
-            r_yield = interfaces[i] if y_yield == y_out else radius / y_yield
-            zones.append((i, r_in, r_yield))
+            zones.append((i, r_in, interfaces[i] if y_yield == y_out else radius / y_yield))
         y_out = y_in
     zones.reverse()
-    b = zones[-1][2] if zones else radius
-    return CavityState(stress=s, S=s / layers[0].tau, radius=radius, velocity=velocity,
-                       plastic_radius=b, plastic_zones=tuple(zones),
-                       state=response_state(zones, interfaces, radius), boundary=boundary)
+    return s, zones
+
+
+def quasi_static_coefficients(layers, interfaces, radius):
+    """``(sigma_0, sigma_2)`` with ``sigma_r(a) = sigma_0 + sigma_2 V^2`` (quasi-static, exact).
+
+    One walk carrying both parts: the quasi-static yield radii depend on neither ``V`` nor
+    ``sigma_r``, so the solution is affine in ``V^2``.
+    """
+    static, per_v2, y_out = 0.0, 0.0, 0.0
+    for i in range(len(layers) - 1, -1, -1):
+        material = layers[i]
+        y_in = radius / interfaces[i - 1] if i > 0 else 1.0
+        y_yield = yield_point(material, 0.0, y_out, y_in, 0.0, 0.0, "quasi-static")
+        pieces = (((elastic_terms, y_out, y_in),) if y_yield is None else
+                  ((elastic_terms, y_out, y_yield), (plastic_terms, y_yield, y_in)))
+        for terms, y0, y1 in pieces:
+            amplification, s0, s2 = terms(material, y0, y1)
+            static = amplification * static + s0
+            per_v2 = amplification * per_v2 + material.rho * s2
+        y_out = y_in
+    return static, per_v2
 
 
 def cavity_stress(layers, interfaces, velocity, radius, *, boundary="dynamic"):

@@ -87,7 +87,7 @@ def crater_stage(projectile, force, depth, samples=50):
     return (t, depths, velocity, stiffness * depths / projectile.m), tc, vc
 
 
-def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=1e-10, atol=1e-12):
+def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=1e-9, atol=1e-12):
     """Integrate the projectile through the target.
 
     Parameters
@@ -122,8 +122,9 @@ def _tunnel(target, projectile, resistance, start, columns, phases, rtol, atol):
     def rhs(t, y):
         return (y[1], -resistance.force(y[0], max(y[1], 0.0)) / m)
 
+    ahead = [H for H in target.interface_depths if H > depth0]
     while v0 > 0.0:
-        events = _phase_events(target, resistance, depth0, label)
+        events = _phase_events(resistance, ahead, len(target.interface_depths), label)
         sol = solve_ivp(rhs, (t0, t0 + MAX_PHASE_DURATION), (depth0, v0),
                         method="DOP853", events=[e for e, _ in events], dense_output=True,
                         rtol=rtol, atol=atol)
@@ -132,17 +133,24 @@ def _tunnel(target, projectile, resistance, start, columns, phases, rtol, atol):
                                       f"depth {sol.y[0, -1]} m: {sol.message}")
         which = next(i for i, te in enumerate(sol.t_events) if te.size)
         t_end, (depth_end, v_end) = sol.t_events[which][0], sol.y_events[which][0]
-        v_end = 0.0 if events[which][1] == "projectile stopped" else v_end
+        reason = events[which][1]
+        if reason == "projectile stopped":
+            v_end = 0.0
+        elif reason.startswith("nose tip"):
+            ahead.pop(0)
         _append_solution(columns, sol, t_end, rhs, len(phases))
-        phases.append(Phase(label, depth_end, v_end, t_end, events[which][1]))
+        phases.append(Phase(label, depth_end, v_end, t_end, reason))
         t0, depth0, v0 = t_end, depth_end, v_end
         if v0 > 0.0:
             label = _next_label(resistance, sol, t_end, label)
     return _trajectory(columns, phases)
 
 
-def _phase_events(target, resistance, depth, label):
-    """Terminal events of one tunnel phase, each with the reason it ends the phase."""
+def _phase_events(resistance, ahead, n_interfaces, label):
+    """Terminal events of one tunnel phase, each with the reason it ends the phase.
+
+    ``ahead`` are the interface depths not yet crossed by the nose tip (only the next counts).
+    """
 
     def stopped(t, y):
         return y[1]
@@ -152,9 +160,9 @@ def _phase_events(target, resistance, depth, label):
 
     stopped.direction = state_changed.direction = -1.0
     events = [(stopped, "projectile stopped"), (state_changed, "response state changed")]
-    for i, H in enumerate(target.interface_depths):
-        if H > depth:
-            events.append((_depth_event(H), f"nose tip reached interface {i + 1}"))
+    if ahead:
+        number = n_interfaces - len(ahead) + 1
+        events.append((_depth_event(ahead[0]), f"nose tip reached interface {number}"))
     for event, _ in events:
         event.terminal = True
     return events

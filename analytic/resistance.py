@@ -5,7 +5,7 @@ A resistance model answers two questions for the integrator: the axial nose forc
 single-medium (first layer) model that the crater stage uses (paper Eq. 34).
 """
 
-from cavex.analytic.cavity import solve_checked
+from cavex.analytic.cavity import quasi_static_coefficients, solve_checked, wall_stress
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.analytic.nose import nose_force, ogive_coefficients
 
@@ -50,16 +50,14 @@ class ClosedFormResistance:
             return self._quadratic_force(layers, interfaces, velocity)
         r = self.projectile.r
 
-        def wall_stress(v):
-            return solve_checked(layers, interfaces, v, r, self.boundary).stress
+        def stress(v):
+            return wall_stress(layers, interfaces, v, r, self.boundary)[0]
 
-        return nose_force(self.projectile, wall_stress, velocity)
+        return nose_force(self.projectile, stress, velocity)
 
     def _quadratic_force(self, layers, interfaces, velocity):
-        r = self.projectile.r
-        static = solve_checked(layers, interfaces, 0.0, r, "quasi-static").stress
-        unit = solve_checked(layers, interfaces, 1.0, r, "quasi-static").stress
-        c_a, c_b = ogive_coefficients(self.projectile, static, unit - static, 1.0, 1.0)
+        static, per_v2 = quasi_static_coefficients(layers, interfaces, self.projectile.r)
+        c_a, c_b = ogive_coefficients(self.projectile, static, per_v2, 1.0, 1.0)
         return c_a + c_b * velocity ** 2
 
     def _paper_force(self, depth, velocity):

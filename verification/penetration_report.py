@@ -1,0 +1,86 @@
+"""The ``cavex penetrate`` job: trajectories, the Table 2 comparison, CSV and PNG outputs."""
+
+import csv
+import os
+from pathlib import Path
+
+from cavex.analytic.penetration import penetrate
+from cavex.analytic.resistance import ClosedFormResistance
+from cavex.verification.table2 import table2_comparison
+
+
+def penetration_job(target, projectile, *, model="derived", boundary="quasi-static",
+                    epsilon="quasi-static", crater="nose-base"):
+    """Run the target and its first layer alone (the paper's Fig. 4 pair); nothing is written."""
+    runs = {}
+    for name, tgt in (("runway", target), ("first_layer_only", target.single(0))):
+        resistance = ClosedFormResistance(tgt, projectile, model, boundary, epsilon=epsilon)
+        runs[name] = penetrate(tgt, projectile, resistance, crater=crater)
+    return {"model": model, "boundary": boundary, "epsilon": epsilon, "crater": crater,
+            "runs": runs, "table2": table2_comparison(runs["runway"])}
+
+
+def phases_as_dicts(trajectory):
+    """The phase table as JSON-able rows."""
+    return [{"phase": i + 1, "label": p.label, "end_depth_m": p.end_depth,
+             "end_velocity_m_s": p.end_velocity, "end_time_s": p.end_time,
+             "end_reason": p.end_reason} for i, p in enumerate(trajectory.phases)]
+
+
+def write_outputs(job, out_dir):
+    """Write CSV trajectories, the phase table and PNG figures; return the written paths."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, trajectory in job["runs"].items():
+        written.append(_write_csv(out / f"trajectory_{name}.csv", trajectory.as_columns()))
+    written.append(_write_csv(out / "phases_runway.csv",
+                              _columns(phases_as_dicts(job["runs"]["runway"]))))
+    written += _write_figures(job, out)
+    return [str(p) for p in written]
+
+
+def _columns(rows):
+    return {key: [row[key] for row in rows] for key in rows[0]}
+
+
+def _write_csv(path, columns):
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    with open(tmp, "w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(columns)
+        writer.writerows(zip(*columns.values(), strict=True))
+    os.replace(tmp, path)
+    return path
+
+
+def _write_figures(job, out):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    runway, single = job["runs"]["runway"], job["runs"]["first_layer_only"]
+    title = f"{job['model']} model, {job['boundary']} boundary"
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(runway.t * 1e3, runway.velocity, label="runway (layered)")
+    ax.plot(single.t * 1e3, single.velocity, "--", label="first layer alone")
+    ax.set(xlabel="time (ms)", ylabel="velocity (m/s)", title=f"Velocity vs time: {title}")
+    ax.legend()
+    velocity_png = _save(fig, out / "velocity_time.png", plt)
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(runway.depth, runway.deceleration / 9.81 / 1e3, label="runway (layered)")
+    ax.plot(single.depth, single.deceleration / 9.81 / 1e3, "--", label="first layer alone")
+    ax.set(xlabel="nose depth (m)", ylabel="deceleration (10^3 g)",
+           title=f"Deceleration vs depth: {title}")
+    ax.legend()
+    return [velocity_png, _save(fig, out / "deceleration_depth.png", plt)]
+
+
+def _save(fig, path, plt):
+    tmp = path.with_name(path.stem + ".tmp.png")
+    fig.tight_layout()
+    fig.savefig(tmp, dpi=120)
+    plt.close(fig)
+    os.replace(tmp, path)
+    return path

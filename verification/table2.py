@@ -1,0 +1,49 @@
+"""The paper's Table 2 and how a computed trajectory's phases map onto its rows.
+
+Row definitions (She 2020, text under Table 2):
+
+1. crater: end of the crater stage;
+2. "before b reaches H1": the first phase end at which the response state leaves ``a``
+   (the elastic-plastic boundary reaches the concrete-macadam interface);
+3. "b past H1, still in concrete": the nose tip reaches ``H1``;
+4. "in macadam": the projectile stops.
+"""
+
+PAPER_TABLE2 = (
+    {"phase": 1, "name": "crater", "depth_m": 0.12, "velocity_m_s": 894.7, "time_s": 0.12e-3},
+    {"phase": 2, "name": "before b reaches H1", "depth_m": 0.40, "velocity_m_s": 506.4,
+     "time_s": 0.53e-3},
+    {"phase": 3, "name": "b past H1, still in concrete", "depth_m": 0.65, "velocity_m_s": 284.3,
+     "time_s": 1.20e-3},
+    {"phase": 4, "name": "in macadam (stop)", "depth_m": 0.79, "velocity_m_s": 0.0,
+     "time_s": 2.40e-3},
+)
+
+# The older runway formula the paper quotes (its ref. 10): velocity after the concrete layer.
+PAPER_REF10_EXIT_VELOCITY = 283.39
+
+
+def table2_rows(trajectory):
+    """Our ``(depth, velocity, time)`` at the end of each Table 2 row, or None where absent."""
+    phases = trajectory.phases
+    crater = next((p for p in phases if p.label == "crater"), None)
+    left_a = next((p for p, q in zip(phases, phases[1:], strict=False)
+                   if p.label.endswith("(a)") and not q.label.endswith("(a)")), None)
+    at_h1 = next((p for p in phases if p.end_reason == "nose tip reached interface 1"), None)
+    stop = phases[-1] if phases and phases[-1].end_reason == "projectile stopped" else None
+    return [_row(p) for p in (crater, left_a, at_h1, stop)]
+
+
+def _row(phase):
+    if phase is None:
+        return None
+    return {"depth_m": phase.end_depth, "velocity_m_s": phase.end_velocity,
+            "time_s": phase.end_time}
+
+
+def table2_comparison(trajectory):
+    """List of ``{"phase", "name", "paper": {...}, "ours": {...} or None}``."""
+    return [{"phase": paper["phase"], "name": paper["name"],
+             "paper": {k: paper[k] for k in ("depth_m", "velocity_m_s", "time_s")},
+             "ours": ours}
+            for paper, ours in zip(PAPER_TABLE2, table2_rows(trajectory), strict=True)]
