@@ -99,3 +99,11 @@ def test_compare_at_depth_is_json_and_side_by_side():
     assert -0.03 < diff < 0
     assert compare_at_depth(target, projectile, 0.5, 500.0, nu=0.49,
                             error_estimate=False)["fe_sigma_r"] < out["fe_sigma_r"]
+
+
+def test_forms_path_reproduces_the_fast_path_over_a_dynamic_run():
+    kwargs = dict(elements_per_decade=15, growth_per_step=0.06, error_estimate=False)
+    fast = expand_cavity([CONCRETE, SOIL], [0.05], 500.0, 0.0125, **kwargs)
+    forms = expand_cavity([CONCRETE, SOIL], [0.05], 500.0, 0.0125, assembly="forms", **kwargs)
+    assert forms.cavity_stress == pytest.approx(fast.cavity_stress, rel=1e-10)
+    assert np.allclose(forms.fields["u"], fast.fields["u"], rtol=0, atol=1e-10 * 0.0125)
