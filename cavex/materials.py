@@ -7,9 +7,20 @@ from itertools import accumulate
 from cavex.errors import require
 
 
+def _is_number(value):
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 def _positive(name, value):
-    require(isinstance(value, (int, float)) and math.isfinite(value) and value > 0,
+    require(_is_number(value) and math.isfinite(value) and value > 0,
             name, "a finite number > 0", value)
+
+
+def _exactly_one(first, second, values):
+    given = [v is not None for v in values]
+    require(any(given), first, f"given (or {second} given)", None)
+    require(not all(given), second, f"omitted when {first} is given (one or the other)",
+            values[1])
 
 
 @dataclass(frozen=True)
@@ -47,12 +58,9 @@ class Material:
     def __post_init__(self):
         _positive("E", self.E)
         _positive("rho", self.rho)
-        require(isinstance(self.nu, (int, float)) and -1.0 < self.nu < 0.5,
-                "nu", "in (-1, 0.5)", self.nu)
-        require(isinstance(self.lam, (int, float)) and 0.0 <= self.lam < 3.0,
-                "lam", "in [0, 3)", self.lam)
-        require(self.tau is not None or self.sigma_c is not None,
-                "tau", "given (or sigma_c given)", None)
+        require(_is_number(self.nu) and -1.0 < self.nu < 0.5, "nu", "in (-1, 0.5)", self.nu)
+        require(_is_number(self.lam) and 0.0 <= self.lam < 3.0, "lam", "in [0, 3)", self.lam)
+        _exactly_one("tau", "sigma_c", (self.tau, self.sigma_c))
         if self.tau is None:
             _positive("sigma_c", self.sigma_c)
             object.__setattr__(self, "tau", (3.0 - self.lam) * self.sigma_c / 3.0)
@@ -142,7 +150,7 @@ class Projectile:
     def __post_init__(self):
         for name in ("r", "l", "m", "V0"):
             _positive(name, getattr(self, name))
-        require(self.R is not None or self.crh is not None, "R", "given (or crh given)", None)
+        _exactly_one("R", "crh", (self.R, self.crh))
         if self.R is None:
             _positive("crh", self.crh)
             object.__setattr__(self, "R", 2.0 * self.r * self.crh)

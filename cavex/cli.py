@@ -1,0 +1,142 @@
+"""The ``cavex`` command line: argument parsing and printing only; the work lives in the parts."""
+
+import argparse
+import json
+import sys
+
+from cavex.config import load_config
+from cavex.errors import CavexInputError, CavexNumericalError
+
+DEFAULT_PENETRATION_DIR = "results/penetration"
+
+
+class _Parser(argparse.ArgumentParser):
+    """Argument errors as one line on stderr and exit code 2."""
+
+    def error(self, message):
+        raise CavexInputError(message)
+
+
+def build_parser():
+    parser = _Parser(prog="cavex", description=__doc__)
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    penetrate = commands.add_parser("penetrate", help="integrate the projectile through the target")
+    _common(penetrate)
+    penetrate.add_argument("--out", default=DEFAULT_PENETRATION_DIR,
+                           help=f"output folder (default {DEFAULT_PENETRATION_DIR})")
+    penetrate.add_argument("--crater", choices=("nose-base", "nose-tip"), default="nose-base",
+                           help="where the crater depth 4.5 r is measured from")
+    stress = commands.add_parser("stress", help="cavity-wall stress at a nose depth")
+    _common(stress)
+    stress.add_argument("--velocity", type=float, required=True, help="expansion velocity V (m/s)")
+    stress.add_argument("--depth", type=float, required=True, help="nose-tip depth L (m)")
+    fem = commands.add_parser("fem", help="FE against analytic wall stress at a nose depth")
+    fem.add_argument("--config", help="target TOML file (default: the paper's Table 1)")
+    fem.add_argument("--velocity", type=float, required=True, help="expansion velocity V (m/s)")
+    fem.add_argument("--depth", type=float, required=True, help="nose-tip depth L (m)")
+    fem.add_argument("--nu", type=float, help="Poisson's ratio for every layer (default: file's)")
+    fem.add_argument("--json", action="store_true", help="print JSON")
+    return parser
+
+
+def _common(command):
+    command.add_argument("--config", help="target TOML file (default: the paper's Table 1)")
+    command.add_argument("--model", choices=("derived", "paper"), default="derived")
+    command.add_argument("--boundary", choices=("quasi-static", "dynamic"), default="quasi-static",
+                         help="yield-at-boundary convention of the derived model")
+    command.add_argument("--epsilon", choices=("quasi-static", "cylindrical"),
+                         default="quasi-static", help="the paper model's reading of epsilon")
+    command.add_argument("--json", action="store_true", help="print JSON")
+
+
+def main(argv=None):
+    """Entry point; returns the exit code (0 ok, 1 numerical failure, 2 bad input)."""
+    try:
+        args = build_parser().parse_args(argv)
+        target, projectile = load_config(args.config)
+        text = COMMANDS[args.command](args, target, projectile)
+    except CavexInputError as exc:
+        print(f"cavex: error: {exc}", file=sys.stderr)
+        return 2
+    except CavexNumericalError as exc:
+        print(f"cavex: numerical failure: {exc}", file=sys.stderr)
+        return 1
+    print(text)
+    return 0
+
+
+def _penetrate(args, target, projectile):
+    from cavex.verification.penetration_report import (
+        penetration_job,
+        phases_as_dicts,
+        write_outputs,
+    )
+
+    job = penetration_job(target, projectile, model=args.model, boundary=args.boundary,
+                          epsilon=args.epsilon, crater=args.crater)
+    written = write_outputs(job, args.out)
+    phases = phases_as_dicts(job["runs"]["runway"])
+    if args.json:
+        settings = {k: job[k] for k in ("model", "boundary", "epsilon", "crater")}
+        return json.dumps({**settings, "phases": phases, "table2": job["table2"],
+                           "outputs": written}, indent=2)
+    return _penetration_text(job, phases, written)
+
+
+def _penetration_text(job, phases, written):
+    lines = [f"model {job['model']}, boundary {job['boundary']}, epsilon {job['epsilon']}, "
+             f"crater from {job['crater']}", "", "phases (runway):",
+             f"{'#':>2} {'label':<24} {'L (m)':>8} {'V (m/s)':>9} {'t (ms)':>8}  ends because"]
+    lines += [f"{p['phase']:>2} {p['label']:<24} {p['end_depth_m']:8.4f} "
+              f"{p['end_velocity_m_s']:9.2f} {p['end_time_s'] * 1e3:8.3f}  {p['end_reason']}"
+              for p in phases]
+    lines += ["", "beside the paper's Table 2:",
+              f"{'row':<32} {'L ours':>7} {'paper':>6} {'V ours':>8} {'paper':>7} "
+              f"{'t ours':>7} {'paper':>6}"]
+    for row in job["table2"]:
+        ours, paper = row["ours"], row["paper"]
+        mine = ("{:7.3f} {:>6} {:8.1f} {:>7} {:7.2f} {:>6.2f}".format(
+            ours["depth_m"], paper["depth_m"], ours["velocity_m_s"], paper["velocity_m_s"],
+            ours["time_s"] * 1e3, paper["time_s"] * 1e3) if ours else "(phase not reached)")
+        lines.append(f"{row['phase']} {row['name']:<30} {mine}")
+    lines += ["", "wrote: " + ", ".join(written)]
+    return "\n".join(lines)
+
+
+def _stress(args, target, projectile):
+    from cavex.verification.stress_query import stress_at_depth
+
+    result = stress_at_depth(target, projectile, args.depth, args.velocity, model=args.model,
+                             boundary=args.boundary, epsilon=args.epsilon)
+    if args.json:
+        return json.dumps(result, indent=2)
+    return "\n".join(f"{key:<22} {value}" for key, value in result.items())
+
+
+def _fem(args, target, projectile):
+    from cavex.fem import compare_at_depth
+
+    result = compare_at_depth(target, projectile, args.depth, args.velocity, nu=args.nu)
+    if args.json:
+        return json.dumps(result, indent=2)
+    fe, analytic = result["fe_sigma_r"], result["analytic_sigma_r"]
+    lines = [f"nose depth {result['depth']} m, V = {result['velocity']} m/s, cavity radius "
+             f"{result['radius']} m, layers {', '.join(result['layers'])}",
+             f"interfaces (m): requested {result['interfaces']}, FE final "
+             f"{result['interfaces_final']}",
+             f"{'':<26} {'sigma_r (MPa)':>14} {'FE/analytic - 1':>16} {'b (m)':>10}",
+             f"{'FE':<26} {fe / 1e6:14.3f} {'':>16} {result['fe_plastic_radius']:10.5f}"]
+    for boundary, stress in analytic.items():
+        lines.append(f"{'analytic ' + boundary:<26} {stress / 1e6:14.3f} "
+                     f"{result['relative_difference'][boundary]:16.4%} "
+                     f"{result['analytic_plastic_radius'][boundary]:10.5f}")
+    estimate = result["error_estimate"]
+    lines.append("FE estimated discretisation error: "
+                 + ("not estimated" if estimate is None else f"{estimate:.3%}"))
+    return "\n".join(lines)
+
+
+COMMANDS = {"penetrate": _penetrate, "stress": _stress, "fem": _fem}
+
+if __name__ == "__main__":
+    sys.exit(main())
