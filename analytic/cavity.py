@@ -41,7 +41,7 @@ the paper's eight states (Fig. 2) are the contiguous cases, labelled ``a``-``h``
 import math
 from dataclasses import dataclass
 
-from cavex.errors import CavexNumericalError, require
+from cavex.errors import CavexNumericalError, require, require_choice
 
 BOUNDARIES = ("dynamic", "quasi-static")
 
@@ -165,7 +165,7 @@ def check_problem(layers, interfaces, velocity, radius, boundary):
     require(math.isfinite(radius) and radius > 0.0, "radius", "a finite number > 0", radius)
     require(math.isfinite(velocity) and velocity >= 0.0, "velocity", "a finite number >= 0",
             velocity)
-    require(boundary in BOUNDARIES, "boundary", " or ".join(map(repr, BOUNDARIES)), boundary)
+    require_choice(boundary, BOUNDARIES, "boundary")
     previous = radius
     for i, h in enumerate(interfaces):
         require(math.isfinite(h) and h > previous, f"interfaces[{i}]",
@@ -236,7 +236,8 @@ def quasi_static_coefficients(layers, interfaces, radius):
     for i in range(len(layers) - 1, -1, -1):
         material = layers[i]
         y_in = radius / interfaces[i - 1] if i > 0 else 1.0
-        y_yield = yield_point(material, 0.0, y_out, y_in, 0.0, 0.0, "quasi-static")
+        epsilon = material.quasi_static_epsilon
+        y_yield = None if epsilon > y_in else max(epsilon, y_out)
         pieces = (((elastic_terms, y_out, y_in),) if y_yield is None else
                   ((elastic_terms, y_out, y_yield), (plastic_terms, y_yield, y_in)))
         for terms, y0, y1 in pieces:

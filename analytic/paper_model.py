@@ -24,7 +24,7 @@ same equations with the layers relabelled (Eqs. 26-28 for two, Eq. 29 for one).
 import math
 from dataclasses import dataclass
 
-from cavex.errors import require
+from cavex.errors import require, require_choice
 
 # eps^k = 3 tau/(2E): k = 3 spherical (physics.md, consistent with the printed A), k = 2 the
 # incompressible cylindrical cavity (the paper never defines eps; this reading reproduces Table 2).
@@ -88,8 +88,7 @@ def layer_epsilon(material, epsilon="quasi-static"):
         ``"cylindrical"``: ``eps^2 = 3 tau/(2E)``, the incompressible cylindrical cavity's
         ``(2E/3)(a/b)^2 = tau``; it reproduces the paper's Table 2 (docs/paper_model.md).
     """
-    require(epsilon in EPSILON_EXPONENTS, "epsilon", " or ".join(map(repr, EPSILON_READINGS)),
-            epsilon)
+    require_choice(epsilon, EPSILON_READINGS, "epsilon")
     return (1.5 * material.tau / material.E) ** (1.0 / EPSILON_EXPONENTS[epsilon])
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from cavex.errors import CavexNumericalError, require
+from cavex.errors import CavexNumericalError, require_choice
 
 CRATER_MODES = ("nose-base", "nose-tip")
 CRATER_RATIO = 4.5
@@ -57,7 +57,7 @@ class Trajectory:
 
 def crater_depth(projectile, crater="nose-base"):
     """Nose-tip depth at the end of the crater stage (m)."""
-    require(crater in CRATER_MODES, "crater", " or ".join(map(repr, CRATER_MODES)), crater)
+    require_choice(crater, CRATER_MODES, "crater")
     length = CRATER_RATIO * projectile.r
     return length + projectile.l if crater == "nose-base" else length
 

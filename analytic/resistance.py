@@ -9,7 +9,7 @@ from cavex.analytic.cavity import quasi_static_coefficients, solve_checked, wall
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.analytic.nose import nose_force, ogive_coefficients
 
-from cavex.errors import require
+from cavex.errors import require, require_choice
 
 MODELS = ("derived", "paper")
 
@@ -32,7 +32,7 @@ class ClosedFormResistance:
 
     def __init__(self, target, projectile, model="derived", boundary="quasi-static",
                  switch=None, epsilon="quasi-static"):
-        require(model in MODELS, "model", " or ".join(map(repr, MODELS)), model)
+        require_choice(model, MODELS, "model")
         require(not (model == "paper" and boundary != "quasi-static"), "boundary",
                 "'quasi-static' for the paper model", boundary)
         self.target, self.projectile = target, projectile

@@ -25,3 +25,9 @@ def require(condition, parameter, accepted, value):
     """
     if not condition:
         raise CavexInputError(f"parameter '{parameter}' must be {accepted} (got {value!r})")
+
+
+def require_choice(value, choices, parameter):
+    """Raise :class:`CavexInputError` unless ``value`` is one of ``choices``."""
+    if value not in choices:
+        require(False, parameter, " or ".join(map(repr, choices)), value)

@@ -2,6 +2,7 @@
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from itertools import accumulate
 
 from cavex.errors import require
@@ -66,12 +67,12 @@ class Material:
             object.__setattr__(self, "tau", (3.0 - self.lam) * self.sigma_c / 3.0)
         _positive("tau", self.tau)
 
-    @property
+    @cached_property
     def alpha(self):
         """``alpha = 3 lam / (3 + 2 lam)``: plastic deviator ``alpha (sigma_r + tau/lam)``."""
         return 3.0 * self.lam / (3.0 + 2.0 * self.lam)
 
-    @property
+    @cached_property
     def yield_intercept(self):
         """``k = alpha tau / lam = 3 tau / (3 + 2 lam)`` (finite as lam -> 0)."""
         return 3.0 * self.tau / (3.0 + 2.0 * self.lam)
@@ -86,7 +87,7 @@ class Material:
         """``K = E / (3 (1 - 2 nu))``."""
         return self.E / (3.0 * (1.0 - 2.0 * self.nu))
 
-    @property
+    @cached_property
     def quasi_static_epsilon(self):
         """``epsilon = a/b`` of the quasi-static convention, ``epsilon^3 = 3 tau / (2 E)``."""
         return (1.5 * self.tau / self.E) ** (1.0 / 3.0)
@@ -108,7 +109,7 @@ class Target:
         for i, h in enumerate(self.thicknesses):
             _positive(f"layers[{i}].thickness", h)
 
-    @property
+    @cached_property
     def interface_depths(self):
         """Depths ``H_1 < H_2 < ...`` of the layer interfaces below the free surface (m)."""
         return tuple(accumulate(self.thicknesses))

@@ -3,7 +3,7 @@
 import math
 from dataclasses import asdict, dataclass, fields, replace
 
-from cavex.errors import require
+from cavex.errors import require, require_choice
 
 ASSEMBLIES = ("fast", "forms")
 OUTER_BOUNDARIES = ("fixed", "free")
@@ -100,10 +100,8 @@ def check_numerics(n):
             "in (0, 1]", n.growth_per_step)
     require(_finite(n.rho_inf) and 0 <= n.rho_inf <= 1, "rho_inf", "in [0, 1]", n.rho_inf)
     require(isinstance(n.dynamic, bool), "dynamic", "True or False", n.dynamic)
-    require(n.outer in OUTER_BOUNDARIES, "outer", " or ".join(map(repr, OUTER_BOUNDARIES)),
-            n.outer)
-    require(n.assembly in ASSEMBLIES, "assembly", " or ".join(map(repr, ASSEMBLIES)),
-            n.assembly)
+    require_choice(n.outer, OUTER_BOUNDARIES, "outer")
+    require_choice(n.assembly, ASSEMBLIES, "assembly")
     require(_finite(n.dilatancy_deg) and 0 <= n.dilatancy_deg < 45, "dilatancy_deg",
             "in [0, 45)", n.dilatancy_deg)
     require(n.tension_cutoff is None or (_finite(n.tension_cutoff) and n.tension_cutoff > 0),
