@@ -1,0 +1,190 @@
+"""Self-contained, JSON-able FE cases for :func:`cavex.verification.runner.run_cases`.
+
+An FE case is a plain dict::
+
+    {"id": "v0500.000_L0.30000", "velocity": 500.0, "depth": 0.3,
+     "nu": 0.4999,                        # optional: Poisson's ratio for every layer
+     "numerics": {"elements_per_decade": 10},   # optional: cavex.fem.Numerics settings
+     "target": [{"name": "concrete", "thickness": 0.65, "E": 25e9, ...}, ...],
+     "projectile": {"r": 0.0125, "l": 0.06, "R": 0.075, "m": 0.505, "V0": 1000.0}}
+
+``target`` is the list of ``[[layers]]`` tables and ``projectile`` the ``[projectile]`` table of
+the config TOML schema (``cavex/data/runway.toml``), so a case carries everything it needs.
+"""
+
+import math
+import os
+import time
+import uuid
+from dataclasses import fields
+
+from cavex.fem.settings import Numerics, make_numerics
+
+from cavex.config import load_config, parse_projectile, parse_target
+from cavex.errors import CavexInputError, CavexNumericalError, require
+
+CASE_KEYS = {"id", "velocity", "depth", "nu", "numerics", "target", "projectile"}
+
+
+def fe_case(case):
+    """Run one FE case: :func:`cavex.fem.compare_at_depth`'s dict plus ``"id"``.
+
+    Parameters
+    ----------
+    case : dict
+        Keys ``id``, ``velocity`` (m/s), ``depth`` (nose-tip depth, m), optional ``nu``,
+        optional ``numerics`` (dict of :class:`cavex.fem.Numerics` settings), ``target`` (list
+        of layer tables, or ``{"layers": [...]}``) and ``projectile`` (table).
+
+    Returns
+    -------
+    dict
+        The JSON-able comparison (``fe_sigma_r``, ``S``, ``analytic_sigma_r``, ...).
+    """
+    from cavex.fem import compare_at_depth
+
+    unknown = sorted(set(case) - CASE_KEYS)
+    if unknown:
+        raise CavexInputError(f"unknown key '{unknown[0]}' in case "
+                              f"(accepted: {', '.join(sorted(CASE_KEYS))})")
+    target = parse_target(_layers(case["target"]))
+    projectile = parse_projectile(case["projectile"])
+    numerics = make_numerics(**case.get("numerics", {})).as_dict()
+    result = compare_at_depth(target, projectile, case["depth"], case["velocity"],
+                              nu=case.get("nu"), **numerics)
+    return {**result, "id": case["id"]}
+
+
+def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, numerics=None):
+    """FE cases on the grid ``velocities x depths`` (velocity outermost), with stable ids.
+
+    Parameters
+    ----------
+    target_table : list of dict or dict
+        The ``[[layers]]`` tables (or ``{"layers": [...]}``), see :func:`target_table`.
+    projectile_table : dict
+        The ``[projectile]`` table, see :func:`projectile_table`.
+    velocities, depths : sequence of float
+        Expansion velocities (m/s, > 0) and nose-tip depths (m, >= 0).
+    nu : float, optional
+        Poisson's ratio for every layer (default: each layer's own).
+    numerics : dict, optional
+        :class:`cavex.fem.Numerics` settings shared by all cases.
+
+    Returns
+    -------
+    list of dict
+        Cases with ids ``"v0500.000_L0.30000"`` (``"_nu0.499900"`` appended when ``nu`` is
+        given); the ids are unique and depend only on the values.
+
+    Raises
+    ------
+    CavexInputError
+        Invalid target, projectile, numerics, velocities or depths, or two values too close to
+        be told apart by the id format.
+    """
+    layers = [dict(table) for table in _layers(target_table)]
+    projectile = dict(projectile_table)
+    parse_target(layers)
+    parse_projectile(projectile)
+    numerics = dict(numerics or {})
+    make_numerics(**numerics)
+    if nu is not None:
+        require(_finite(nu) and -1.0 < nu < 0.5, "nu", "in (-1, 0.5)", nu)
+    cases = []
+    for i, velocity in enumerate(velocities):
+        require(_finite(velocity) and velocity > 0, f"velocities[{i}]", "a finite number > 0",
+                velocity)
+        for j, depth in enumerate(depths):
+            require(_finite(depth) and depth >= 0, f"depths[{j}]", "a finite number >= 0", depth)
+            case = {"id": fe_case_id(velocity, depth, nu), "velocity": float(velocity),
+                    "depth": float(depth)}
+            if nu is not None:
+                case["nu"] = float(nu)
+            if numerics:
+                case["numerics"] = dict(numerics)
+            cases.append({**case, "target": layers, "projectile": projectile})
+    check_unique_ids(cases)
+    return cases
+
+
+def fe_case_id(velocity, depth, nu=None):
+    """``"v0500.000_L0.30000"`` (plus ``"_nu0.499900"`` when ``nu`` is given)."""
+    text = f"v{velocity:08.3f}_L{depth:.5f}"
+    return text if nu is None else f"{text}_nu{nu:.6f}"
+
+
+def check_unique_ids(cases):
+    """Raise ``CavexInputError`` if two cases share an id (values closer than the id format)."""
+    seen = {}
+    for case in cases:
+        if case["id"] in seen:
+            raise CavexInputError(f"cases {seen[case['id']]} and {case} both get id "
+                                  f"'{case['id']}': values too close to tell apart")
+        seen[case["id"]] = {k: v for k, v in case.items() if k not in ("target", "projectile")}
+
+
+def config_tables(path=None):
+    """``(layer tables, projectile table)`` of a config TOML (default: the embedded Table 1)."""
+    target, projectile = load_config(path)
+    return target_table(target), projectile_table(projectile)
+
+
+def target_table(target):
+    """The ``[[layers]]`` tables of a :class:`cavex.materials.Target` (JSON-able, exact)."""
+    tables = []
+    for i, material in enumerate(target.layers):
+        table = {"name": material.name} if material.name else {}
+        if i < len(target.thicknesses):
+            table["thickness"] = float(target.thicknesses[i])
+        table.update(E=float(material.E), nu=float(material.nu), rho=float(material.rho),
+                     lam=float(material.lam), tau=float(material.tau))
+        tables.append(table)
+    return tables
+
+
+def projectile_table(projectile):
+    """The ``[projectile]`` table of a :class:`cavex.materials.Projectile`."""
+    return {key: float(getattr(projectile, key)) for key in ("r", "l", "R", "m", "V0")}
+
+
+def numerics_names():
+    """Names of the :class:`cavex.fem.Numerics` settings."""
+    return [f.name for f in fields(Numerics)]
+
+
+def probe_case(case):
+    """A cheap deterministic case for checking runners and clusters (no FE).
+
+    Keys: ``id``; ``x`` (float); optional ``fail`` (message: raises ``CavexNumericalError``);
+    optional ``sleep`` (seconds); optional ``marker_dir`` (a file is created there for every
+    computation, so that computations can be counted).
+
+    Returns
+    -------
+    dict
+        ``{"x": x, "value": exp(sin(x)) / 3, "values": [x / 7, sqrt(|x|) / 3, |x| ** 0.1]}``.
+    """
+    if case.get("marker_dir"):
+        name = f"{case['id']}.{os.getpid()}.{uuid.uuid4().hex}.done"
+        with open(os.path.join(case["marker_dir"], name), "w", encoding="utf-8"):
+            pass
+    if case.get("sleep"):
+        time.sleep(case["sleep"])
+    if case.get("fail"):
+        raise CavexNumericalError(f"{case['fail']} (x = {case['x']})")
+    x = float(case["x"])
+    return {"x": x, "value": math.exp(math.sin(x)) / 3.0,
+            "values": [x / 7.0, math.sqrt(abs(x)) / 3.0, abs(x) ** 0.1]}
+
+
+def _layers(target):
+    if isinstance(target, dict):
+        require(set(target) == {"layers"}, "target", "a list of layer tables or {'layers': [...]}",
+                sorted(target))
+        return target["layers"]
+    return target
+
+
+def _finite(x):
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)

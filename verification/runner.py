@@ -1,0 +1,345 @@
+"""Run many independent cases locally or on a Dask cluster, with a resumable on-disk store.
+
+One function does the work, :func:`run_cases`. A *case* is a JSON-able dict with a unique string
+``"id"``; the *function* is a picklable top-level callable ``case -> dict``. Every result is
+passed through JSON inside the worker, so a result read back from the store is bit-for-bit the
+one computed (floats are written with ``repr``, which round-trips exactly).
+"""
+
+import json
+import math
+import multiprocessing
+import os
+import sys
+import threading
+import time
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+from cavex.errors import CavexInputError, require
+
+STORE_SUFFIX = ".json"
+TMP_SUFFIX = ".json.tmp"
+_BAD_ID_CHARS = set('/\\\0:*?"<>|')
+
+
+def run_cases(function, cases, *, store=None, scheduler=None, workers=None, progress=None):
+    """Run ``function`` on every case and return the results in the order of ``cases``.
+
+    Parameters
+    ----------
+    function : callable
+        Picklable top-level callable ``case(dict) -> dict`` (a JSON-able result).
+    cases : list of dict
+        JSON-able dicts, each with a unique string key ``"id"`` (used as a file name).
+    store : str or os.PathLike, optional
+        Directory; each finished case is written atomically to ``store/<id>.json`` as soon as
+        it finishes, and cases already stored there are loaded instead of recomputed.
+    scheduler : str or dask.distributed.Client, optional
+        None runs on local processes; an address (``"tcp://host:8786"``) or a ``Client`` runs
+        on that Dask cluster.
+    workers : int, optional
+        Local processes (default ``os.cpu_count()``); 1 runs serially in this process. With a
+        Dask scheduler it bounds nothing: the cluster's threads set the parallelism.
+    progress : bool, optional
+        Progress bar with ETA on stderr; None shows it when stderr is a terminal.
+
+    Returns
+    -------
+    list of dict
+        The function's result plus ``"id"`` and ``"status"`` (``"ok"``), or
+        ``{"id", "status": "failed", "reason": "<one line>"}`` when the function raised.
+
+    Raises
+    ------
+    CavexInputError
+        Bad cases (missing, duplicate or unusable ids, not JSON-able), bad ``workers``, or a
+        store that holds a different case under the same id.
+    """
+    cases = list(cases)
+    _check_cases(cases)
+    workers = _check_workers(workers)
+    results = _load_store(store, cases) if store is not None else {}
+    todo = [case for case in cases if case["id"] not in results]
+    bar = _Progress(len(cases), len(results), _show_progress(progress))
+
+    def finished(case, result):
+        if store is not None:
+            write_case(store, case, result)
+        results[case["id"]] = result
+        bar.update()
+
+    try:
+        if todo:
+            _execute(function, todo, scheduler, workers, finished)
+    finally:
+        bar.close()
+    return [results[case["id"]] for case in cases]
+
+
+def run_one(function, case):
+    """Call ``function(case)`` and return its JSON-normalised result with ``id`` and ``status``.
+
+    Any exception becomes ``{"status": "failed", "reason": "<ExceptionType: first line>"}``.
+    This is what the workers execute; it is public so that a case can be debugged alone.
+    """
+    try:
+        result = function(case)
+        if not isinstance(result, dict):
+            raise TypeError(f"the case function returned {type(result).__name__}, not a dict")
+        result = {**result, "id": case["id"], "status": "ok"}
+        return json.loads(json.dumps(result))
+    except Exception as exc:  # every failure of a case is recorded, not raised
+        return {"id": case["id"], "status": "failed", "reason": one_line_reason(exc)}
+
+
+def one_line_reason(exc):
+    """``"ExceptionType: message"`` reduced to its first line."""
+    text = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0] if text else ''}".rstrip(": ")
+
+
+# --- the store ----------------------------------------------------------------------------------
+
+def case_path(store, case_id):
+    """Path of the stored case ``case_id`` in ``store``."""
+    return os.path.join(os.fspath(store), case_id + STORE_SUFFIX)
+
+
+def write_case(store, case, result):
+    """Atomically write ``{"case": case, "result": result}`` to ``store/<id>.json``.
+
+    The text goes to ``<id>.json.tmp``, is flushed and fsynced, then ``os.replace``-d onto the
+    final name, so a reader (or a resumed run after ``kill -9``) never sees a partial file.
+    """
+    final = case_path(store, case["id"])
+    tmp = os.path.join(os.fspath(store), case["id"] + TMP_SUFFIX)
+    text = json.dumps({"case": case, "result": result}, indent=1)
+    with open(tmp, "w", encoding="utf-8") as handle:
+        handle.write(text)
+        handle.flush()
+        os.fsync(handle.fileno())
+    os.replace(tmp, final)
+    _fsync_dir(store)
+
+
+def read_store(store):
+    """All complete stored cases of ``store`` as ``{id: {"case": ..., "result": ...}}``."""
+    entries = {}
+    if not os.path.isdir(store):
+        return entries
+    for name in sorted(os.listdir(store)):
+        if name.endswith(STORE_SUFFIX):
+            entry = _read_entry(os.path.join(store, name))
+            if entry is not None:
+                entries[entry["case"]["id"]] = entry
+    return entries
+
+
+def _read_entry(path):
+    try:
+        with open(path, encoding="utf-8") as handle:
+            entry = json.load(handle)
+    except (OSError, ValueError):
+        return None  # unreadable: treated as not computed (it is rewritten when recomputed)
+    if not (isinstance(entry, dict) and {"case", "result"} <= entry.keys()):
+        return None
+    return entry
+
+
+def _load_store(store, cases):
+    os.makedirs(store, exist_ok=True)
+    _remove_stale_tmp(store)
+    stored = read_store(store)
+    results = {}
+    for case in cases:
+        entry = stored.get(case["id"])
+        if entry is None:
+            continue
+        if entry["case"] != _json_normalised(case):
+            raise CavexInputError(f"store '{os.fspath(store)}' holds a different case under id "
+                                  f"'{case['id']}'; use a new store directory")
+        results[case["id"]] = entry["result"]
+    return results
+
+
+def _remove_stale_tmp(store):
+    for name in os.listdir(store):
+        if name.endswith(TMP_SUFFIX):
+            try:
+                os.remove(os.path.join(store, name))
+            except FileNotFoundError:
+                pass
+
+
+def _fsync_dir(path):
+    try:
+        fd = os.open(os.fspath(path), os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _json_normalised(value):
+    return json.loads(json.dumps(value))
+
+
+# --- checks -------------------------------------------------------------------------------------
+
+def _check_cases(cases):
+    seen = set()
+    for i, case in enumerate(cases):
+        require(isinstance(case, dict) and "id" in case, f"cases[{i}]", "a dict with an 'id'",
+                case)
+        case_id = case["id"]
+        require(_usable_id(case_id), f"cases[{i}].id",
+                "a non-empty string usable as a file name (no path separators, not starting "
+                "with '.')", case_id)
+        require(case_id not in seen, f"cases[{i}].id", "unique", case_id)
+        seen.add(case_id)
+        try:
+            json.dumps(case, allow_nan=False)
+        except (TypeError, ValueError) as exc:
+            raise CavexInputError(f"case '{case_id}' is not JSON-able: {exc}") from None
+
+
+def _usable_id(case_id):
+    return (isinstance(case_id, str) and 0 < len(case_id) <= 200 and not case_id.startswith(".")
+            and not (_BAD_ID_CHARS & set(case_id)) and case_id.isprintable())
+
+
+def _check_workers(workers):
+    if workers is None:
+        return os.cpu_count() or 1
+    require(isinstance(workers, int) and not isinstance(workers, bool) and workers >= 1,
+            "workers", "an integer >= 1", workers)
+    return workers
+
+
+# --- execution ----------------------------------------------------------------------------------
+
+def _execute(function, todo, scheduler, workers, finished):
+    if scheduler is not None:
+        _run_dask(function, todo, scheduler, finished)
+    elif workers == 1:
+        for case in todo:
+            finished(case, run_one(function, case))
+    else:
+        _run_pool(function, todo, workers, finished)
+
+
+def _pool_context():
+    """``fork`` from a single-threaded process (fast, no ``__main__`` guard needed), else
+    ``forkserver`` (forking a threaded process, e.g. one holding a Dask client, can deadlock)."""
+    methods = multiprocessing.get_all_start_methods()
+    if "fork" in methods and threading.active_count() == 1:
+        return multiprocessing.get_context("fork")
+    return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
+
+
+def _run_pool(function, todo, workers, finished):
+    """Local processes; at most ``2 * workers`` cases in flight."""
+    pending = iter(todo)
+    with ProcessPoolExecutor(max_workers=workers, mp_context=_pool_context()) as pool:
+        try:
+            running = {}
+            _top_up(running, pending, 2 * workers,
+                    lambda case: pool.submit(run_one, function, case))
+            while running:
+                done, _ = wait(running, return_when=FIRST_COMPLETED)
+                for future in done:
+                    finished(running.pop(future), future.result())
+                _top_up(running, pending, 2 * workers,
+                        lambda case: pool.submit(run_one, function, case))
+        except BaseException:
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+
+
+def _top_up(running, pending, limit, submit):
+    while len(running) < limit:
+        case = next(pending, None)
+        if case is None:
+            return
+        running[submit(case)] = case
+
+
+def _run_dask(function, todo, scheduler, finished):
+    """A Dask cluster: an address (a client is opened and closed here) or a ``Client``."""
+    from dask.distributed import Client, as_completed
+
+    own = isinstance(scheduler, str)
+    client = Client(scheduler) if own else scheduler
+    try:
+        limit = 2 * max(1, sum(client.nthreads().values()))
+        pending = iter(todo)
+        running = {}
+        _top_up(running, pending, limit,
+                lambda case: client.submit(run_one, function, case, pure=False))
+        stream = as_completed(list(running))
+        for future in stream:
+            case = running.pop(future)
+            result = future.result()
+            future.release()
+            finished(case, result)
+            before = set(running)
+            _top_up(running, pending, limit,
+                    lambda case: client.submit(run_one, function, case, pure=False))
+            for new in running.keys() - before:
+                stream.add(new)
+    finally:
+        if own:
+            client.close()
+
+
+# --- progress -----------------------------------------------------------------------------------
+
+def _show_progress(progress):
+    if progress is None:
+        return bool(getattr(sys.stderr, "isatty", lambda: False)())
+    return bool(progress)
+
+
+class _Progress:
+    """A one-line progress bar with ETA on stderr (nothing when disabled)."""
+
+    def __init__(self, total, done, enabled, width=30):
+        self.total, self.done, self.enabled, self.width = total, done, enabled, width
+        self.stored = done
+        self.start = time.monotonic()
+        self._draw()
+
+    def update(self):
+        self.done += 1
+        self._draw()
+
+    def close(self):
+        if self.enabled:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
+    def _draw(self):
+        if not self.enabled:
+            return
+        fraction = self.done / self.total if self.total else 1.0
+        filled = int(round(self.width * fraction))
+        elapsed = time.monotonic() - self.start
+        computed = self.done - self.stored
+        remaining = self.total - self.done
+        eta = elapsed / computed * remaining if computed else math.nan
+        sys.stderr.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] "
+                         f"{self.done}/{self.total} {fraction:4.0%} "
+                         f"elapsed {_clock(elapsed)} ETA {_clock(eta)}")
+        sys.stderr.flush()
+
+
+def _clock(seconds):
+    if not math.isfinite(seconds):
+        return "--:--"
+    minutes, secs = divmod(int(round(seconds)), 60)
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes:02d}:{secs:02d}"
