@@ -17,6 +17,10 @@ infinite frequency, 1 = no numerical damping). The plastic state is return-mappe
 Newton matrix is ``(1-alpha_m)/(beta dt^2) M + (1-alpha_f) K_T``, banded with ``p`` off-diagonals.
 ``dynamic=False`` drops the inertia (quasi-static load stepping).
 
+The scheme is second order only from a consistent initial acceleration; a load applied
+suddenly at ``t = 0`` (Blake's problem) needs :meth:`RadialSolver.start_under_load`, which
+solves ``M a_0 = r - f(u_0)`` on the free dofs (the solver otherwise starts from ``a_0 = 0``).
+
 A step whose Newton iteration fails (no convergence, folded element or non-finite value) is
 retried as two half steps, recursively, up to ``max_cutbacks`` times; then
 :class:`~cavex.errors.CavexNumericalError` is raised.
@@ -196,6 +200,22 @@ class RadialSolver:
             previous = self.load
             self.advance(0.5 * (previous + load), 0.5 * dt, depth + 1)
             self.advance(load, 0.5 * dt, depth + 1)
+
+    def start_under_load(self, load):
+        """Consistent start for a wall pressure ``load`` applied suddenly at ``t = 0+``.
+
+        Sets the acceleration from ``M a_0 = r - f(u_0)`` on the free dofs (``r``: the wall
+        load ``p 4 pi r^2``) and holds ``load`` as the current load, so that cut-backs do not
+        ramp it. Call before the first :meth:`advance` of a dynamic, pressure-controlled run.
+        """
+        if not (self.dynamic and self.pressure_control and self.steps == 0):
+            raise ValueError("start_under_load needs a dynamic, pressure-controlled solver "
+                             "before its first step")
+        d = self.disc
+        residual = -self.f - d.mass @ self.a
+        residual[0] += load * 4.0 * np.pi * (d.R_dofs[0] + self.u[0]) ** 2
+        self.a[self.free] += self._solve(d.mass_band, residual[self.free])
+        self.load = load
 
     # -------------------------------------------------------------- energies
     def kinetic_energy(self):
