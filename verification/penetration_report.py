@@ -17,7 +17,8 @@ def penetration_job(target, projectile, *, model="derived", boundary="quasi-stat
         resistance = ClosedFormResistance(tgt, projectile, model, boundary, epsilon=epsilon)
         runs[name] = penetrate(tgt, projectile, resistance, crater=crater)
     return {"model": model, "boundary": boundary, "epsilon": epsilon, "crater": crater,
-            "runs": runs, "table2": table2_comparison(runs["runway"])}
+            "runs": runs, "table2": table2_comparison(runs["runway"]),
+            "interface_depths": target.interface_depths}
 
 
 def phases_as_dicts(trajectory):
@@ -71,6 +72,8 @@ def _write_figures(job, out):
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(runway.depth, runway.deceleration / 9.81 / 1e3, label="runway (layered)")
     ax.plot(single.depth, single.deceleration / 9.81 / 1e3, "--", label="first layer alone")
+    for depth in job["interface_depths"]:
+        ax.axvline(depth, color="grey", linewidth=0.8, linestyle=":")
     ax.set(xlabel="nose depth (m)", ylabel="deceleration (10^3 g)",
            title=f"Deceleration vs depth: {title}")
     ax.legend()
