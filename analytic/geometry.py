@@ -8,6 +8,8 @@ radius is the shank radius ``r``. A plane interface at depth ``H_i`` becomes a s
 - ``switch="nose-tip"`` (the paper): the nose tip crosses its lower face, ``L >= H_i``.
 """
 
+import math
+
 from cavex.errors import require, require_choice
 
 SWITCHES = ("cavity", "nose-tip")
@@ -15,7 +17,7 @@ SWITCHES = ("cavity", "nose-tip")
 
 def spherical_problem(target, projectile, depth, switch="cavity"):
     """``(layers, interfaces)`` of the spherical problem at nose-tip depth ``depth`` (m)."""
-    require(depth >= 0.0, "depth", ">= 0", depth)
+    require(math.isfinite(depth) and depth >= 0.0, "depth", "a finite number >= 0", depth)
     require_choice(switch, SWITCHES, "switch")
     radii = [H - depth + projectile.l for H in target.interface_depths]
     if switch == "cavity":

@@ -9,8 +9,10 @@ on the nose is the cavity-wall stress at the normal expansion velocity ``V cos(p
 
 For ``sigma_r = tau A + B rho V^2`` this is ``F = C_A + C_B V^2`` with ``C_A = pi r^2 tau A``
 and ``C_B = pi r^2 rho B (8 psi - 1)/(24 psi^2)``, ``psi = R/(2r)`` (Eqs. 12-14). For any other
-``sigma_r(V)`` the integral is evaluated by Gauss-Legendre quadrature in ``phi``; the integrand
-is smooth, so the rule converges exponentially (``test_nose`` measures it).
+``sigma_r(V)`` the integral is evaluated by Gauss-Legendre quadrature in ``phi``. Where the
+response state does not change over ``[0, V]`` the integrand is smooth and the rule converges
+exponentially (``test_nose`` measures 1e-13 at 8 points); where it changes, ``sigma_r(V)`` has a
+kink and the error is algebraic (measured 6e-6 relative at 8 points, dynamic convention, 0.62 m).
 """
 
 import math

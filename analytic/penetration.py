@@ -84,6 +84,7 @@ def crater_stage(projectile, force, depth, samples=50):
     t = np.linspace(0.0, tc, samples)
     depths = projectile.V0 / omega * np.sin(omega * t)
     velocity = projectile.V0 * np.cos(omega * t)
+    depths[-1], velocity[-1] = depth, vc  # the exit state exactly, not re-rounded
     return (t, depths, velocity, stiffness * depths / projectile.m), tc, vc
 
 

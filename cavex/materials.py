@@ -42,7 +42,8 @@ class Material:
     lam : float
         Pressure sensitivity lambda in [0, 3); 0 is Tresca.
     tau : float, optional
-        Shear strength intercept (Pa), > 0. Derived from ``sigma_c`` when omitted.
+        Shear strength intercept (Pa), > 0. Derived from ``sigma_c`` when omitted; if both are
+        given they must agree (``dataclasses.replace`` keeps both).
     name : str, optional
     sigma_c : float, optional
         Unconfined compressive strength (Pa), > 0, from which ``tau`` is derived.
@@ -61,10 +62,15 @@ class Material:
         _positive("rho", self.rho)
         require(_is_number(self.nu) and -1.0 < self.nu < 0.5, "nu", "in (-1, 0.5)", self.nu)
         require(_is_number(self.lam) and 0.0 <= self.lam < 3.0, "lam", "in [0, 3)", self.lam)
-        _exactly_one("tau", "sigma_c", (self.tau, self.sigma_c))
-        if self.tau is None:
+        require(self.tau is not None or self.sigma_c is not None, "tau",
+                "given (or sigma_c given)", None)
+        if self.sigma_c is not None:
             _positive("sigma_c", self.sigma_c)
-            object.__setattr__(self, "tau", (3.0 - self.lam) * self.sigma_c / 3.0)
+            derived = (3.0 - self.lam) * self.sigma_c / 3.0
+            require(self.tau is None or math.isclose(self.tau, derived, rel_tol=1e-12),
+                    "tau", f"(3 - lam) sigma_c / 3 = {derived} when sigma_c is also given",
+                    self.tau)
+            object.__setattr__(self, "tau", derived)
         _positive("tau", self.tau)
 
     @cached_property

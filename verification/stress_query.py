@@ -1,5 +1,7 @@
 """The ``cavex stress`` query: S, sigma_r, response state and b at one nose depth and velocity."""
 
+import math
+
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.analytic.paper_model import paper_coefficients
@@ -10,7 +12,10 @@ from cavex.errors import require
 def stress_at_depth(target, projectile, depth, velocity, *, model="derived",
                     boundary="quasi-static", epsilon="quasi-static"):
     """JSON-able description of the cavity-wall stress at nose depth ``depth`` (m)."""
-    require(velocity >= 0.0, "velocity", ">= 0", velocity)
+    require(math.isfinite(velocity) and velocity >= 0.0, "velocity", "a finite number >= 0",
+            velocity)
+    require(model != "paper" or boundary == "quasi-static", "boundary",
+            "'quasi-static' for the paper model", boundary)
     if model == "paper":
         return _paper(target, projectile, depth, velocity, epsilon)
     layers, interfaces = spherical_problem(target, projectile, depth)
