@@ -252,7 +252,7 @@ def test_console_script_exit_codes(tmp_path):
                          capture_output=True, text=True, timeout=120, check=False)
     assert bad.returncode == 2 and bad.stdout == ""
     assert bad.stderr.splitlines() == [
-        "cavex: error: parameter 'velocity' must be >= 0 (got -1.0)"]
+        "cavex: error: parameter 'velocity' must be a finite number >= 0 (got -1.0)"]
     good = subprocess.run([str(script), "stress", "--velocity", "500", "--depth", "0.3",
                            "--json"], capture_output=True, text=True, timeout=120, check=False)
     assert (good.returncode, good.stderr) == (0, "")
