@@ -1,0 +1,377 @@
+"""FE-tabulated cavity-wall stress ``sigma_r(V, L)`` for one target and projectile.
+
+The table holds the FE cavity-wall radial stress of the spherical problem at nose-tip depth
+``L`` (:func:`cavex.analytic.geometry.spherical_problem`, ``switch="cavity"``) for expansion
+velocity ``V``, on a grid, as an :class:`xarray.Dataset`:
+
+- coordinates ``velocity`` (m/s; must start at 0, see ``docs/verification.md``) and ``depth``
+  (nose-tip depth, m); the depth grid always contains the wall-layer switch depths
+  ``H_i + l - r`` inside its range, where ``sigma_r`` is continuous but its slope is not;
+- ``sigma_r``, ``S``, ``error_estimate``, ``failed`` on ``(velocity, depth)`` (failed cells
+  NaN), ``wall_layer`` on ``depth``, the analytic ``sigma_r_dynamic`` and
+  ``sigma_r_quasi_static`` for reference, and ``sigma_r_first_layer`` / ``failed_first_layer``
+  on ``velocity``: the first layer alone, semi-infinite, for the crater stage;
+- attributes: the TOML text of the target and projectile, their fingerprint, the solver
+  settings (JSON), package versions and the creation time.
+
+The FE cells are run with the shared case runner (:mod:`cavex.verification.runner`) on cases
+from :func:`cavex.verification.cases.make_fe_cases`.
+"""
+
+import hashlib
+import json
+import math
+import os
+import time
+from datetime import UTC, datetime
+from importlib import metadata
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from cavex.analytic.cavity import cavity_stress
+from cavex.analytic.geometry import spherical_problem, wall_layer
+from cavex.verification.cases import fe_case, fe_case_id, make_fe_cases
+from cavex.verification.cases import projectile_table as projectile_to_table
+from cavex.verification.cases import target_table as target_to_table
+from cavex.verification.runner import run_cases
+
+from cavex.errors import CavexInputError, require
+
+DEFAULT_VELOCITIES = tuple(np.linspace(0.0, 1200.0, 13))
+DEFAULT_DEPTHS = tuple(np.round(np.linspace(0.10, 1.30, 31), 6))
+FINGERPRINT_SCOPE = "layers (all keys) and projectile r, l: what sigma_r(V, L) depends on"
+VERSIONED = ("cavex", "numpy", "scipy", "scikit-fem", "xarray")
+SWITCH_REFINEMENT = (2.0, 1.0, 0.5, 0.25, 0.125)  # depths L_s - f r added above each switch
+SWITCH_OFFSET = 1e-9  # m: the switch node sits this far below the switch depth
+FIRST_LAYER_DEPTH = 0.0  # the single first-layer problem has no interfaces; any depth will do
+
+
+# --- target and projectile as TOML-schema data ------------------------------------------------
+
+def config_text(target, projectile):
+    """TOML text that :func:`cavex.config.load_config` reads back to ``(target, projectile)``."""
+    lines = ["[projectile]"]
+    lines += [f"{k} = {_toml_value(v)}" for k, v in projectile_to_table(projectile).items()]
+    for table in target_to_table(target):
+        lines += ["", "[[layers]]"] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _toml_value(value):
+    return json.dumps(value) if isinstance(value, str) else repr(float(value))
+
+
+def fingerprint_data(target, projectile):
+    """The data the table depends on: every layer key and the projectile's ``r`` and ``l``."""
+    p = projectile_to_table(projectile)
+    return {"layers": target_to_table(target), "projectile": {"r": p["r"], "l": p["l"]}}
+
+
+def fingerprint(target, projectile):
+    """sha256 of the canonical JSON (sorted keys, repr floats) of :func:`fingerprint_data`."""
+    text = json.dumps(fingerprint_data(target, projectile), sort_keys=True,
+                      separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+# --- the grid ---------------------------------------------------------------------------------
+
+def switch_depths(target, projectile):
+    """Nose depths ``H_i + l - r`` where the wall layer changes (``switch="cavity"``)."""
+    return tuple(H + projectile.l - projectile.r for H in target.interface_depths)
+
+
+def switch_nodes(target, projectile):
+    """Grid depths standing for the switch depths: ``L_s + SWITCH_OFFSET``.
+
+    At ``L_s`` itself rounding may keep a zero-thickness shell of the upper layer (the FE mesh
+    then degenerates); ``SWITCH_OFFSET`` past it the upper layer is surely gone. ``sigma_r`` is
+    continuous there, so the node serves both segments.
+    """
+    return tuple(s + SWITCH_OFFSET for s in switch_depths(target, projectile))
+
+
+def grid_depths(depths, target, projectile, refine=SWITCH_REFINEMENT):
+    """Sorted unique ``depths`` plus, for each switch depth ``L_s`` inside their range, its
+    node (:func:`switch_nodes`) and the refinement depths ``L_s - f r`` (``f`` in ``refine``).
+
+    Just above a switch the upper layer is a shell of thickness ``delta = L_s - L`` around the
+    cavity, and ``sigma_r`` changes over ``delta ~ r/4`` (it decays with distance from the wall
+    like the cavity field, on the cavity radius), so the grid is refined there.
+    """
+    d = np.unique(np.asarray(depths, dtype=float))
+    extra = []
+    for s, node in zip(switch_depths(target, projectile), switch_nodes(target, projectile),
+                       strict=True):
+        if d[0] < s < d[-1]:
+            extra += [node] + [s - f * projectile.r for f in refine
+                               if s - f * projectile.r > d[0]]
+    d = d[~np.any(np.abs(d[:, None] - np.asarray(extra)[None, :]) < 1e-6, axis=1)] if extra else d
+    return np.unique(np.round(np.concatenate([d, extra]), 12))
+
+
+def check_grid(velocities, depths):
+    """Raise :class:`CavexInputError` unless the grid can be tabulated and interpolated."""
+    v = np.asarray(velocities, dtype=float)
+    d = np.asarray(depths, dtype=float)
+    require(v.ndim == 1 and v.size >= 2 and np.all(np.isfinite(v)), "velocities",
+            "at least two finite values", list(v))
+    require(v.min() == 0.0, "velocities",
+            "a grid that includes V = 0 (the nose tip sees V cos(phi) -> 0)", list(v))
+    require(np.all(v >= 0.0), "velocities", ">= 0", list(v))
+    require(d.ndim == 1 and d.size >= 2 and np.all(np.isfinite(d)) and np.all(d >= 0.0),
+            "depths", "at least two finite values >= 0", list(d))
+
+
+# --- building ---------------------------------------------------------------------------------
+
+def build_table(target, projectile, velocities, depths, *, nu=None, numerics=None,
+                scheduler=None, workers=None, store=None, progress=None,
+                refine=SWITCH_REFINEMENT):
+    """FE cavity-wall stress on the ``(velocity, depth)`` grid, as an :class:`xarray.Dataset`.
+
+    Parameters
+    ----------
+    target, projectile : Target, Projectile
+    velocities : sequence of float
+        Expansion velocities (m/s); must include 0. Sorted and made unique.
+    depths : sequence of float
+        Nose-tip depths (m); the wall-layer switch depths inside their range are added.
+    nu : float, optional
+        Poisson's ratio for every layer (default: each layer's own).
+    numerics : dict, optional
+        Settings of :class:`cavex.fem.Numerics`.
+    scheduler, workers, store, progress
+        Passed to :func:`cavex.verification.runner.run_cases`.
+    refine : sequence of float
+        Depths ``L_s - f r`` added above each switch depth (see :func:`grid_depths`).
+
+    Returns
+    -------
+    xarray.Dataset
+        See the module docstring; failed cells are NaN with ``failed`` True and their reasons
+        in the ``failures`` attribute (JSON).
+    """
+    check_grid(velocities, depths)
+    v = np.unique(np.asarray(velocities, dtype=float))
+    d = grid_depths(depths, target, projectile, refine)
+    grid = table_cases(target, projectile, v, d, nu, numerics)
+    first = [{**case, "id": f"first-layer-{case['id']}"} for case in
+             table_cases(target.single(0), projectile, v, [FIRST_LAYER_DEPTH], nu, numerics)]
+    results = run_cases(fe_case, grid + first, store=store, scheduler=scheduler,
+                        workers=workers, progress=progress)
+    cells = _cells(results[:len(grid)], grid, v, d)
+    crater = _cells(results[len(grid):], first, v, [FIRST_LAYER_DEPTH])
+    return assemble_table(target, projectile, v, d, cells, crater, settings_json(nu, numerics))
+
+
+def table_cases(target, projectile, velocities, depths, nu, numerics):
+    """FE cases in the order velocity-major, depth-minor, ``V = 0`` included.
+
+    ``make_fe_cases`` takes ``V > 0`` only; the ``V = 0`` cases (a quasi-static FE run, which
+    ``expand_cavity`` supports) are its ``V = 1`` cases with the velocity and id replaced.
+    """
+    positive = [x for x in velocities if x > 0.0]
+    args = (target_to_table(target), projectile_to_table(projectile))
+    cases = make_fe_cases(*args, positive, depths, nu=nu, numerics=numerics) if positive else []
+    if velocities[0] == 0.0:
+        zero = make_fe_cases(*args, [1.0], depths, nu=nu, numerics=numerics)
+        cases = [{**case, "velocity": 0.0, "id": fe_case_id(0.0, case["depth"], nu)}
+                 for case in zero] + cases
+    return cases
+
+
+def _cells(results, cases, velocities, depths):
+    """Grid arrays ``sigma_r``, ``S``, ``error_estimate``, ``failed`` and the failure list."""
+    shape = (len(velocities), len(depths))
+    out = {k: np.full(shape, np.nan) for k in ("sigma_r", "S", "error_estimate")}
+    failed = np.zeros(shape, dtype=bool)
+    failures = []
+    for case, result in zip(cases, results, strict=True):
+        i = int(np.searchsorted(velocities, case["velocity"]))
+        j = int(np.searchsorted(depths, case["depth"]))
+        if result.get("status") != "ok":
+            failed[i, j] = True
+            failures.append({"velocity": float(case["velocity"]), "depth": float(case["depth"]),
+                             "reason": str(result.get("reason", ""))})
+            continue
+        out["sigma_r"][i, j] = result["fe_sigma_r"]
+        out["S"][i, j] = result["S"]
+        estimate = result.get("error_estimate")
+        out["error_estimate"][i, j] = np.nan if estimate is None else estimate
+    return {**out, "failed": failed, "failures": failures}
+
+
+def settings_json(nu, numerics):
+    """Solver settings (``nu`` and every :class:`~cavex.fem.Numerics` value) as JSON."""
+    from cavex.fem.settings import make_numerics
+
+    return json.dumps({"nu": nu, "numerics": make_numerics(**(numerics or {})).as_dict(),
+                       "switch": "cavity"}, sort_keys=True)
+
+
+def analytic_table(target, projectile, velocities, depths, boundary="quasi-static",
+                   refine=SWITCH_REFINEMENT):
+    """A table filled from the closed form instead of the FE (for tests and comparisons).
+
+    ``sigma_r`` is :func:`cavex.analytic.cavity_stress` with ``boundary``; the grid is built as
+    :func:`build_table` builds it.
+    """
+    check_grid(velocities, depths)
+    v = np.unique(np.asarray(velocities, dtype=float))
+    d = grid_depths(depths, target, projectile, refine)
+
+    def cells(tgt, ds):
+        sigma = _analytic_grid(tgt, projectile, v, ds, boundary)
+        tau = np.array([tgt.layers[wall_layer(tgt, projectile, L)].tau for L in ds])
+        return {"sigma_r": sigma, "S": sigma / tau, "error_estimate": np.zeros_like(sigma),
+                "failed": np.zeros(sigma.shape, dtype=bool), "failures": []}
+
+    return assemble_table(target, projectile, v, d, cells(target, d),
+                          cells(target.single(0), [FIRST_LAYER_DEPTH]),
+                          json.dumps({"analytic": boundary, "switch": "cavity"}))
+
+
+def _analytic_grid(target, projectile, velocities, depths, boundary):
+    out = np.empty((len(velocities), len(depths)))
+    for j, L in enumerate(depths):
+        layers, interfaces = spherical_problem(target, projectile, L)
+        for i, V in enumerate(velocities):
+            out[i, j] = cavity_stress(layers, interfaces, V, projectile.r, boundary=boundary)
+    return out
+
+
+def assemble_table(target, projectile, velocities, depths, cells, crater, settings):
+    """The Dataset from grid arrays (see :func:`build_table`)."""
+    v, d = np.asarray(velocities, dtype=float), np.asarray(depths, dtype=float)
+    grid = ("velocity", "depth")
+    names = [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]
+    data = {
+        "sigma_r": (grid, cells["sigma_r"], _attrs("Pa", "FE cavity-wall radial stress, "
+                                                   "compression positive")),
+        "S": (grid, cells["S"], _attrs("1", "sigma_r / tau of the wall layer")),
+        "error_estimate": (grid, cells["error_estimate"],
+                           _attrs("1", "FE relative discretisation error (Richardson)")),
+        "failed": (grid, cells["failed"], _attrs("1", "FE run failed (cell is NaN)")),
+        "wall_layer": ("depth", np.array([wall_layer(target, projectile, L) for L in d],
+                                         dtype=np.int32),
+                       _attrs("1", "index of the layer at the cavity wall; names in "
+                                   "attribute layer_names")),
+        "sigma_r_first_layer": ("velocity", cells_first(crater, "sigma_r"),
+                                _attrs("Pa", "FE cavity-wall stress, first layer alone "
+                                             "(crater stage)")),
+        "failed_first_layer": ("velocity", cells_first(crater, "failed"),
+                               _attrs("1", "FE first-layer run failed")),
+    }
+    for boundary in ("dynamic", "quasi-static"):
+        data["sigma_r_" + boundary.replace("-", "_")] = (
+            grid, _analytic_grid(target, projectile, v, d, boundary),
+            _attrs("Pa", f"analytic cavity-wall stress, {boundary} boundary (reference)"))
+    coords = {"velocity": ("velocity", v, _attrs("m/s", "cavity expansion velocity")),
+              "depth": ("depth", d, _attrs("m", "nose-tip depth L"))}
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(table_attrs(target, projectile, settings))
+    ds.attrs["layer_names"] = json.dumps(names)
+    ds.attrs["failures"] = json.dumps(cells["failures"] + crater["failures"])
+    return ds
+
+
+def cells_first(crater, key):
+    """The single-depth column of the first-layer cells."""
+    return crater[key][:, 0]
+
+
+def _attrs(units, long_name):
+    return {"units": units, "long_name": long_name}
+
+
+def table_attrs(target, projectile, settings):
+    """Global attributes: TOML text, fingerprint, settings, versions, creation time."""
+    return {
+        "title": "cavex FE-tabulated cavity-wall stress sigma_r(V, L)",
+        "target": config_text(target, projectile),
+        "fingerprint": fingerprint(target, projectile),
+        "fingerprint_scope": FINGERPRINT_SCOPE,
+        "fingerprint_data": json.dumps(fingerprint_data(target, projectile), sort_keys=True),
+        "solver_settings": settings,
+        "versions": json.dumps({name: _version(name) for name in VERSIONED}),
+        "created": datetime.now(UTC).isoformat(timespec="seconds"),
+    }
+
+
+def _version(name):
+    try:
+        return metadata.version(name)
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
+
+# --- files ------------------------------------------------------------------------------------
+
+def write_table(ds, path):
+    """Write ``ds`` as netCDF3 (scipy engine) atomically: a temporary file, then ``os.replace``."""
+    path = Path(path)
+    if path.parent != Path(""):
+        path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        ds.to_netcdf(tmp, engine="scipy")
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+def load_table(path):
+    """Read a table written by :func:`write_table` (fully into memory; the file is closed)."""
+    try:
+        ds = xr.load_dataset(path, engine="scipy")
+    except (OSError, ValueError, TypeError) as exc:
+        raise CavexInputError(f"table '{path}' cannot be read as a netCDF3 table: {exc}") from None
+    missing = [k for k in ("sigma_r", "sigma_r_first_layer", "wall_layer") if k not in ds]
+    if missing or "fingerprint" not in ds.attrs:
+        raise CavexInputError(f"'{path}' is not a cavex table (missing "
+                              f"{', '.join(missing) or 'fingerprint attribute'})")
+    ds.attrs["source"] = str(path)
+    return ds
+
+
+# --- command-line job -------------------------------------------------------------------------
+
+def table_main(config_path=None, velocities=None, depths=None, out_path="results/table.nc",
+               nu=None, workers=None, scheduler=None, numerics=None, progress=None):
+    """The ``cavex table`` job: build, write and summarise a table; returns the summary text.
+
+    Defaults: velocities 0, 100, ..., 1200 m/s (13), depths 0.10 ... 1.30 m every 0.04 m (31,
+    plus the two wall-layer switch depths): concrete, macadam and into the soil.
+    """
+    from cavex.config import load_config
+
+    target, projectile = load_config(config_path)
+    start = time.perf_counter()
+    ds = build_table(target, projectile,
+                     DEFAULT_VELOCITIES if velocities is None else velocities,
+                     DEFAULT_DEPTHS if depths is None else depths, nu=nu, numerics=numerics,
+                     scheduler=scheduler, workers=workers, progress=progress)
+    seconds = time.perf_counter() - start
+    written = write_table(ds, out_path)
+    return summary_text(ds, seconds, written)
+
+
+def summary_text(ds, seconds, path):
+    """Cases, failed cells, time and path of a built table, one item per line."""
+    cells = ds.sizes["velocity"] * (ds.sizes["depth"] + 1)
+    failed = int(ds["failed"].sum()) + int(ds["failed_first_layer"].sum())
+    estimate = float(np.nanmax(ds["error_estimate"])) if np.any(
+        np.isfinite(ds["error_estimate"])) else math.nan
+    v, d = ds["velocity"].values, ds["depth"].values
+    return "\n".join([
+        f"cases   {cells} ({ds.sizes['velocity']} velocities {v[0]:g}..{v[-1]:g} m/s x "
+        f"{ds.sizes['depth']} depths {d[0]:g}..{d[-1]:g} m, + first layer alone)",
+        f"failed  {failed}",
+        f"largest FE error estimate {estimate:.3%}",
+        f"time    {seconds:.1f} s",
+        f"wrote   {path}",
+    ])
