@@ -197,3 +197,8 @@ def test_fe_case_ids_are_stable_and_unique():
         make_fe_cases(layers, projectile, [-1.0], [0.3])
     with pytest.raises(CavexInputError, match="growth_per_step"):
         make_fe_cases(layers, projectile, [500.0], [0.3], numerics={"growth_per_step": 2.0})
+
+
+def test_bad_scheduler_address_is_an_input_error():
+    with pytest.raises(CavexInputError, match="parameter 'scheduler' must be a reachable Dask"):
+        run_cases(probe_case, probes(1), scheduler="nonsense://nowhere")

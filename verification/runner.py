@@ -273,7 +273,7 @@ def _run_dask(function, todo, scheduler, finished):
     from dask.distributed import Client, as_completed
 
     own = isinstance(scheduler, str)
-    client = Client(scheduler) if own else scheduler
+    client = _connect(Client, scheduler) if own else scheduler
     try:
         limit = 2 * max(1, sum(client.nthreads().values()))
         pending = iter(todo)
@@ -294,6 +294,15 @@ def _run_dask(function, todo, scheduler, finished):
     finally:
         if own:
             client.close()
+
+
+def _connect(client_class, address):
+    """A client for ``address``; an unreachable or malformed address is an input error."""
+    try:
+        return client_class(address)
+    except (OSError, ValueError, TypeError) as exc:
+        raise CavexInputError(f"parameter 'scheduler' must be a reachable Dask scheduler "
+                              f"address (got {address!r}: {one_line_reason(exc)})") from None
 
 
 # --- progress -----------------------------------------------------------------------------------
