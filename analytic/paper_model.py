@@ -26,10 +26,17 @@ from dataclasses import dataclass
 
 from cavex.errors import require, require_choice
 
-# eps^k = 3 tau/(2E): k = 3 spherical (physics.md, consistent with the printed A), k = 2 the
-# incompressible cylindrical cavity (the paper never defines eps; this reading reproduces Table 2).
-EPSILON_EXPONENTS = {"quasi-static": 3.0, "cylindrical": 2.0}
-EPSILON_READINGS = tuple(EPSILON_EXPONENTS)
+# Readings of the paper's undefined eps: (2E/3) eps^k = Y -> (k, Y). k = 3 spherical (physics.md,
+# consistent with the printed A), k = 2 the incompressible cylindrical cavity; Y is tau or the
+# uniaxial strength sigma_c = 3 tau/(3 - lam) of Eq. 2 (docs/table2.md: "cylindrical-sigma_c" is
+# the only reading that puts Table 2's L1 at its printed 0.40 m).
+EPSILON_FORMS = {
+    "quasi-static": (3.0, "tau"),
+    "cylindrical": (2.0, "tau"),
+    "quasi-static-sigma_c": (3.0, "sigma_c"),
+    "cylindrical-sigma_c": (2.0, "sigma_c"),
+}
+EPSILON_READINGS = tuple(EPSILON_FORMS)
 MAX_LAYERS = 3
 
 # (equation, state) for the concentric problem, by number of layers and response index.
@@ -76,20 +83,27 @@ def alpha_lambda(material):
     return 6.0 * material.lam / (3.0 + 2.0 * material.lam)
 
 
+def uniaxial_strength(material):
+    """``sigma_c = 3 tau/(3 - lam)`` (paper Eq. 2)."""
+    return 3.0 * material.tau / (3.0 - material.lam)
+
+
 def layer_epsilon(material, epsilon="quasi-static"):
     """``eps = a/b`` of a layer under a reading of the paper's undefined ``eps_i = V/c_i``.
 
     Parameters
     ----------
     material : Material
-    epsilon : {"quasi-static", "cylindrical"}
-        ``"quasi-static"``: ``eps^3 = 3 tau/(2E)``, the spherical elastic zone's yield
-        (physics.md; the only reading consistent with the ``2/3`` of the printed ``A``).
-        ``"cylindrical"``: ``eps^2 = 3 tau/(2E)``, the incompressible cylindrical cavity's
-        ``(2E/3)(a/b)^2 = tau``; it reproduces the paper's Table 2 (docs/paper_model.md).
+    epsilon : str
+        One of :data:`EPSILON_READINGS`: ``(2E/3) eps^k = Y`` with ``k = 3`` (``"quasi-static"``,
+        the spherical elastic zone's yield of physics.md; the only reading consistent with the
+        ``2/3`` of the printed ``A``) or ``k = 2`` (``"cylindrical"``, the incompressible
+        cylindrical cavity), and ``Y = tau`` or, with the ``-sigma_c`` suffix, ``sigma_c``.
     """
     require_choice(epsilon, EPSILON_READINGS, "epsilon")
-    return (1.5 * material.tau / material.E) ** (1.0 / EPSILON_EXPONENTS[epsilon])
+    exponent, strength = EPSILON_FORMS[epsilon]
+    y = material.tau if strength == "tau" else uniaxial_strength(material)
+    return (1.5 * y / material.E) ** (1.0 / exponent)
 
 
 def check_target(target):

@@ -160,10 +160,11 @@ def _phase_events(resistance, ahead, n_interfaces, label):
         return 1.0 if resistance.label(y[0], max(y[1], 0.0)) == label else -1.0
 
     stopped.direction = state_changed.direction = -1.0
-    events = [(stopped, "projectile stopped"), (state_changed, "response state changed")]
-    if ahead:
+    events = [(stopped, "projectile stopped")]
+    if ahead:  # before the state change: where both coincide, the interface names the phase end
         number = n_interfaces - len(ahead) + 1
         events.append((_depth_event(ahead[0]), f"nose tip reached interface {number}"))
+    events.append((state_changed, "response state changed"))
     for event, _ in events:
         event.terminal = True
     return events

@@ -5,6 +5,7 @@ values (``PAPER_TABLE2``) are typed in, as reference values.
 """
 
 import pytest
+from cavex.analytic.paper_model import layer_epsilon
 from cavex.analytic.penetration import crater_depth
 from cavex.verification.table2 import PAPER_TABLE2
 from cavex.verification.table2_study import (
@@ -14,7 +15,6 @@ from cavex.verification.table2_study import (
     ReadingResistance,
     factorial_readings,
     phase_depth_l1,
-    reading_epsilon,
     relative_error,
     run_reading,
     segment_rows,
@@ -49,7 +49,7 @@ def test_state_a_ends_at_L1_in_the_trajectory(default, epsilon):
     """Phase 2 ends where b reaches H1: L1 = H1 + l - r/eps1 (Eq. 18), in the integrated run."""
     target, projectile = default
     rows = _rows(default, Reading("x", epsilon=epsilon))
-    eps1 = reading_epsilon(target.layers[0], epsilon)
+    eps1 = layer_epsilon(target.layers[0], epsilon)
     expected = target.interface_depths[0] + projectile.l - projectile.r / eps1
     assert rows[1]["depth_m"] == pytest.approx(expected, abs=1e-9)
     assert expected == pytest.approx(phase_depth_l1(target, projectile, epsilon), abs=1e-15)

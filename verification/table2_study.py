@@ -46,15 +46,8 @@ from scipy.integrate import solve_ivp
 
 from cavex.errors import CavexNumericalError, require
 
-# eps^k = 3 Y/(2E): reading -> (k, which strength Y of Eq. 2)
-EPSILON_FORMS = {
-    "quasi-static": (3, "tau"),
-    "cylindrical": (2, "tau"),
-    "quasi-static-sigma_c": (3, "sigma_c"),
-    "cylindrical-sigma_c": (2, "sigma_c"),
-}
 CHOICES = {
-    "epsilon": tuple(EPSILON_FORMS),
+    "epsilon": pm.EPSILON_READINGS,
     "crater": ("nose-base", "nose-tip"),
     "crater_medium": ("concrete", "soil"),
     "crater_law": ("linear", "tunnel"),
@@ -121,22 +114,9 @@ def _readings():
 READINGS = _readings()
 
 
-def uniaxial_strength(material):
-    """``sigma_c = 3 tau/(3 - lam)`` (paper Eq. 2)."""
-    return 3.0 * material.tau / (3.0 - material.lam)
-
-
-def reading_epsilon(material, epsilon):
-    """``eps = a/b`` of one layer: ``(2E/3) eps^k = Y`` with ``k``, ``Y`` of the reading."""
-    require(epsilon in EPSILON_FORMS, "epsilon", "one of " + ", ".join(EPSILON_FORMS), epsilon)
-    exponent, strength = EPSILON_FORMS[epsilon]
-    y = material.tau if strength == "tau" else uniaxial_strength(material)
-    return (1.5 * y / material.E) ** (1.0 / exponent)
-
-
 def phase_depth_l1(target, projectile, epsilon):
     """``L1 = H1 + l - r/eps1`` (Eq. 18) under a reading of ``eps``."""
-    eps1 = reading_epsilon(target.layers[0], epsilon)
+    eps1 = pm.layer_epsilon(target.layers[0], epsilon)
     return target.interface_depths[0] + projectile.l - projectile.r / eps1
 
 
@@ -172,7 +152,7 @@ class ReadingResistance:
         for index, material in enumerate(target.layers):
             pm.check_paper_material(material, index)
         self.target, self.projectile, self.reading = target, projectile, reading
-        self.eps = [reading_epsilon(m, reading.epsilon) for m in target.layers]
+        self.eps = [pm.layer_epsilon(m, reading.epsilon) for m in target.layers]
 
     def first_layer(self, depth):
         """Index of the layer whose equations apply at nose-tip depth ``depth``."""
@@ -455,8 +435,8 @@ def main():
 
     target, projectile = load_config()
     print("L1 = H1 + l - r/eps1 by reading of eps (Table 2: 0.40 m):")
-    for epsilon in EPSILON_FORMS:
-        eps1 = reading_epsilon(target.layers[0], epsilon)
+    for epsilon in pm.EPSILON_READINGS:
+        eps1 = pm.layer_epsilon(target.layers[0], epsilon)
         print(f"  {epsilon:22s} eps1 = {eps1:.5f}  L1 = "
               f"{phase_depth_l1(target, projectile, epsilon):.4f} m")
     print(format_study(table2_study(target, projectile)))
