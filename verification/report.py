@@ -1,0 +1,285 @@
+"""The verification report: closed forms against the FE over a (V, L) grid, for one target.
+
+:func:`verify` builds the FE table (:func:`cavex.verification.table.build_table`, run by the
+shared case runner), adds the closed forms (derived dynamic, derived quasi-static, the paper's
+printed model), and writes ``report.md``, ``report.html``, PNG figures, a pyvista picture of the
+cut-open layered sphere and ``grid.nc`` (every number the report prints) into ``out_dir``.
+:func:`verify_main` is the ``cavex verify`` job.
+"""
+
+import json
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+from cavex.verification import report_plots as plots
+from cavex.verification import report_text as text
+from cavex.verification.report_analysis import all_stats, analyse, layer_names
+from cavex.verification.report_html import markdown_to_html
+
+from cavex.errors import CavexInputError
+
+DEFAULT_VELOCITIES = (0.0, 50.0, 100.0, 200.0, 300.0, 400.0, 500.0, 600.0, 800.0, 1000.0,
+                      1200.0)
+# 31 depths through concrete and macadam into the soil (every 0.04 m), then the soil alone
+# (single layer: sigma_r no longer depends on L) down to where the trajectories stop.
+DEFAULT_DEPTHS = tuple(np.round(np.linspace(0.10, 1.30, 31), 6)) + (1.6, 2.0, 2.6, 3.4, 4.0)
+QUICK_VELOCITIES = (0.0, 600.0, 1000.0)
+QUICK_DEPTHS = (0.30, 0.90, 1.30)
+# quick: half the FE resolution in space and time (the error estimate says what that costs)
+QUICK_NUMERICS = {"elements_per_decade": 15.0, "growth_per_step": 0.06}
+PICTURE_VELOCITY = 600.0
+CURVE_VELOCITIES = (200.0, 600.0, 1000.0)
+DEFAULT_OUT = "results/verification"
+
+
+def grid_axes(quick, velocities=None, depths=None):
+    """``(velocities, depths)`` of the report grid (explicit values win over the presets)."""
+    v = velocities if velocities is not None else (QUICK_VELOCITIES if quick
+                                                    else DEFAULT_VELOCITIES)
+    d = depths if depths is not None else (QUICK_DEPTHS if quick else DEFAULT_DEPTHS)
+    return tuple(float(x) for x in v), tuple(float(x) for x in d)
+
+
+def fe_grid(target, projectile, velocities, depths, *, nu, numerics, scheduler, workers,
+            store, progress):
+    """The FE table plus the FE plastic radius of every cell (read from the runner's store)."""
+    from cavex.verification.runner import read_store
+    from cavex.verification.table import build_table
+
+    table = build_table(target, projectile, velocities, depths, nu=nu, numerics=numerics,
+                        scheduler=scheduler, workers=workers, store=store, progress=progress)
+    if "plastic_radius" not in table:
+        table["plastic_radius"] = (("velocity", "depth"), _store_radii(read_store(store), table))
+        table["plastic_radius"].attrs.update(units="m", long_name="FE plastic radius b")
+    return table
+
+
+def _store_radii(entries, table):
+    """FE plastic radius per cell from stored case results (NaN where missing or failed)."""
+    out = np.full((table.sizes["velocity"], table.sizes["depth"]), np.nan)
+    where = {(float(e["case"]["velocity"]), float(e["case"]["depth"])): e["result"]
+             for e in entries.values() if "layers" not in e["case"]
+             and not str(e["case"]["id"]).startswith("first-layer")}
+    for i, V in enumerate(table.velocity.values):
+        for j, L in enumerate(table.depth.values):
+            result = where.get((float(V), float(L)))
+            if result and result.get("status") == "ok":
+                out[i, j] = result["fe_plastic_radius"]
+    return out
+
+
+def trajectories(target, projectile, table):
+    """:func:`compare_trajectories` on the FE table, or a one-line reason why not."""
+    from cavex.verification.tabulated_resistance import compare_trajectories
+
+    try:
+        return compare_trajectories(target, projectile, table)
+    except CavexInputError as exc:
+        return f"Trajectory comparison not possible: {exc}"
+
+
+def picture(target, projectile, grid, out, nu, numerics):
+    """The pyvista picture at ``PICTURE_VELOCITY`` (nearest grid velocity); path and message."""
+    from cavex.verification import report_picture
+
+    v = grid.velocity.values
+    velocity = float(v[np.argmin(np.abs(v - PICTURE_VELOCITY))])
+    depth = report_picture.picture_depth(target, projectile, velocity, grid.depth.values)
+    try:
+        path, message = report_picture.make_picture(target, projectile, velocity, depth,
+                                                    out / "sphere.png", numerics, nu)
+    except Exception as exc:  # noqa: BLE001 - the FE run of the picture failed
+        path, message = None, ("3-D picture not rendered (FE run failed: "
+                               f"{report_picture.first_line(exc)})")
+    return {"path": path, "message": message, "velocity": velocity, "depth": depth}
+
+
+def curve_velocities(grid):
+    """Velocities of the S(L) and b(L) curves: the preset ones present, else three spread."""
+    v = [float(x) for x in grid.velocity.values]
+    chosen = [x for x in CURVE_VELOCITIES if x in v]
+    return chosen or [v[i] for i in sorted({len(v) // 4, len(v) // 2, len(v) - 1})]
+
+
+def figures(grid, target, out):
+    """Write every matplotlib figure; returns ``{name: path}``."""
+    curves = curve_velocities(grid)
+    paths = dict(zip(("error_dynamic", "error_quasi_static", "error_paper"),
+                     plots.error_maps(grid, target, out), strict=True))
+    paths["validity"] = plots.validity_map(grid, target, out)
+    paths["S_depth"] = plots.s_curves(grid, target, out, curves)
+    paths["states"] = plots.state_map(grid, target, out)
+    paths["plastic_radius"] = plots.plastic_radius_plot(grid, target, out, curves)
+    paths["error_estimate"] = plots.error_estimate_map(grid, target, out)
+    return paths
+
+
+def write_grid(grid, path, extra):
+    """``grid.nc`` (netCDF3, scipy engine) with the report's extra attributes as JSON."""
+    ds = grid.copy()
+    for key, value in extra.items():
+        ds.attrs[key] = value if isinstance(value, str) else json.dumps(value)
+    ds.to_netcdf(path, engine="scipy")
+    return path
+
+
+def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=None,
+           config_text=None, velocities=None, depths=None, nu=None, numerics=None,
+           store=None, progress=None):
+    """Write the verification report of ``target`` into ``out_dir``; return its summary.
+
+    Parameters
+    ----------
+    target, projectile : Target, Projectile
+    quick : bool
+        A small grid (3 velocities x 3 depths, plus the table's switch depths) at half the FE
+        resolution, instead of the default (11 velocities 0-1200 m/s x 36 depths, plus the
+        switch depths).
+    out_dir : str or path
+        Output folder (created).
+    scheduler, workers
+        Passed to the case runner (Dask scheduler address, local processes).
+    config_text : str, optional
+        TOML text of the configuration; copied to ``out_dir/target.toml``.
+    velocities, depths : sequence of float, optional
+        Override the grid (velocities must include 0 and reach ``V0`` for the trajectories).
+    nu : float, optional
+        Poisson's ratio for every layer in the FE (default: each layer's own).
+    numerics : dict, optional
+        :class:`cavex.fem.Numerics` settings.
+    store : str or path, optional
+        Case store of the runner (resumable); default: a temporary folder, removed after.
+    progress : bool, optional
+        Runner progress bar.
+
+    Returns
+    -------
+    dict
+        ``out_dir``, ``files``, ``cells``, ``failed``, ``seconds`` (wall time), ``table_seconds``,
+        ``conclusions`` (list of str), ``picture`` (message), ``stats``.
+    """
+    started = time.perf_counter()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    v, d = grid_axes(quick, velocities, depths)
+    if numerics is None and quick:
+        numerics = dict(QUICK_NUMERICS)
+    temporary = store is None
+    store = Path(tempfile.mkdtemp(prefix="cavex-verify-")) if temporary else Path(store)
+    try:
+        fe = fe_grid(target, projectile, v, d, nu=nu, numerics=numerics, scheduler=scheduler,
+                     workers=workers, store=store, progress=progress)
+    finally:
+        if temporary:
+            shutil.rmtree(store, ignore_errors=True)
+    table_seconds = time.perf_counter() - started
+    grid = analyse(fe, target, projectile)
+    trajectory = trajectories(target, projectile, fe)
+    pic = picture(target, projectile, grid, out, nu, numerics)
+    paths = figures(grid, target, out)
+    stats = all_stats(grid, target)
+    lines = text.conclusions(grid, target, stats)
+    seconds = time.perf_counter() - started
+    info = {"quick": quick, "cells": int(grid["failed"].size), "failed": int(grid["failed"].sum()),
+            "table_seconds": table_seconds, "seconds": seconds, "picture": pic["message"]}
+    files = {**{k: str(p) for k, p in paths.items()},
+             "grid": str(write_grid(grid, out / "grid.nc",
+                                    {"report": info, "trajectories": trajectory,
+                                     "conclusions": lines}))}
+    if pic["path"] is not None:
+        files["sphere"] = str(pic["path"])
+    if config_text is not None:
+        (out / "target.toml").write_text(config_text, encoding="utf-8")
+        files["config"] = str(out / "target.toml")
+    markdown = report_markdown(grid, target, stats, lines, trajectory, pic, paths, info)
+    (out / "report.md").write_text(markdown, encoding="utf-8")
+    (out / "report.html").write_text(markdown_to_html(markdown, "cavex verification report"),
+                                     encoding="utf-8")
+    files.update(report=str(out / "report.md"), html=str(out / "report.html"))
+    return {"out_dir": str(out), "files": files, "conclusions": lines, "stats": stats, **info}
+
+
+def _settings_lines(grid, info):
+    v, d = grid.velocity.values, grid.depth.values
+    settings = json.loads(grid.attrs.get("solver_settings", "{}"))
+    return [
+        f"- grid: {v.size} velocities ({', '.join(f'{x:g}' for x in v)} m/s) x {d.size} nose "
+        f"depths ({d[0]:.4g} to {d[-1]:.4g} m, including the wall-layer switch depths) = "
+        f"{info['cells']} FE cells, {info['failed']} failed; "
+        f"{'quick' if info['quick'] else 'default'} settings",
+        f"- FE: Poisson's ratio {settings.get('nu') or 'of each layer'}, numerics "
+        f"`{json.dumps(settings.get('numerics', {}), sort_keys=True)}`",
+        f"- target fingerprint `{grid.attrs.get('fingerprint', '?')}`; versions "
+        f"`{grid.attrs.get('versions', '?')}`; table created {grid.attrs.get('created', '?')}",
+        f"- wall time {info['seconds']:.1f} s (FE table {info['table_seconds']:.1f} s); every "
+        "number below is in `grid.nc`",
+        "- relative error = (analytic - FE) / FE; S = sigma_r / tau of the layer at the cavity "
+        "wall (the derived model's cavity switch) for every model",
+    ]
+
+
+def report_markdown(grid, target, stats, lines, trajectory, pic, paths, info):
+    """The whole ``report.md`` text."""
+    names = layer_names(target)
+    md = ["# cavex verification report: closed forms against FE",
+          f"Target: {', '.join(names)} (interfaces at "
+          f"{', '.join(f'{H:g}' for H in target.interface_depths)} m).", "",
+          *_settings_lines(grid, info), "", "## Conclusion", "",
+          *(f"- {line}" for line in lines), "",
+          "## Accuracy by closed form and wall layer", "", text.accuracy_table(stats, target), "",
+          "## Relative-error maps", "",
+          "Dots: the FE error estimate is not small against the difference (not resolved). "
+          "Crosses: FE failed. Dashed: interface depths.", ""]
+    for key in ("error_dynamic", "error_quasi_static", "error_paper"):
+        md += [f"![{key}]({Path(paths[key]).name})", ""]
+    md += ["## Validity (within 1 % and 5 % of FE)", "",
+           f"![validity]({Path(paths['validity']).name})", "", "## S against depth", "",
+           f"![S_depth]({Path(paths['S_depth']).name})", "",
+           "## Response states and plastic radius", "",
+           f"![states]({Path(paths['states']).name})", "",
+           f"![plastic_radius]({Path(paths['plastic_radius']).name})", "",
+           "## FE error estimate", "", text.resolution_text(grid, stats), "",
+           f"![error_estimate]({Path(paths['error_estimate']).name})", "",
+           "## Failed FE cells", "", text.failed_table(grid), "",
+           "## Where the paper's error comes from", "",
+           "Per cell, (paper - FE)/FE = formulas + convention + idealisation exactly; medians:",
+           "", text.parts_table(grid, target), "",
+           "## The layered sphere cut open", ""]
+    if pic["path"] is not None:
+        md += [f"![sphere]({Path(pic['path']).name})", "", pic["message"] + ".", ""]
+    else:
+        md += [pic["message"], ""]
+    md += ["## Trajectories: closed forms against the FE table", "",
+           text.trajectory_section(trajectory), "",
+           "## Appendix: every cell", "",
+           text.table(text.CELL_HEADER, text.cell_rows(grid, target)), ""]
+    return "\n".join(md)
+
+
+def summary_text(summary):
+    """Printable summary of :func:`verify`'s result."""
+    return "\n".join([
+        f"cells   {summary['cells']} ({summary['failed']} failed)",
+        f"time    {summary['seconds']:.1f} s (FE table {summary['table_seconds']:.1f} s)",
+        f"picture {summary['picture']}",
+        *(f"- {line}" for line in summary["conclusions"]),
+        f"wrote   {summary['files']['report']} (+ html, PNGs, grid.nc) in {summary['out_dir']}",
+    ])
+
+
+def verify_main(config_path=None, quick=False, out_dir=None, scheduler=None, workers=None):
+    """The ``cavex verify`` job: load the config, write the report, return a printable summary."""
+    from cavex.config import default_config_text, load_config
+
+    target, projectile = load_config(config_path)
+    config = default_config_text() if config_path is None else Path(config_path).read_text(
+        encoding="utf-8")
+    summary = verify(target, projectile, quick=quick, out_dir=out_dir or DEFAULT_OUT,
+                     scheduler=scheduler, workers=workers, config_text=config)
+    return summary_text(summary)
+
+
+__all__ = ["verify", "verify_main", "DEFAULT_VELOCITIES", "DEFAULT_DEPTHS"]

@@ -1,0 +1,182 @@
+"""Numbers of the verification report: closed forms against the FE grid, cell by cell.
+
+Everything the report states is computed here from the grid Dataset (the FE table of
+:func:`cavex.verification.table.build_table`) and stored back into it, so that ``grid.nc``
+holds every number the report prints.
+
+Conventions: the relative error of a closed form is ``(analytic - FE) / FE``; ``S`` is
+``sigma_r`` over ``tau`` of the layer at the cavity wall (the FE table's ``wall_layer``, the
+derived model's ``"cavity"`` switch) for every model, so that the curves are comparable.
+"""
+
+import math
+
+import numpy as np
+import xarray as xr
+from cavex.analytic.cavity import cavity_solution
+from cavex.analytic.geometry import spherical_problem
+from cavex.analytic.paper_model import paper_stress
+
+from cavex.errors import CavexInputError
+
+# (key, label, sigma_r variable) of each closed form, in report order.
+MODELS = (("dynamic", "derived dynamic", "sigma_r_dynamic"),
+          ("quasi_static", "derived quasi-static", "sigma_r_quasi_static"),
+          ("paper", "paper (She 2020)", "sigma_r_paper"))
+TOLERANCES = (0.01, 0.05)
+# validity codes: within 1 %, within 5 %, beyond 5 %, FE cell failed
+VALIDITY_LABELS = {0: "within 1 %", 1: "within 5 %", 2: "beyond 5 %", -1: "FE failed"}
+# a difference is "resolved" when the FE error estimate is below this fraction of it
+RESOLVED_FRACTION = 1.0 / 3.0
+# named parts of (paper - FE)/FE: printed formulas, boundary convention, idealisation
+ERROR_PARTS = (("formulas", "paper's printed formulas vs the derived quasi-static solution"),
+               ("convention", "quasi-static vs dynamic elastic-plastic boundary"),
+               ("idealisation", "incompressible small-strain closed form vs the compressible "
+                                "finite-strain FE"))
+
+
+def layer_names(target):
+    """Display name of every layer of ``target``."""
+    return [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]
+
+
+def analytic_cell(target, projectile, depth, velocity):
+    """Closed-form quantities at one nose depth (m) and velocity (m/s) as a plain dict."""
+    layers, interfaces = spherical_problem(target, projectile, depth)
+    cell = {}
+    for key, boundary in (("dynamic", "dynamic"), ("quasi_static", "quasi-static")):
+        state = cavity_solution(layers, interfaces, velocity, projectile.r, boundary=boundary)
+        cell[f"state_{key}"] = state.state
+        cell[f"b_{key}"] = state.plastic_radius
+    try:
+        cell["sigma_r_paper"] = paper_stress(target, projectile, float(depth), float(velocity))
+    except CavexInputError:
+        cell["sigma_r_paper"] = math.nan
+    return cell
+
+
+def add_analytic(grid, target, projectile):
+    """Add ``sigma_r_paper``, ``state_*`` and ``b_*`` (derived dynamic and quasi-static)."""
+    cells = [[analytic_cell(target, projectile, float(L), float(V)) for L in grid.depth.values]
+             for V in grid.velocity.values]
+    dims = ("velocity", "depth")
+    out = grid.copy()
+    for key in cells[0][0]:
+        values = np.array([[c[key] for c in row] for row in cells])
+        out[key] = (dims, values.astype(str) if values.dtype.kind in "US" else values)
+    out["sigma_r_paper"].attrs.update(units="Pa", long_name="paper's wall stress, Eqs. 19-29")
+    for key in ("dynamic", "quasi_static"):
+        out[f"b_{key}"].attrs.update(units="m", long_name=f"derived {key} plastic radius b")
+        out[f"state_{key}"].attrs["long_name"] = f"derived {key} response state (Fig. 2)"
+    return out
+
+
+def add_errors(grid):
+    """Add ``rel_err_*``, ``validity_*`` and ``resolved_*`` for every closed form."""
+    out = grid.copy()
+    failed = out["failed"].astype(bool)
+    fe = out["sigma_r"].where(~failed)
+    for key, label, var in MODELS:
+        rel = (out[var] - fe) / fe
+        out[f"rel_err_{key}"] = rel.assign_attrs(long_name=f"({label} - FE) / FE")
+        out[f"validity_{key}"] = validity_codes(rel, failed)
+        resolved = out["error_estimate"] < RESOLVED_FRACTION * abs(rel)
+        out[f"resolved_{key}"] = xr.where(failed, -1, resolved.astype(np.int8)).astype(
+            np.int8).assign_attrs(long_name=f"FE error estimate < {RESOLVED_FRACTION:.3g} "
+                                  "|rel_err| (1), not (0), failed (-1)")
+    return out
+
+
+def validity_codes(rel, failed):
+    """0 within 1 %, 1 within 5 %, 2 beyond, -1 failed (``int8``)."""
+    mag = abs(rel)
+    codes = xr.where(mag <= TOLERANCES[0], 0, xr.where(mag <= TOLERANCES[1], 1, 2))
+    codes = xr.where(failed | rel.isnull(), -1, codes).astype(np.int8)
+    return codes.assign_attrs(long_name="; ".join(f"{k}: {v}" for k, v in
+                                                  VALIDITY_LABELS.items()))
+
+
+def add_S(grid, target):
+    """Add ``S_<model>`` = analytic ``sigma_r`` over the wall layer's ``tau``."""
+    out = grid.copy()
+    taus = np.array([m.tau for m in target.layers])
+    tau = xr.DataArray(taus[out["wall_layer"].values.astype(int)], dims=out["wall_layer"].dims)
+    for key, _, var in MODELS:
+        out[f"S_{key}"] = (out[var] / tau).assign_attrs(long_name=f"{var} / tau of wall layer")
+    return out
+
+
+def add_error_parts(grid):
+    """Split ``rel_err_paper`` into formulas + convention + idealisation (exactly additive)."""
+    out = grid.copy()
+    fe = out["sigma_r"].where(~out["failed"].astype(bool))
+    parts = {"formulas": out["sigma_r_paper"] - out["sigma_r_quasi_static"],
+             "convention": out["sigma_r_quasi_static"] - out["sigma_r_dynamic"],
+             "idealisation": out["sigma_r_dynamic"] - fe}
+    for name, text in ERROR_PARTS:
+        out[f"part_{name}"] = (parts[name] / fe).assign_attrs(long_name=text + " (over FE)")
+    return out
+
+
+def analyse(grid, target, projectile):
+    """The FE grid with every analytic and derived report quantity added."""
+    grid = grid.transpose("velocity", "depth", ...)
+    return add_error_parts(add_S(add_errors(add_analytic(grid, target, projectile)), target))
+
+
+def layer_mask(grid, index):
+    """Cells (velocity x depth) whose wall layer is ``index`` (FE table's ``wall_layer``)."""
+    return (grid["wall_layer"] == index).broadcast_like(grid["sigma_r"])
+
+
+def layer_stats(grid, key, index):
+    """Statistics of one closed form's error over the cells with wall layer ``index``.
+
+    Returns
+    -------
+    dict
+        ``cells``, ``failed``, ``median``, ``max_abs`` (signed value of the largest
+        magnitude), ``at`` ((V, L) of it), ``within`` (fractions for 1 % and 5 %),
+        ``unresolved`` (cells whose FE error estimate is not small against the difference),
+        ``v_within`` (largest V up to which every cell is within each tolerance, or None).
+    """
+    mask = layer_mask(grid, index)
+    rel = grid[f"rel_err_{key}"].where(mask)
+    ok = rel.notnull()
+    n_ok = int(ok.sum())
+    stats = {"cells": int(mask.sum()), "failed": int((mask & (grid["failed"] != 0)).sum())}
+    if n_ok == 0:
+        return {**stats, "median": math.nan, "max_abs": math.nan, "at": None,
+                "within": (math.nan, math.nan), "unresolved": 0, "v_within": (None, None)}
+    flat = rel.stack(cell=("velocity", "depth")).dropna("cell")
+    worst = flat.isel(cell=int(np.argmax(np.abs(flat.values))))
+    return {**stats, "median": float(flat.median()), "max_abs": float(worst),
+            "at": (float(worst.velocity), float(worst.depth)),
+            "within": tuple(float((abs(flat) <= t).mean()) for t in TOLERANCES),
+            "unresolved": int(((grid[f"resolved_{key}"] == 0) & mask).sum()),
+            "v_within": tuple(velocity_limit(rel, t) for t in TOLERANCES)}
+
+
+def velocity_limit(rel, tolerance):
+    """Largest V such that every cell with velocity <= V is within ``tolerance`` (or None)."""
+    limit = None
+    for V in rel.velocity.values:
+        row = rel.sel(velocity=V)
+        if not bool(row.notnull().any()):
+            continue
+        if bool((abs(row) > tolerance).any()):
+            break
+        limit = float(V)
+    return limit
+
+
+def all_stats(grid, target):
+    """``{model key: {layer index: layer_stats}}`` for the layers present at the wall."""
+    present = sorted({int(i) for i in np.unique(grid["wall_layer"].values)})
+    return {key: {i: layer_stats(grid, key, i) for i in present} for key, _, _ in MODELS}
+
+
+def part_medians(grid, index):
+    """Median of each error part of the paper model over wall layer ``index``."""
+    mask = layer_mask(grid, index)
+    return {name: float(grid[f"part_{name}"].where(mask).median()) for name, _ in ERROR_PARTS}
