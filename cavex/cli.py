@@ -26,6 +26,9 @@ def build_parser():
                            help=f"output folder (default {DEFAULT_PENETRATION_DIR})")
     penetrate.add_argument("--crater", choices=("nose-base", "nose-tip"), default="nose-base",
                            help="where the crater depth 4.5 r is measured from")
+    penetrate.add_argument("--resistance", choices=("closed-form", "table"),
+                           default="closed-form", help="closed form (--model) or an FE table")
+    penetrate.add_argument("--table", help="NetCDF table from `cavex table` (--resistance table)")
     stress = commands.add_parser("stress", help="cavity-wall stress at a nose depth")
     _common(stress)
     stress.add_argument("--velocity", type=float, required=True, help="expansion velocity V (m/s)")
@@ -36,7 +39,23 @@ def build_parser():
     fem.add_argument("--depth", type=float, required=True, help="nose-tip depth L (m)")
     fem.add_argument("--nu", type=float, help="Poisson's ratio for every layer (default: file's)")
     fem.add_argument("--json", action="store_true", help="print JSON")
+    table = commands.add_parser("table", help="FE-tabulated sigma_r(V, L) for the target")
+    table.add_argument("--config", help="target TOML file (default: the paper's Table 1)")
+    table.add_argument("--velocities", nargs="+", type=float, help="m/s (default 0..1200)")
+    table.add_argument("--depths", nargs="+", type=float, help="nose depths, m")
+    table.add_argument("-o", "--out", default="results/table.nc", help="NetCDF file to write")
+    table.add_argument("--nu", type=float, help="Poisson's ratio for every layer")
+    _parallel(table)
+    batch = commands.add_parser("batch", help="run a sweep of FE cases (TOML) into one Dataset")
+    batch.add_argument("sweep", help="sweep TOML file; its [target] section names the target")
+    batch.add_argument("--out", help="output folder (default results/batch/<sweep name>)")
+    _parallel(batch)
     return parser
+
+
+def _parallel(command):
+    command.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://127.0.0.1:8786")
+    command.add_argument("--workers", type=int, help="local worker processes (default: CPUs)")
 
 
 def _common(command):
@@ -53,7 +72,7 @@ def main(argv=None):
     """Entry point; returns the exit code (0 ok, 1 numerical failure, 2 bad input)."""
     try:
         args = build_parser().parse_args(argv)
-        target, projectile = load_config(args.config)
+        target, projectile = load_config(args.config) if "config" in args else (None, None)
         text = COMMANDS[args.command](args, target, projectile)
     except CavexInputError as exc:
         print(f"cavex: error: {exc}", file=sys.stderr)
@@ -72,8 +91,11 @@ def _penetrate(args, target, projectile):
         write_outputs,
     )
 
+    if (args.resistance == "table") != (args.table is not None):
+        raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
+                              "neither)")
     job = penetration_job(target, projectile, model=args.model, boundary=args.boundary,
-                          epsilon=args.epsilon, crater=args.crater)
+                          epsilon=args.epsilon, crater=args.crater, table_path=args.table)
     written = write_outputs(job, args.out)
     phases = phases_as_dicts(job["runs"]["runway"])
     if args.json:
@@ -136,7 +158,21 @@ def _fem(args, target, projectile):
     return "\n".join(lines)
 
 
-COMMANDS = {"penetrate": _penetrate, "stress": _stress, "fem": _fem}
+def _table(args, target, projectile):
+    from cavex.verification.table import table_main
+
+    return table_main(args.config, args.velocities, args.depths, args.out, args.nu,
+                      args.workers, args.scheduler)
+
+
+def _batch(args, target, projectile):
+    from cavex.verification.batch import batch_main
+
+    return batch_main(args.sweep, args.out, args.scheduler, args.workers)
+
+
+COMMANDS = {"penetrate": _penetrate, "stress": _stress, "fem": _fem, "table": _table,
+            "batch": _batch}
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -65,7 +65,8 @@ def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, n
     projectile_table : dict
         The ``[projectile]`` table, see :func:`projectile_table`.
     velocities, depths : sequence of float
-        Expansion velocities (m/s, > 0) and nose-tip depths (m, >= 0).
+        Expansion velocities (m/s, >= 0; 0 is a quasi-static FE run) and nose-tip depths
+        (m, >= 0).
     nu : float, optional
         Poisson's ratio for every layer (default: each layer's own).
     numerics : dict, optional
@@ -93,7 +94,7 @@ def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, n
         require(_finite(nu) and -1.0 < nu < 0.5, "nu", "in (-1, 0.5)", nu)
     cases = []
     for i, velocity in enumerate(velocities):
-        require(_finite(velocity) and velocity > 0, f"velocities[{i}]", "a finite number > 0",
+        require(_finite(velocity) and velocity >= 0, f"velocities[{i}]", "a finite number >= 0",
                 velocity)
         for j, depth in enumerate(depths):
             require(_finite(depth) and depth >= 0, f"depths[{j}]", "a finite number >= 0", depth)

@@ -10,15 +10,30 @@ from cavex.verification.table2 import table2_comparison
 
 
 def penetration_job(target, projectile, *, model="derived", boundary="quasi-static",
-                    epsilon="quasi-static", crater="nose-base"):
-    """Run the target and its first layer alone (the paper's Fig. 4 pair); nothing is written."""
-    runs = {}
-    for name, tgt in (("runway", target), ("first_layer_only", target.single(0))):
-        resistance = ClosedFormResistance(tgt, projectile, model, boundary, epsilon=epsilon)
-        runs[name] = penetrate(tgt, projectile, resistance, crater=crater)
+                    epsilon="quasi-static", crater="nose-base", table_path=None):
+    """Run the target and its first layer alone (the paper's Fig. 4 pair); nothing is written.
+
+    With ``table_path`` the runway uses the FE-tabulated resistance of that table (which must
+    have been built for this target); the first layer alone keeps the closed form ``model``.
+    """
+    single = target.single(0)
+    runs = {"runway": _runway(target, projectile, model, boundary, epsilon, crater, table_path),
+            "first_layer_only": penetrate(single, projectile, ClosedFormResistance(
+                single, projectile, model, boundary, epsilon=epsilon), crater=crater)}
+    if table_path is not None:
+        model = f"FE table {table_path} (first layer alone: {model})"
     return {"model": model, "boundary": boundary, "epsilon": epsilon, "crater": crater,
             "runs": runs, "table2": table2_comparison(runs["runway"]),
             "interface_depths": target.interface_depths}
+
+
+def _runway(target, projectile, model, boundary, epsilon, crater, table_path):
+    if table_path is None:
+        resistance = ClosedFormResistance(target, projectile, model, boundary, epsilon=epsilon)
+        return penetrate(target, projectile, resistance, crater=crater)
+    from cavex.verification.tabulated_resistance import penetrate_with_table
+
+    return penetrate_with_table(target, projectile, table_path, crater=crater)
 
 
 def phases_as_dicts(trajectory):

@@ -31,7 +31,7 @@ import numpy as np
 import xarray as xr
 from cavex.analytic.cavity import cavity_stress
 from cavex.analytic.geometry import spherical_problem, wall_layer
-from cavex.verification.cases import fe_case, fe_case_id, make_fe_cases
+from cavex.verification.cases import fe_case, make_fe_cases
 from cavex.verification.cases import projectile_table as projectile_to_table
 from cavex.verification.cases import target_table as target_to_table
 from cavex.verification.runner import run_cases
@@ -167,19 +167,9 @@ def build_table(target, projectile, velocities, depths, *, nu=None, numerics=Non
 
 
 def table_cases(target, projectile, velocities, depths, nu, numerics):
-    """FE cases in the order velocity-major, depth-minor, ``V = 0`` included.
-
-    ``make_fe_cases`` takes ``V > 0`` only; the ``V = 0`` cases (a quasi-static FE run, which
-    ``expand_cavity`` supports) are its ``V = 1`` cases with the velocity and id replaced.
-    """
-    positive = [x for x in velocities if x > 0.0]
-    args = (target_to_table(target), projectile_to_table(projectile))
-    cases = make_fe_cases(*args, positive, depths, nu=nu, numerics=numerics) if positive else []
-    if velocities[0] == 0.0:
-        zero = make_fe_cases(*args, [1.0], depths, nu=nu, numerics=numerics)
-        cases = [{**case, "velocity": 0.0, "id": fe_case_id(0.0, case["depth"], nu)}
-                 for case in zero] + cases
-    return cases
+    """FE cases in the order velocity-major, depth-minor (``V = 0`` is a quasi-static run)."""
+    return make_fe_cases(target_to_table(target), projectile_to_table(projectile), velocities,
+                         depths, nu=nu, numerics=numerics)
 
 
 def _cells(results, cases, velocities, depths):
