@@ -11,6 +11,12 @@ from matplotlib.colors import BoundaryNorm, ListedColormap, TwoSlopeNorm  # noqa
 VALIDITY_COLOURS = ("#1a9850", "#fee08b", "#d73027", "#7f7f7f")  # 1 %, 5 %, beyond, failed
 
 
+def _depth_limit(ax, grid, target):
+    """Curves end shortly below the last interface (deeper, the wall layer is alone)."""
+    deepest = max(target.interface_depths, default=float(grid.depth.max()))
+    ax.set_xlim(float(grid.depth.min()) - 0.02, min(float(grid.depth.max()), deepest + 0.25))
+
+
 def _save(fig, path):
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
@@ -35,7 +41,7 @@ def _frame(ax, grid, target, title):
         ax.plot(X[failed], Y[failed], "kx", ms=7, mew=1.5, label="FE failed")
         ax.legend(loc="lower right", fontsize=7)
     step = max(1, depths.size // 12)
-    ax.set_yticks(np.arange(0, depths.size, step), [f"{d:.3g}" for d in depths[::step]])
+    ax.set_yticks(np.arange(0, depths.size, step), [f"{d:.4g}" for d in depths[::step]])
     ax.set_xticks(np.arange(velocities.size), [f"{v:g}" for v in velocities], rotation=90)
     ax.set(xlabel="V (m/s)", ylabel="nose depth L (m)", title=title)
     ax.set_ylim(depths.size - 0.5, -0.5)
@@ -96,6 +102,7 @@ def s_curves(grid, target, out, velocities):
                     label=label if i == 0 else None)
     for H in target.interface_depths:
         ax.axvline(H, color="k", lw=0.8, ls="--")
+    _depth_limit(ax, grid, target)
     ax.set(xlabel="nose depth L (m)", ylabel="S = sigma_r / tau (wall layer)", yscale="log",
            title="S against depth (lines: closed forms, points: FE)")
     ax.legend(fontsize=7, ncol=2)
@@ -131,6 +138,7 @@ def plastic_radius_plot(grid, target, out, velocities):
         ax.plot(row.depth.values, row["b_quasi_static"].values, "--", color=colour, lw=1,
                 label="derived quasi-static" if i == 0 else None)
     names = layer_names(target)
+    _depth_limit(ax, grid, target)
     for k, H in enumerate(target.interface_depths):
         ax.axvline(H, color="k", lw=0.8, ls="--")
         ax.text(H, ax.get_ylim()[1], f" {names[k]}|{names[k + 1]}", fontsize=7, va="top")
