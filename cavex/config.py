@@ -3,7 +3,7 @@
 import tomllib
 from importlib import resources
 
-from cavex.errors import CavexInputError, require
+from cavex.errors import CavexInputError, check_keys, prefixed, require
 from cavex.materials import Material, Projectile, Target
 
 LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c"}
@@ -42,7 +42,7 @@ def _read(path):
 
 def parse_config(data):
     """Build ``(target, projectile)`` from an already parsed TOML mapping."""
-    _check_keys(data, TOP_KEYS, "", required=TOP_KEYS)
+    check_keys(data, TOP_KEYS, "", required=TOP_KEYS)
     return parse_target(data["layers"]), parse_projectile(data["projectile"])
 
 
@@ -55,45 +55,28 @@ def parse_target(layers):
         require(isinstance(table, dict), f"layers[{i}]", "a table", table)
         last = i == len(layers) - 1
         required = {"E", "nu", "rho", "lam"} | (set() if last else {"thickness"})
-        _check_keys(table, LAYER_KEYS, where, required=required)
+        check_keys(table, LAYER_KEYS, where, required=required)
         if last and "thickness" in table:
             raise CavexInputError(f"parameter '{where}thickness' must be absent: "
                                   "the last layer is semi-infinite")
         numbers = {k: _number(table[k], where + k) for k in table if k != "name"}
         thickness = numbers.pop("thickness", None)
-        materials.append(_prefixed(Material, where, name=str(table.get("name", "")), **numbers))
+        materials.append(prefixed(Material, where, name=str(table.get("name", "")), **numbers))
         if thickness is not None:
             thicknesses.append(thickness)
-    return _prefixed(Target, "", materials, thicknesses)
+    return prefixed(Target, "", materials, thicknesses)
 
 
 def parse_projectile(table):
     """Build a :class:`Projectile` from the ``[projectile]`` table."""
     require(isinstance(table, dict), "projectile", "a table", table)
-    _check_keys(table, PROJECTILE_KEYS, "projectile.", required={"r", "l", "m", "V0"})
+    check_keys(table, PROJECTILE_KEYS, "projectile.", required={"r", "l", "m", "V0"})
     numbers = {k: _number(v, "projectile." + k) for k, v in table.items()}
-    return _prefixed(Projectile, "projectile.", **numbers)
-
-
-def _prefixed(factory, where, *args, **kwargs):
-    """Call ``factory`` and prefix the parameter named in any input error with ``where``."""
-    try:
-        return factory(*args, **kwargs)
-    except CavexInputError as exc:
-        raise CavexInputError(str(exc).replace("parameter '", f"parameter '{where}", 1)) from None
-
-
-def _check_keys(table, allowed, where, required):
-    for key in table:
-        if key not in allowed:
-            accepted = ", ".join(sorted(allowed))
-            raise CavexInputError(f"unknown key '{where}{key}' (accepted: {accepted})")
-    for key in sorted(required):
-        if key not in table:
-            raise CavexInputError(f"missing key '{where}{key}'")
+    return prefixed(Projectile, "projectile.", **numbers)
 
 
 def _number(value, name):
-    is_number = isinstance(value, (int, float)) and not isinstance(value, bool)
-    require(is_number, name, "a number", value)
+    """Type check only: ranges (and finiteness) are checked by the objects built from it."""
+    require(isinstance(value, (int, float)) and not isinstance(value, bool), name, "a number",
+            value)
     return float(value)

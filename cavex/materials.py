@@ -5,15 +5,11 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from itertools import accumulate
 
-from cavex.errors import require
-
-
-def _is_number(value):
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
+from cavex.errors import is_finite_number, require
 
 
 def _positive(name, value):
-    require(_is_number(value) and math.isfinite(value) and value > 0,
+    require(is_finite_number(value) and math.isfinite(value) and value > 0,
             name, "a finite number > 0", value)
 
 
@@ -60,8 +56,8 @@ class Material:
     def __post_init__(self):
         _positive("E", self.E)
         _positive("rho", self.rho)
-        require(_is_number(self.nu) and -1.0 < self.nu < 0.5, "nu", "in (-1, 0.5)", self.nu)
-        require(_is_number(self.lam) and 0.0 <= self.lam < 3.0, "lam", "in [0, 3)", self.lam)
+        require(is_finite_number(self.nu) and -1.0 < self.nu < 0.5, "nu", "in (-1, 0.5)", self.nu)
+        require(is_finite_number(self.lam) and 0.0 <= self.lam < 3.0, "lam", "in [0, 3)", self.lam)
         require(self.tau is not None or self.sigma_c is not None, "tau",
                 "given (or sigma_c given)", None)
         if self.sigma_c is not None:

@@ -1,8 +1,8 @@
 """Numerical settings of a cavity-expansion run, with their accepted ranges."""
 
-import math
 from dataclasses import asdict, dataclass, fields, replace
 
+from cavex.errors import is_finite_number as _finite
 from cavex.errors import require, require_choice
 
 ASSEMBLIES = ("fast", "forms")
@@ -81,10 +81,6 @@ class Numerics:
 
     def as_dict(self):
         return asdict(self)
-
-
-def _finite(x):
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
 
 
 def check_numerics(n):

@@ -11,7 +11,6 @@ finished case, the resumable store) and ``results.nc`` (the Dataset, netCDF3 via
 
 import itertools
 import json
-import math
 import os
 import re
 import time
@@ -24,7 +23,7 @@ from cavex.verification.cases import config_tables, fe_case, fe_case_id, numeric
 from cavex.verification.runner import read_store, run_cases
 
 from cavex.config import parse_projectile, parse_target
-from cavex.errors import CavexInputError, require
+from cavex.errors import CavexInputError, check_keys, is_finite_number, prefixed, require
 
 SECTIONS = ("sweep", "target", "grid", "numerics", "materials")
 SWEEP_KEYS = ("name", "scheduler", "workers")
@@ -128,13 +127,7 @@ def _read_sweep(path_or_dict):
 
 def _check_table(table, where, allowed, required=()):
     require(isinstance(table, dict), where.rstrip(".") or "sweep file", "a table", table)
-    for key in table:
-        if key not in allowed:
-            raise CavexInputError(f"unknown key '{where}{key}' (accepted: "
-                                  f"{', '.join(sorted(allowed))})")
-    for key in required:
-        if key not in table:
-            raise CavexInputError(f"missing key '{where}{key}'")
+    check_keys(table, allowed, where, required)
 
 
 def _sweep_section(table, default_name):
@@ -164,10 +157,10 @@ def _target_section(table, base_dir):
             raise CavexInputError(f"key 'target.config': {exc}") from None
     layers, projectile = config_tables()
     if "layers" in table:
-        _prefixed(parse_target, "target.", table["layers"])
+        prefixed(parse_target, "target.", table["layers"])
         layers = [dict(t) for t in table["layers"]]
     if "projectile" in table:
-        _prefixed(parse_projectile, "target.", table["projectile"])
+        prefixed(parse_projectile, "target.", table["projectile"])
         projectile = {k: float(v) for k, v in table["projectile"].items()}
     return layers, projectile
 
@@ -185,7 +178,7 @@ def _grid_section(table):
         axes.append(Axis("nu", "grid", ("nu",), values, "1", "Poisson's ratio of every layer"))
         return axes, None
     if nu is not None:
-        require(_is_number(nu) and -1 < nu < 0.5, "grid.nu", "in (-1, 0.5)", nu)
+        require(is_finite_number(nu) and -1 < nu < 0.5, "grid.nu", "in (-1, 0.5)", nu)
         nu = float(nu)
     return axes, nu
 
@@ -203,7 +196,7 @@ def _numerics_section(table):
             fixed[key] = value
     for combination in _combinations(axes):
         settings = {**fixed, **{a.key[1]: v for a, v in zip(axes, combination, strict=True)}}
-        _prefixed(make_numerics, "numerics.", **settings)
+        prefixed(make_numerics, "numerics.", **settings)
     return fixed, axes
 
 
@@ -236,7 +229,7 @@ def _materials_section(entries, layers, grid_sets_nu):
                 _check_property(layers, index, prop, value, where + prop)
                 _set_property(layers[index], prop, value)
     for combination in _combinations(axes):
-        _prefixed(parse_target, "target.", _apply_materials(layers, axes, combination))
+        prefixed(parse_target, "target.", _apply_materials(layers, axes, combination))
     return layers, axes
 
 
@@ -283,7 +276,7 @@ def _apply_materials(layers, axes, combination):
 def _number_list(values, where, condition, accepted):
     require(isinstance(values, list) and values, where, "a non-empty array of numbers", values)
     for i, value in enumerate(values):
-        require(_is_number(value) and condition(value), f"{where}[{i}]",
+        require(is_finite_number(value) and condition(value), f"{where}[{i}]",
                 f"a finite number {accepted}", value)
     return _unique(tuple(float(v) for v in values), where)
 
@@ -300,22 +293,8 @@ def _unique(values, where):
     return values
 
 
-def _prefixed(factory, where, *args, **kwargs):
-    """Call ``factory``; prefix the key named in an input error with ``where``."""
-    try:
-        return factory(*args, **kwargs)
-    except CavexInputError as exc:
-        message = re.sub(r"(parameter|key) '", lambda m: f"{m.group(1)} '{where}", str(exc),
-                         count=1)
-        raise CavexInputError(message) from None
-
-
 def _combinations(axes):
     return itertools.product(*(axis.values for axis in axes))
-
-
-def _is_number(value):
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def _is_int(value):

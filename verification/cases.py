@@ -22,6 +22,7 @@ from cavex.fem.settings import Numerics, make_numerics
 
 from cavex.config import load_config, parse_projectile, parse_target
 from cavex.errors import CavexInputError, CavexNumericalError, require
+from cavex.errors import is_finite_number as _finite
 
 CASE_KEYS = {"id", "velocity", "depth", "nu", "numerics", "target", "projectile"}
 
@@ -185,7 +186,3 @@ def _layers(target):
                 sorted(target))
         return target["layers"]
     return target
-
-
-def _finite(x):
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)

@@ -275,31 +275,39 @@ def _run_dask(function, todo, scheduler, finished):
     own = isinstance(scheduler, str)
     client = _connect(Client, scheduler) if own else scheduler
     try:
-        limit = 2 * max(1, sum(client.nthreads().values()))
-        pending = iter(todo)
-        running = {}
-        _top_up(running, pending, limit,
-                lambda case: client.submit(run_one, function, case, pure=False))
-        stream = as_completed(list(running))
-        for future in stream:
-            case = running.pop(future)
-            result = future.result()
-            future.release()
-            finished(case, result)
-            before = set(running)
-            _top_up(running, pending, limit,
-                    lambda case: client.submit(run_one, function, case, pure=False))
-            for new in running.keys() - before:
-                stream.add(new)
+        with client.as_current():
+            _stream_dask(client, as_completed, function, todo, finished)
     finally:
         if own:
             client.close()
 
 
+def _stream_dask(client, as_completed, function, todo, finished):
+    """Keep at most twice the cluster's threads in flight; hand results back as they finish."""
+    limit = 2 * max(1, sum(client.nthreads().values()))
+    pending = iter(todo)
+    running = {}
+
+    def submit(case):
+        return client.submit(run_one, function, case, pure=False)
+
+    _top_up(running, pending, limit, submit)
+    stream = as_completed(list(running))
+    for future in stream:
+        case = running.pop(future)
+        result = future.result()
+        future.release()
+        finished(case, result)
+        before = set(running)
+        _top_up(running, pending, limit, submit)
+        for new in running.keys() - before:
+            stream.add(new)
+
+
 def _connect(client_class, address):
     """A client for ``address``; an unreachable or malformed address is an input error."""
-    try:
-        return client_class(address)
+    try:  # not the default client: a failed connection must not leave dask (and xarray) using it
+        return client_class(address, set_as_default=False)
     except (OSError, ValueError, TypeError) as exc:
         raise CavexInputError(f"parameter 'scheduler' must be a reachable Dask scheduler "
                               f"address (got {address!r}: {one_line_reason(exc)})") from None
