@@ -46,6 +46,11 @@ def build_parser():
     table.add_argument("-o", "--out", default="results/table.nc", help="NetCDF file to write")
     table.add_argument("--nu", type=float, help="Poisson's ratio for every layer")
     _parallel(table)
+    verify = commands.add_parser("verify", help="analytic against FE report for the target")
+    verify.add_argument("--config", help="target TOML file (default: the paper's Table 1)")
+    verify.add_argument("--quick", action="store_true", help="small grid (under a minute)")
+    verify.add_argument("--out", help="report folder (default results/verification)")
+    _parallel(verify)
     batch = commands.add_parser("batch", help="run a sweep of FE cases (TOML) into one Dataset")
     batch.add_argument("sweep", help="sweep TOML file; its [target] section names the target")
     batch.add_argument("--out", help="output folder (default results/batch/<sweep name>)")
@@ -165,6 +170,12 @@ def _table(args, target, projectile):
                       args.workers, args.scheduler)
 
 
+def _verify(args, target, projectile):
+    from cavex.verification.report import verify_main
+
+    return verify_main(args.config, args.quick, args.out, args.scheduler, args.workers)
+
+
 def _batch(args, target, projectile):
     from cavex.verification.batch import batch_main
 
@@ -172,7 +183,7 @@ def _batch(args, target, projectile):
 
 
 COMMANDS = {"penetrate": _penetrate, "stress": _stress, "fem": _fem, "table": _table,
-            "batch": _batch}
+            "verify": _verify, "batch": _batch}
 
 if __name__ == "__main__":
     sys.exit(main())
