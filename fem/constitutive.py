@@ -86,6 +86,10 @@ class PointMaterial:
                    lam_psi=np.full(pick.shape, lam_psi),
                    tension=per_layer(cut))
 
+    def take(self, index):
+        """The constants at ``index`` (anything that indexes the point arrays)."""
+        return PointMaterial(**{name: value[index] for name, value in vars(self).items()})
+
 
 @dataclass
 class PointResponse:
@@ -118,7 +122,7 @@ def _surfaces(sign, mat):
     return (a_mc, mat.tau, g_mc), (a_tc, mat.tension, g_tc)
 
 
-def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat):
+def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat, groups=None):
     """Return-map the trial state; see the module docstring for the equations solved.
 
     Parameters
@@ -128,6 +132,11 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat):
     theta_p, gamma_p : ndarray
         Plastic volumetric and deviatoric log strains at the start of the step.
     mat : PointMaterial
+    groups : ndarray of int, optional
+        Group (independent model, e.g. one case of a batch) of every point. The Mohr-Coulomb-
+        only return is used for all points unless some point needs the multi-surface one;
+        that choice is made per group, so each group gets exactly the arithmetic it would get
+        if it were return-mapped alone. None: all points form one group.
 
     Returns
     -------
@@ -148,7 +157,8 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat):
         sigma_3 = np.where(positive, P - Q / 3.0, P + 2.0 * Q / 3.0)
         f_tc = -sigma_3 - mat.tension * J
     plastic = (f_mc > tol) | (f_tc > tol)
-    if np.any(f_tc > tol):
+    general = f_tc > tol
+    if groups is None and np.any(general):
         return _general_return(theta, gamma, J, theta_p, gamma_p, mat)
     # Mohr-Coulomb alone (tension cut-off inactive everywhere): one multiplier per point
     c_psi = np.where(positive, 1.0, 1.0 + mat.lam_psi / 3.0)
@@ -158,7 +168,8 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat):
     P_new = P - dl * d_P
     Q_new = Q - dl * d_Q
     trial_ok = _tension_ok(P_new, Q_new, J, mat)
-    if not np.all(trial_ok | ~plastic):
+    general |= plastic & ~trial_ok
+    if groups is None and np.any(general):
         return _general_return(theta, gamma, J, theta_p, gamma_p, mat)
     th_p = theta_p + dl * mat.lam_psi
     ga_p = gamma_p - dl * 1.5 * c_psi * sign
@@ -167,7 +178,22 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat):
     row_t = (mat.lam * K - mat.tau * J) * pl
     row_g = (-2.0 * G * c_mc * sign) * pl
     T = np.array([[-K - d_P * row_t, -d_P * row_g], [-d_Q * row_t, -2.0 * G - d_Q * row_g]])
-    return _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P_new, Q_new, T, plastic, J, mat)
+    response = _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P_new, Q_new, T, plastic, J,
+                       mat)
+    if groups is not None and np.any(general):
+        redo = np.isin(groups, np.unique(groups[general]))
+        _replace(response, redo, _general_return(theta[redo], gamma[redo], J[redo],
+                                                 theta_p[redo], gamma_p[redo], mat.take(redo)))
+    return response
+
+
+def _replace(response, where, other):
+    """Overwrite ``response`` at the points ``where`` (boolean) by ``other`` (those points)."""
+    for name, value in vars(response).items():
+        if name == "tangent":
+            value[:, :, where] = other.tangent
+        else:
+            value[where] = getattr(other, name)
 
 
 def _tension_ok(P, Q, J, mat):

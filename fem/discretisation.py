@@ -26,7 +26,60 @@ def gauss_rule(n):
     return np.array([0.5 * (x + 1.0)]), 0.5 * w
 
 
-class Discretisation:
+class FastAssembly:
+    """The vectorised kernels over (element, point) arrays, shared with batches of models.
+
+    Needs ``degree``, ``ndof``, ``element_dofs`` (nel, nb), ``N`` (nb, nq), ``dNdR``
+    (nel, nb, nq), ``R_points`` and ``weights`` (nel, nq).
+    """
+
+    def displacement_gradients(self, u):
+        """``(lambda_r - 1, lambda_t - 1) = (du/dR, u/R)`` at the reduced quadrature points.
+
+        Strains are formed as ``log1p`` of these, which keeps full relative precision at the
+        tiny strains of the elastic verification problems.
+        """
+        ue = u[self.element_dofs]  # (nel, nb)
+        g_r = (ue[:, :, None] * self.dNdR).sum(1)
+        g_t = (ue @ self.N) / self.R_points
+        return g_r, g_t
+
+    def assemble_response(self, lam_r, lam_t, resp, tangent=True):
+        """Internal force, banded tangent and ``resp`` from the stretches and point response."""
+        W = self.weights
+        Br = self.dNdR / lam_r[:, None, :]                       # (nel, nb, nq)
+        Bt = self.N[None, :, :] / (self.R_points * lam_t)[:, None, :]
+        fe = ((W * resp.tau_r)[:, None, :] * Br + (2.0 * W * resp.tau_t)[:, None, :] * Bt).sum(2)
+        f = np.bincount(self.element_dofs.ravel(), fe.ravel(), minlength=self.ndof)
+        if not tangent:
+            return f, None, resp
+        C = resp.tangent
+        # d tau_i / du_b minus the geometric term, then K_ab = sum_q W (Br_a X_b + 2 Bt_a Y_b)
+        X = C[0, 0][:, None, :] * Br + C[0, 1][:, None, :] * Bt - resp.tau_r[:, None, :] * Br
+        Y = C[1, 0][:, None, :] * Br + C[1, 1][:, None, :] * Bt - resp.tau_t[:, None, :] * Bt
+        P = Br * W[:, None, :]
+        Q = Bt * (2.0 * W)[:, None, :]
+        # K_ab = sum_q P_aq X_bq + sum_q Q_aq Y_bq, summed in q order (not BLAS): reproducible
+        k1 = P[:, :, None, 0] * X[:, None, :, 0]
+        k2 = Q[:, :, None, 0] * Y[:, None, :, 0]
+        for q in range(1, P.shape[2]):
+            k1 += P[:, :, None, q] * X[:, None, :, q]
+            k2 += Q[:, :, None, q] * Y[:, None, :, q]
+        Ke = k1 + k2
+        return f, self._band(Ke), resp
+
+    def _band(self, Ke):
+        """Scatter element matrices (nel, nb, nb) into LAPACK band storage (2p+1, ndof)."""
+        p = self.degree
+        if not hasattr(self, "_band_index"):
+            rows = np.repeat(self.element_dofs[:, :, None], self.element_dofs.shape[1], axis=2)
+            cols = np.repeat(self.element_dofs[:, None, :], self.element_dofs.shape[1], axis=1)
+            self._band_index = ((p + rows - cols) * self.ndof + cols).ravel()
+        band = np.bincount(self._band_index, Ke.ravel(), minlength=(2 * p + 1) * self.ndof)
+        return band.reshape(2 * p + 1, self.ndof)
+
+
+class Discretisation(FastAssembly):
     """Mesh, bases and point data of one radial model.
 
     Parameters
@@ -96,17 +149,6 @@ class Discretisation:
                 "eq_p": np.zeros(shape)}
 
     # ------------------------------------------------------------------ kinematics
-    def displacement_gradients(self, u):
-        """``(lambda_r - 1, lambda_t - 1) = (du/dR, u/R)`` at the reduced quadrature points.
-
-        Strains are formed as ``log1p`` of these, which keeps full relative precision at the
-        tiny strains of the elastic verification problems.
-        """
-        ue = u[self.element_dofs]  # (nel, nb)
-        g_r = (ue[:, :, None] * self.dNdR).sum(1)
-        g_t = (ue @ self.N) / self.R_points
-        return g_r, g_t
-
     def respond(self, u, state, g=None):
         """Return map at the points from radial dofs ``u`` (or given gradients ``g``).
 
@@ -129,30 +171,7 @@ class Discretisation:
     def assemble_fast(self, u, state, tangent=True):
         """Internal force (radial order), banded tangent and point response, vectorised."""
         lam_r, lam_t, resp = self.respond(u, state)
-        W = self.weights
-        Br = self.dNdR / lam_r[:, None, :]                       # (nel, nb, nq)
-        Bt = self.N[None, :, :] / (self.R_points * lam_t)[:, None, :]
-        fe = ((W * resp.tau_r)[:, None, :] * Br + (2.0 * W * resp.tau_t)[:, None, :] * Bt).sum(2)
-        f = np.bincount(self.element_dofs.ravel(), fe.ravel(), minlength=self.ndof)
-        if not tangent:
-            return f, None, resp
-        C = resp.tangent
-        # d tau_i / du_b minus the geometric term, then K_ab = sum_q W (Br_a X_b + 2 Bt_a Y_b)
-        X = C[0, 0][:, None, :] * Br + C[0, 1][:, None, :] * Bt - resp.tau_r[:, None, :] * Br
-        Y = C[1, 0][:, None, :] * Br + C[1, 1][:, None, :] * Bt - resp.tau_t[:, None, :] * Bt
-        Ke = (Br * W[:, None, :]) @ X.transpose(0, 2, 1) + (Bt * (2.0 * W)[:, None, :]) @ \
-            Y.transpose(0, 2, 1)
-        return f, self._band(Ke), resp
-
-    def _band(self, Ke):
-        """Scatter element matrices (nel, nb, nb) into LAPACK band storage (2p+1, ndof)."""
-        p = self.degree
-        if not hasattr(self, "_band_index"):
-            rows = np.repeat(self.element_dofs[:, :, None], self.element_dofs.shape[1], axis=2)
-            cols = np.repeat(self.element_dofs[:, None, :], self.element_dofs.shape[1], axis=1)
-            self._band_index = ((p + rows - cols) * self.ndof + cols).ravel()
-        band = np.bincount(self._band_index, Ke.ravel(), minlength=(2 * p + 1) * self.ndof)
-        return band.reshape(2 * p + 1, self.ndof)
+        return self.assemble_response(lam_r, lam_t, resp, tangent)
 
     # ------------------------------------------------------------------ forms path
     def assemble_forms(self, u, state, tangent=True):
