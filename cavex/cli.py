@@ -4,6 +4,7 @@ import argparse
 import json
 import sys
 
+from cavex.analytic.paper_model import EPSILON_READINGS
 from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
 
@@ -68,8 +69,8 @@ def _common(command):
     command.add_argument("--model", choices=("derived", "paper"), default="derived")
     command.add_argument("--boundary", choices=("quasi-static", "dynamic"), default="quasi-static",
                          help="yield-at-boundary convention of the derived model")
-    command.add_argument("--epsilon", choices=("quasi-static", "cylindrical"),
-                         default="quasi-static", help="the paper model's reading of epsilon")
+    command.add_argument("--epsilon", choices=EPSILON_READINGS, default="quasi-static",
+                         help="the paper model's reading of epsilon (docs/table2.md)")
     command.add_argument("--json", action="store_true", help="print JSON")
 
 
