@@ -224,32 +224,43 @@ class Stack(FastAssembly):
     def per_case_all(self, dof_flags):
         return np.logical_and.reduceat(dof_flags, self.dof_start)
 
-    def solve(self, band, rhs, identity_cases):
-        """Solve the block-diagonal banded system; fixed dofs and ``identity_cases`` (bool per
-        case) get identity rows. Returns the increment and the cases whose block is singular."""
-        band = band.copy()
-        flat = band.reshape(-1)
+    def solve(self, band, rhs, skip):
+        """Solve the block-diagonal banded system for the cases without ``skip`` (bool per
+        case; their increment is zero); fixed dofs get identity rows. Returns the increment and
+        the cases whose block is singular.
+
+        Only the blocks solved are passed to LAPACK (gathered when some are skipped): partial
+        pivoting never leaves a block, so each is factorised exactly as it would be alone.
+        """
+        p = self.degree
+        flat = band.reshape(-1)  # band is the caller's scratch copy
         flat[self.fixed_entries] = 0.0
         flat[self.fixed_diagonal] = 1.0
         rhs = np.where(self.free, rhs, 0.0)
-        if identity_cases.any():
-            cols = _ranges(self.dof_start[identity_cases], self.dof_count[identity_cases])
-            band[:, cols] = 0.0
-            band[self.degree, cols] = 1.0
-            rhs[cols] = 0.0
-        p = self.degree
+        du = np.zeros_like(rhs)
         singular = np.zeros(self.n_cases, dtype=bool)
+        solve = np.flatnonzero(~skip)
+        if solve.size == 0:
+            return du, singular
+        if solve.size < self.n_cases:
+            cols = _ranges(self.dof_start[solve], self.dof_count[solve])
+            band, rhs = band[:, cols], rhs[cols]
+        else:
+            cols = slice(None)
         try:
-            return solve_banded((p, p), band, rhs, check_finite=False), singular
+            du[cols] = solve_banded((p, p), band, rhs, check_finite=False)
         except (LinAlgError, ValueError):
-            du = np.zeros_like(rhs)
-            for c in range(self.n_cases):
-                s = slice(self.dof_start[c], self.dof_start[c] + self.dof_count[c])
+            starts = _starts(self.dof_count[solve])
+            for c, start in zip(solve, starts, strict=True):
+                s = slice(start, start + self.dof_count[c])
                 try:
-                    du[s] = solve_banded((p, p), band[:, s], rhs[s], check_finite=False)
+                    part = solve_banded((p, p), band[:, s], rhs[s], check_finite=False)
                 except (LinAlgError, ValueError):
                     singular[c] = True
-            return du, singular
+                    continue
+                d = self.dof_start[c]
+                du[d:d + self.dof_count[c]] = part
+        return du, singular
 
 
 # ---------------------------------------------------------------------------------- Newton
@@ -306,7 +317,7 @@ def _newton(stack, w, params, dynamic, tol, first_iteration=1):
         else:
             a = np.zeros_like(u)
             residual = f
-            jac = band
+            jac = band.copy()
         r_free = np.where(stack.free, residual, 0.0)
         _fail(reasons, done, ~stack.per_case_all(np.isfinite(r_free)), "non-finite residual")
         with np.errstate(invalid="ignore"):
@@ -337,6 +348,8 @@ def _newton(stack, w, params, dynamic, tol, first_iteration=1):
 
 def _fail(reasons, done, flags, why):
     """Mark the not-yet-done cases among ``flags`` failed with ``why``."""
+    if not flags.any():
+        return
     new = flags & ~done
     for c in np.flatnonzero(new):
         reasons[c] = why
