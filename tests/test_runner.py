@@ -109,7 +109,8 @@ def test_store_resume_computes_only_missing_cases(tmp_path):
         run_cases(probe_case, json.loads({json.dumps(json.dumps(cases))}),
                   store={str(store)!r}, workers=1)
     """)
-    process = subprocess.Popen([sys.executable, "-c", script])
+    # -P: import the installed package, not the checkout's cavex/ folder
+    process = subprocess.Popen([sys.executable, "-P", "-c", script])
     try:
         _wait_for_files(store, 5, process)
     finally:
