@@ -29,7 +29,7 @@ one-case path, also the debugging path) for those.
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -61,6 +61,8 @@ DEFAULT_BATCH = 200     # cases per stack (measured optimum on a 2-core machine:
 SHRINK_FRACTION = 0.25  # continue on a smaller stack when at most this fraction still iterates
 MIN_SHRINK = 8          # ... and the stack has at least this many cases
 ON_ERROR = ("return", "raise")
+DISC_CACHE = 1024       # discretisations kept per process (a table has 2 per depth)
+_DISCS = {}             # (layers, interfaces, radius, numerics) -> Discretisation
 
 
 @dataclass
@@ -72,7 +74,9 @@ class CaseResult:
     m) are those :func:`cavex.fem.expand_cavity` returns; NaN (``u`` None) when the case failed,
     and ``error`` then holds the :class:`~cavex.errors.CavexNumericalError` (naming V, the step's
     cavity radius and the wall radius). ``stats``: ``elements``, ``dofs``, ``steps``,
-    ``newton_iterations``, ``cutbacks`` of the main run and ``coarse_cavity_stress``.
+    ``newton_iterations``, ``cutbacks`` of the main run, ``coarse_cavity_stress`` and
+    ``refinements`` (see ``error_target``). ``numerics``: the settings of the run (those given,
+    or refined ones), with which :func:`cavex.fem.expand_cavity` reproduces it.
     """
 
     velocity: float
@@ -83,6 +87,7 @@ class CaseResult:
     u: np.ndarray | None
     stats: dict = field(default_factory=dict)
     error: CavexNumericalError | None = None
+    numerics: dict = field(default_factory=dict)
 
     @property
     def ok(self):
@@ -534,7 +539,8 @@ def _problem(i, problem):
     return layers, interfaces, float(velocity), float(radius)
 
 
-def expand_cavities(problems, *, batch_size=DEFAULT_BATCH, on_error="return", **numerics):
+def expand_cavities(problems, *, batch_size=DEFAULT_BATCH, on_error="return", error_target=None,
+                    max_refinements=2, **numerics):
     """Expand many spherical cavities with shared settings; the batched :func:`expand_cavity`.
 
     Parameters
@@ -548,6 +554,13 @@ def expand_cavities(problems, *, batch_size=DEFAULT_BATCH, on_error="return", **
         A case whose Newton iteration fails after the cut-backs comes back with ``error`` set
         (the others are unaffected), or, with ``"raise"``, the first such error is raised after
         the whole list has run.
+    error_target : float, optional
+        With the error estimate on, a case whose estimate exceeds this relative error is run
+        again at twice the space and time resolution (``elements_per_decade * 2``,
+        ``growth_per_step / 2``; the estimate then comes from that run and its half-resolution
+        run), up to ``max_refinements`` times. None (default): every case at the given settings.
+    max_refinements : int
+        See ``error_target``, >= 0.
     **numerics
         Fields of :class:`cavex.fem.settings.Numerics`, shared by all cases.
         ``assembly="forms"`` runs the cases one at a time through :func:`expand_cavity` (the
@@ -574,14 +587,38 @@ def expand_cavities(problems, *, batch_size=DEFAULT_BATCH, on_error="return", **
         require(settings.seed_radius is None or settings.seed_radius < radius,
                 f"problems[{i}]: seed_radius", f"in (0, radius = {radius})",
                 settings.seed_radius)
-    if settings.assembly == "forms":
-        results = [_one_case(p, settings) for p in problems]
-    else:
-        results = _batched(problems, settings, batch_size)
+    require(error_target is None or (isinstance(error_target, float) and 0 < error_target < 1),
+            "error_target", "None or a float in (0, 1)", error_target)
+    require(isinstance(max_refinements, int) and not isinstance(max_refinements, bool)
+            and max_refinements >= 0, "max_refinements", "an integer >= 0", max_refinements)
+    results = _run(problems, settings, batch_size)
+    for refinement in range(1, max_refinements + 1):
+        if error_target is None or not settings.error_estimate:
+            break
+        redo = [i for i, r in enumerate(results) if r.ok and r.error_estimate > error_target]
+        if not redo:
+            break
+        settings = replace(settings, elements_per_decade=2.0 * settings.elements_per_decade,
+                           growth_per_step=0.5 * settings.growth_per_step)
+        for i, r in zip(redo, _run([problems[i] for i in redo], settings, batch_size),
+                        strict=True):
+            r.stats["refinements"] = refinement
+            results[i] = r
     if on_error == "raise":
         for r in results:
             if r.error is not None:
                 raise r.error
+    return results
+
+
+def _run(problems, settings, batch_size):
+    if settings.assembly == "forms":
+        results = [_one_case(p, settings) for p in problems]
+    else:
+        results = _batched(problems, settings, batch_size)
+    for r in results:
+        r.stats.setdefault("refinements", 0)
+        r.numerics = settings.as_dict()
     return results
 
 
@@ -602,13 +639,14 @@ def _batched(problems, settings, batch_size):
     runs = [settings] + ([settings.coarsened()] if settings.error_estimate else [])
     outs = []
     for numerics in runs:
-        cache = {}
 
-        def disc(layers, interfaces, radius, numerics=numerics, cache=cache):
-            key = (layers, interfaces, radius)
-            if key not in cache:
-                cache[key] = build_model(layers, interfaces, radius, numerics)[0]
-            return cache[key]
+        def disc(layers, interfaces, radius, numerics=numerics):
+            key = (layers, interfaces, radius, numerics)
+            if key not in _DISCS:
+                if len(_DISCS) >= DISC_CACHE:
+                    _DISCS.clear()
+                _DISCS[key] = build_model(layers, interfaces, radius, numerics)[0]
+            return _DISCS[key]
 
         out = [None] * len(problems)
         for dynamic in (True, False):
@@ -654,7 +692,8 @@ def expand_chunk(case):
     """:func:`expand_cavities` on a JSON-able chunk of problems (for a process pool or Dask).
 
     ``case``: ``{"id": str, "problems": [{"layers": [Material fields], "interfaces": [...],
-    "velocity": V, "radius": a}, ...], "numerics": {...}}`` (``numerics`` optional). Returns a
+    "velocity": V, "radius": a}, ...], "numerics": {...}, "error_target": e}`` (the last two
+    optional; see :func:`expand_cavities`). Returns a
     JSON-able dict of lists in the order of the problems: ``cavity_stress``,
     ``error_estimate``, ``plastic_radius`` (None where the case failed) and ``error`` (the
     one-line failure message, or None).
@@ -663,7 +702,8 @@ def expand_chunk(case):
 
     problems = [([Material(**m) for m in p["layers"]], p["interfaces"], p["velocity"],
                  p["radius"]) for p in case["problems"]]
-    results = expand_cavities(problems, **case.get("numerics", {}))
+    results = expand_cavities(problems, error_target=case.get("error_target"),
+                              **case.get("numerics", {}))
 
     def value(x):
         return None if x is None or not math.isfinite(x) else float(x)

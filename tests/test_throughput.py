@@ -110,3 +110,18 @@ def test_bad_input_is_rejected(problems, kwargs, name):
 
 def test_empty_list_gives_empty_result():
     assert expand_cavities([]) == []
+
+
+def test_error_target_refines_only_the_cases_above_it():
+    cases = [([CONCRETE], [], 500.0, RADIUS), ([CONCRETE], [], 100.0, RADIUS)]
+    plain = expand_cavities(cases)
+    target = 0.5 * (plain[0].error_estimate + plain[1].error_estimate)
+    above = int(plain[1].error_estimate > target)
+    results = expand_cavities(cases, error_target=target, max_refinements=1)
+    refined = results[above]
+    assert refined.stats["refinements"] == 1 and results[1 - above].stats["refinements"] == 0
+    assert refined.numerics["elements_per_decade"] == 60.0
+    one = expand_cavity(*cases[above], **refined.numerics)
+    assert refined.cavity_stress == one.cavity_stress
+    assert refined.error_estimate == one.error_estimate < plain[above].error_estimate
+    assert results[1 - above].cavity_stress == plain[1 - above].cavity_stress
