@@ -35,7 +35,8 @@ class ExpansionResult:
         ``work`` at the wall, ``kinetic``, ``stored`` (elastic), ``dissipated`` (J).
     stats : dict
         ``elements``, ``dofs``, ``steps``, ``newton_iterations``, ``cutbacks``, ``seconds``,
-        ``coarse_cavity_stress``.
+        and with an error estimate ``error_companion`` (``"coarse"``, or ``"finer"`` where the
+        coarse run failed) with that run's ``coarse_cavity_stress`` or ``finer_cavity_stress``.
     """
 
     cavity_stress: float
