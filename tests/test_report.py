@@ -89,6 +89,119 @@ def test_accuracy_table_and_conclusion_from_grid(quick_report):
     assert all(line in md for line in summary["conclusions"])
 
 
+PARTS = {"dynamic": ("idealisation",), "quasi_static": ("convention", "idealisation"),
+         "paper": ("formulas", "convention", "idealisation")}
+PART_NAMES = {"formulas": "printed formulas/switch", "convention": "boundary convention",
+              "idealisation": "idealisation"}
+NUMBER = r"([+-]\d+\.\d{3}) %"
+
+
+def _parts_from_stresses(grid):
+    """(paper - FE)/FE split into formulas + convention + idealisation, from the stresses."""
+    fe = np.where(grid["failed"].values.astype(bool), np.nan, grid["sigma_r"].values)
+    paper, qs, dyn = (grid[v].values for v in ("sigma_r_paper", "sigma_r_quasi_static",
+                                                "sigma_r_dynamic"))
+    return {"formulas": (paper - qs) / fe, "convention": (qs - dyn) / fe,
+            "idealisation": (dyn - fe) / fe}
+
+
+def _listed(text):
+    """``{part: percent}`` from ``"name +1.234 %, name -0.500 %"``."""
+    names = {v: k for k, v in PART_NAMES.items()}
+    items = [re.fullmatch(r"([a-z /]+) " + NUMBER, x) for x in text.split(", ")]
+    return {names[m.group(1)]: float(m.group(2)) for m in items}
+
+
+def _expected_within(rel, velocities, tolerance):
+    """Largest V up to which every depth is within ``tolerance`` (rows all-NaN skipped)."""
+    limit = None
+    for i, V in enumerate(velocities):
+        row = rel[i][np.isfinite(rel[i])]
+        if row.size == 0:
+            continue
+        if np.any(np.abs(row) > tolerance):
+            break
+        limit = V
+    return limit
+
+
+def test_conclusions_attribute_the_error_from_recomputed_parts(quick_report):
+    """Every number of the conclusion lines, recomputed here from the stresses in grid.nc."""
+    _, summary, grid = quick_report
+    parts = _parts_from_stresses(grid)
+    fe = np.where(grid["failed"].values.astype(bool), np.nan, grid["sigma_r"].values)
+    velocities, depths = grid.velocity.values, grid.depth.values
+    var = {"dynamic": "sigma_r_dynamic", "quasi_static": "sigma_r_quasi_static",
+           "paper": "sigma_r_paper"}
+    labels = {"dynamic": "derived dynamic", "quasi_static": "derived quasi-static",
+              "paper": "paper (She 2020)"}
+    checked = set()
+    for key in PARTS:
+        rel_all = (grid[var[key]].values - fe) / fe
+        # the parts add up exactly to the model's error, cell by cell
+        np.testing.assert_allclose(sum(parts[p] for p in PARTS[key]), rel_all, rtol=0,
+                                   atol=1e-12)
+        for index, name in enumerate(("concrete", "macadam", "soil")):
+            mask = (grid["wall_layer"].values == index)[None, :] & np.isfinite(rel_all)
+            rel = np.where(mask, rel_all, np.nan)
+            line = next(x for x in summary["conclusions"]
+                        if x.startswith(f"{labels[key]}, {name} at the wall: "))
+            # where within 1 % and 5 %
+            for tolerance in TOLERANCES:
+                t = f"within {100 * tolerance:g} % of FE"
+                limit = _expected_within(rel, velocities, tolerance)
+                fraction = np.mean(np.abs(rel[mask]) <= tolerance)
+                if limit is None:
+                    assert (f"never {t}" in line if fraction == 0 else
+                            f"{t} in only {100 * fraction:.1f} % of its cells" in line)
+                elif limit == velocities[-1]:
+                    assert f"{t} in every cell (V up to {limit:g} m/s)" in line
+                elif limit == 0:
+                    assert f"{t} at every depth only at V = 0" in line
+                else:
+                    assert f"{t} at every depth only for V <= {limit:g} m/s" in line
+            # the worst cell
+            i, j = np.unravel_index(np.nanargmax(np.abs(rel)), rel.shape)
+            worst = re.search(r"worst " + NUMBER + r" at V = (\S+) m/s, L = (\S+) m\.", line)
+            assert float(worst.group(1)) == pytest.approx(100 * rel[i, j], abs=5e-4)
+            assert float(worst.group(2)) == velocities[i]
+            assert float(worst.group(3)) == pytest.approx(depths[j], rel=5e-4)
+            # medians of the parts, and the parts at the worst cell
+            medians = {p: 100 * np.nanmedian(np.where(mask, parts[p], np.nan))
+                       for p in PARTS[key]}
+            at_worst = {p: 100 * parts[p][i, j] for p in PARTS[key]}
+            median_part = max(medians, key=lambda p: abs(medians[p]))
+            worst_part = max(at_worst, key=lambda p: abs(at_worst[p]))
+            if key == "dynamic":
+                alone = re.search(r"Its error is the idealisation part alone \(median "
+                                  + NUMBER + r"\)", line)
+                assert float(alone.group(1)) == pytest.approx(medians["idealisation"],
+                                                              abs=5e-4)
+                assert medians["idealisation"] == pytest.approx(100 * np.nanmedian(rel))
+            else:
+                listed = re.search(r"Medians of its error parts: (.*?) \(median error "
+                                   + NUMBER + r"\)\.", line)
+                printed = _listed(listed.group(1))
+                assert printed.keys() == medians.keys()
+                for p in medians:
+                    assert printed[p] == pytest.approx(medians[p], abs=5e-4), (line, p)
+                assert float(listed.group(2)) == pytest.approx(100 * np.nanmedian(rel),
+                                                               abs=5e-4)
+                there = _listed(re.search(r"\(there: (.*?)\)", line).group(1))
+                assert there.keys() == at_worst.keys()
+                for p in at_worst:
+                    assert there[p] == pytest.approx(at_worst[p], abs=5e-4), (line, p)
+                if median_part == worst_part:
+                    assert (f"The {PART_NAMES[median_part]} part dominates both the median "
+                            "and the worst cell" in line)
+                else:
+                    assert f"The {PART_NAMES[median_part]} part dominates the median" in line
+                    assert (f"At the worst cell the {PART_NAMES[worst_part]} part dominates"
+                            in line)
+            checked.add((key, index))
+    assert len(checked) == 9
+
+
 def test_validity_matches_recomputed_errors(quick_report):
     _, _, grid = quick_report
     fe = grid["sigma_r"].values
@@ -134,6 +247,8 @@ def test_failed_cell_and_renderer_failure(tmp_path, monkeypatch, capsys):
     grid = xr.load_dataset(tmp_path / "grid.nc", engine="scipy")
     assert int(grid["failed"].sum()) == 1 and bool(grid["failed"].sel(velocity=1000.0, depth=0.5))
     assert int(grid["validity_paper"].sel(velocity=1000.0, depth=0.5)) == -1
+    assert np.isnan(grid["plastic_radius"].sel(velocity=1000.0, depth=0.5))
+    assert int(np.isnan(grid["plastic_radius"]).sum()) == 1
     assert "| 1000 | 0.5 | RuntimeError: injected failure |" in md
     _, rows = appendix_rows(md)
     assert [r[:2] for r in rows if r[-1] == "FE FAILED"] == [["1000", "0.5"]]

@@ -13,12 +13,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import xarray as xr
-from cavex.analytic.cavity import cavity_stress
+from cavex.analytic.cavity import cavity_solution, cavity_stress
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.penetration import penetrate
 from cavex.analytic.resistance import ClosedFormResistance
 from cavex.verification.cases import fe_case
-from cavex.verification.runner import run_cases
+from cavex.verification.runner import read_store, run_cases
 from cavex.verification.table import (
     DEFAULT_DEPTHS,
     DEFAULT_VELOCITIES,
@@ -58,10 +58,16 @@ def synthetic(runway):
 
 
 @pytest.fixture(scope="module")
-def fe_table(runway):
+def fe_store(tmp_path_factory):
+    """The runner's case store of ``fe_table`` (to compare the table with the case results)."""
+    return tmp_path_factory.mktemp("fe_store")
+
+
+@pytest.fixture(scope="module")
+def fe_table(runway, fe_store):
     """A real FE table, 4 velocities x 4 depths + the 2 switch nodes, coarse numerics."""
     return build_table(*runway, [0.0, 400.0, 800.0, 1200.0], [0.1, 0.4, 0.8, 1.2],
-                       numerics=COARSE, workers=2, progress=False, refine=())
+                       numerics=COARSE, workers=2, progress=False, refine=(), store=fe_store)
 
 
 def test_lean_pchip_is_scipys():
@@ -80,7 +86,7 @@ def test_netcdf_round_trip_is_exact_with_attributes(synthetic, runway, tmp_path)
     loaded = load_table(path)
     assert loaded.attrs.pop("source") == str(path)
     xr.testing.assert_identical(loaded, synthetic)
-    for name in ("sigma_r", "S", "error_estimate", "sigma_r_first_layer"):
+    for name in ("sigma_r", "S", "error_estimate", "plastic_radius", "sigma_r_first_layer"):
         assert np.array_equal(loaded[name].values, synthetic[name].values, equal_nan=True)
     assert loaded["failed"].dtype == bool and loaded["wall_layer"].dtype == np.int32
     for name in [*loaded.data_vars, *loaded.coords]:
@@ -276,3 +282,32 @@ def test_small_fe_table_builds_and_drives_the_integrator(fe_table, runway, tmp_p
     assert set(summary) == {"derived quasi-static", "derived dynamic", "paper", "FE table"}
     fe, dynamic = summary["FE table"]["at_H1"], summary["derived dynamic"]["at_H1"]
     assert fe["velocity_m_s"] == pytest.approx(dynamic["velocity_m_s"], rel=0.1)
+
+
+def test_table_plastic_radius_is_the_case_results(fe_table, fe_store, runway):
+    """``plastic_radius`` of every cell is its case result's ``fe_plastic_radius`` (NaN where
+    the cell failed); the first-layer cases are not in the grid."""
+    b = fe_table["plastic_radius"]
+    assert b.dims == ("velocity", "depth") and b.attrs["units"] == "m"
+    entries = [e for e in read_store(fe_store).values()
+               if not str(e["case"]["id"]).startswith("first-layer")]
+    assert len(entries) == b.size
+    for entry in entries:
+        case, result = entry["case"], entry["result"]
+        value = float(b.sel(velocity=case["velocity"], depth=case["depth"]))
+        if result["status"] == "ok":
+            assert value == result["fe_plastic_radius"]
+        else:
+            assert np.isnan(value)
+    # no failed cell; b >= the cavity radius (b = a where the soil is elastic, FE to 0.1 %)
+    assert np.all(b.values > 0.999 * runway[1].r)
+
+
+def test_analytic_table_plastic_radius_is_the_closed_forms(synthetic, runway):
+    target, projectile = runway
+    for V in (0.0, 600.0, 1200.0):
+        for L in synthetic.depth.values[::7]:
+            layers, interfaces = spherical_problem(target, projectile, float(L))
+            state = cavity_solution(layers, interfaces, V, projectile.r, boundary="quasi-static")
+            assert float(synthetic["plastic_radius"].sel(velocity=V, depth=L)) == \
+                state.plastic_radius

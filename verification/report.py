@@ -8,8 +8,6 @@ cut-open layered sphere and ``grid.nc`` (every number the report prints) into ``
 """
 
 import json
-import shutil
-import tempfile
 import time
 from pathlib import Path
 
@@ -18,6 +16,7 @@ from cavex.verification import report_plots as plots
 from cavex.verification import report_text as text
 from cavex.verification.report_analysis import all_stats, analyse, layer_names
 from cavex.verification.report_html import markdown_to_html
+from cavex.verification.table import build_table
 
 from cavex.errors import CavexInputError
 
@@ -41,34 +40,6 @@ def grid_axes(quick, velocities=None, depths=None):
                                                     else DEFAULT_VELOCITIES)
     d = depths if depths is not None else (QUICK_DEPTHS if quick else DEFAULT_DEPTHS)
     return tuple(float(x) for x in v), tuple(float(x) for x in d)
-
-
-def fe_grid(target, projectile, velocities, depths, *, nu, numerics, scheduler, workers,
-            store, progress):
-    """The FE table plus the FE plastic radius of every cell (read from the runner's store)."""
-    from cavex.verification.runner import read_store
-    from cavex.verification.table import build_table
-
-    table = build_table(target, projectile, velocities, depths, nu=nu, numerics=numerics,
-                        scheduler=scheduler, workers=workers, store=store, progress=progress)
-    if "plastic_radius" not in table:
-        table["plastic_radius"] = (("velocity", "depth"), _store_radii(read_store(store), table))
-        table["plastic_radius"].attrs.update(units="m", long_name="FE plastic radius b")
-    return table
-
-
-def _store_radii(entries, table):
-    """FE plastic radius per cell from stored case results (NaN where missing or failed)."""
-    out = np.full((table.sizes["velocity"], table.sizes["depth"]), np.nan)
-    where = {(float(e["case"]["velocity"]), float(e["case"]["depth"])): e["result"]
-             for e in entries.values() if "layers" not in e["case"]
-             and not str(e["case"]["id"]).startswith("first-layer")}
-    for i, V in enumerate(table.velocity.values):
-        for j, L in enumerate(table.depth.values):
-            result = where.get((float(V), float(L)))
-            if result and result.get("status") == "ok":
-                out[i, j] = result["fe_plastic_radius"]
-    return out
 
 
 def trajectories(target, projectile, table):
@@ -151,7 +122,7 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     numerics : dict, optional
         :class:`cavex.fem.Numerics` settings.
     store : str or path, optional
-        Case store of the runner (resumable); default: a temporary folder, removed after.
+        Case store of the runner (resumable); default: none (nothing kept on disk).
     progress : bool, optional
         Runner progress bar.
 
@@ -167,14 +138,8 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     v, d = grid_axes(quick, velocities, depths)
     if numerics is None and quick:
         numerics = dict(QUICK_NUMERICS)
-    temporary = store is None
-    store = Path(tempfile.mkdtemp(prefix="cavex-verify-")) if temporary else Path(store)
-    try:
-        fe = fe_grid(target, projectile, v, d, nu=nu, numerics=numerics, scheduler=scheduler,
+    fe = build_table(target, projectile, v, d, nu=nu, numerics=numerics, scheduler=scheduler,
                      workers=workers, store=store, progress=progress)
-    finally:
-        if temporary:
-            shutil.rmtree(store, ignore_errors=True)
     table_seconds = time.perf_counter() - started
     grid = analyse(fe, target, projectile)
     trajectory = trajectories(target, projectile, fe)

@@ -33,6 +33,9 @@ ERROR_PARTS = (("formulas", "paper's printed formulas vs the derived quasi-stati
                ("convention", "quasi-static vs dynamic elastic-plastic boundary"),
                ("idealisation", "incompressible small-strain closed form vs the compressible "
                                 "finite-strain FE"))
+# the parts that make up each closed form's (model - FE)/FE, exactly, cell by cell
+MODEL_PARTS = {"dynamic": ("idealisation",), "quasi_static": ("convention", "idealisation"),
+               "paper": ("formulas", "convention", "idealisation")}
 
 
 def layer_names(target):
@@ -180,3 +183,26 @@ def part_medians(grid, index):
     """Median of each error part of the paper model over wall layer ``index``."""
     mask = layer_mask(grid, index)
     return {name: float(grid[f"part_{name}"].where(mask).median()) for name, _ in ERROR_PARTS}
+
+
+def attribution(grid, key, index, at):
+    """Where the error of closed form ``key`` over wall layer ``index`` comes from.
+
+    The parts of :data:`MODEL_PARTS` add up exactly, per cell, to ``rel_err_<key>``; their
+    medians (over the cells of the layer where the model's error is defined) do not add up.
+
+    Returns
+    -------
+    dict
+        ``medians`` ({part: median}), ``median_part`` (largest ``|median|``), ``worst``
+        ({part: value} at the cell ``at`` = (V, L), the model's worst cell) and ``worst_part``
+        (largest ``|value|`` there).
+    """
+    parts = MODEL_PARTS[key]
+    mask = layer_mask(grid, index) & grid[f"rel_err_{key}"].notnull()
+    medians = {p: float(grid[f"part_{p}"].where(mask).median()) for p in parts}
+    cell = grid.sel(velocity=at[0], depth=at[1])
+    worst = {p: float(cell[f"part_{p}"]) for p in parts}
+    return {"medians": medians, "worst": worst,
+            "median_part": max(parts, key=lambda p: abs(medians[p])),
+            "worst_part": max(parts, key=lambda p: abs(worst[p]))}

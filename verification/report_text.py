@@ -13,6 +13,7 @@ from cavex.verification.report_analysis import (
     MODELS,
     RESOLVED_FRACTION,
     TOLERANCES,
+    attribution,
     layer_names,
     part_medians,
 )
@@ -43,20 +44,35 @@ def table(header, rows):
     return "\n".join(lines)
 
 
-def _limit_text(limit, vmax):
+PART_NAMES = {"formulas": "printed formulas/switch", "convention": "boundary convention",
+              "idealisation": "idealisation"}
+
+
+def _within_text(limit, vmax, vmin, fraction, tolerance):
+    """Where the closed form is within ``tolerance`` of FE, plainly."""
+    t = f"{100 * tolerance:g} % of FE"
     if limit is None:
-        return "not even at the lowest velocity"
-    if limit == 0.0:
-        return "only at V = 0 (quasi-static)"
+        if fraction == 0.0:
+            return f"never within {t}"
+        return (f"within {t} in only {100 * fraction:.1f} % of its cells (some depths are "
+                f"beyond even at V = {vmin:g} m/s)")
     if limit >= vmax:
-        return f"at every velocity up to {vmax:g} m/s"
-    return f"for V <= {limit:g} m/s"
+        return f"within {t} in every cell (V up to {vmax:g} m/s)"
+    if limit == 0.0:
+        return f"within {t} at every depth only at V = 0 (quasi-static)"
+    return f"within {t} at every depth only for V <= {limit:g} m/s"
 
 
 def conclusions(grid, target, stats):
-    """Plain-language conclusion lines generated from the statistics."""
+    """Plain-language conclusion lines generated from the statistics.
+
+    Per closed form and wall layer: the velocities up to which every depth is within 1 % and
+    5 % of FE, the worst cell, and the attribution of the error to the parts of
+    :data:`~cavex.verification.report_analysis.MODEL_PARTS` (their medians, the part dominating
+    the median and the part dominating the worst cell).
+    """
     names = layer_names(target)
-    vmax = float(grid.velocity.max())
+    vmax, vmin = float(grid.velocity.max()), float(grid.velocity.min())
     lines = []
     for index in sorted(next(iter(stats.values()))):
         best = min(stats, key=lambda k: abs(stats[k][index]["median"])
@@ -67,25 +83,32 @@ def conclusions(grid, target, stats):
             if not math.isfinite(s["median"]):
                 lines.append(f"{LABELS[key]}: no FE result in {names[index]}.")
                 continue
+            within = [_within_text(s["v_within"][i], vmax, vmin, s["within"][i], t)
+                      for i, t in enumerate(TOLERANCES)]
             lines.append(
-                f"{LABELS[key]}, {names[index]} at the wall: within {100 * TOLERANCES[0]:g} % "
-                f"of FE {_limit_text(s['v_within'][0], vmax)}, within "
-                f"{100 * TOLERANCES[1]:g} % {_limit_text(s['v_within'][1], vmax)}; worst "
-                f"{pct(s['max_abs'])} at V = {s['at'][0]:g} m/s, L = {s['at'][1]:.4g} m"
-                f"{_reason(grid, index, key)}.")
+                f"{LABELS[key]}, {names[index]} at the wall: {within[0]}; {within[1]}; worst "
+                f"{pct(s['max_abs'])} at V = {s['at'][0]:g} m/s, L = {s['at'][1]:.4g} m. "
+                f"{_attribution_text(attribution(grid, key, index, s['at']), s['median'])}")
     return lines
 
 
-def _reason(grid, index, key):
-    """``" because ..."`` naming the largest median part of the error (paper: three parts)."""
-    parts = part_medians(grid, index)
-    used = {"paper": ("formulas", "convention", "idealisation"),
-            "quasi_static": ("convention", "idealisation"), "dynamic": ("idealisation",)}[key]
-    name = max(used, key=lambda p: abs(parts[p]) if math.isfinite(parts[p]) else -1.0)
-    if not math.isfinite(parts[name]):
-        return ""
-    return (f"; the largest part of the median error ({pct(parts[name])}) is because "
-            f"{PART_REASONS[name]}")
+def _attribution_text(a, median):
+    """The parts of the error: medians, and which part dominates the median and the worst cell."""
+    medians, worst = a["medians"], a["worst"]
+    if len(medians) == 1:
+        (part,) = medians
+        return (f"Its error is the {PART_NAMES[part]} part alone (median {pct(medians[part])}): "
+                f"{PART_REASONS[part]}.")
+    listed = ", ".join(f"{PART_NAMES[p]} {pct(m)}" for p, m in medians.items())
+    there = ", ".join(f"{PART_NAMES[p]} {pct(w)}" for p, w in worst.items())
+    m, w = a["median_part"], a["worst_part"]
+    out = f"Medians of its error parts: {listed} (median error {pct(median)}). "
+    if m == w:
+        return (out + f"The {PART_NAMES[m]} part dominates both the median and the worst cell "
+                f"(there: {there}): {PART_REASONS[m]}.")
+    return (out + f"The {PART_NAMES[m]} part dominates the median: {PART_REASONS[m]}. At the "
+            f"worst cell the {PART_NAMES[w]} part dominates (there: {there}): "
+            f"{PART_REASONS[w]}.")
 
 
 def accuracy_table(stats, target):
@@ -150,14 +173,12 @@ def cell_rows(grid, target):
                          "n/a" if failed else f"{float(c['error_estimate']):.3e}",
                          *(pct(float(c[f"rel_err_{k}"])) for k, _, _ in MODELS),
                          str(c["state_dynamic"].values), str(c["state_quasi_static"].values),
-                         _mm(c.get("plastic_radius")), _mm(c["b_dynamic"]),
+                         _mm(c["plastic_radius"]), _mm(c["b_dynamic"]),
                          _mm(c["b_quasi_static"]), ", ".join(flags) or "-"])
     return rows
 
 
 def _mm(value):
-    if value is None:
-        return "n/a"
     x = float(value)
     return "n/a" if not math.isfinite(x) else f"{1e3 * x:.2f}"
 

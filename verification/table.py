@@ -7,10 +7,11 @@ velocity ``V``, on a grid, as an :class:`xarray.Dataset`:
 - coordinates ``velocity`` (m/s; must start at 0, see ``docs/verification.md``) and ``depth``
   (nose-tip depth, m); the depth grid always contains the wall-layer switch depths
   ``H_i + l - r`` inside its range, where ``sigma_r`` is continuous but its slope is not;
-- ``sigma_r``, ``S``, ``error_estimate``, ``failed`` on ``(velocity, depth)`` (failed cells
-  NaN), ``wall_layer`` on ``depth``, the analytic ``sigma_r_dynamic`` and
-  ``sigma_r_quasi_static`` for reference, and ``sigma_r_first_layer`` / ``failed_first_layer``
-  on ``velocity``: the first layer alone, semi-infinite, for the crater stage;
+- ``sigma_r``, ``S``, ``error_estimate``, ``plastic_radius`` (FE elastic-plastic boundary),
+  ``failed`` on ``(velocity, depth)`` (failed cells NaN), ``wall_layer`` on ``depth``, the
+  analytic ``sigma_r_dynamic`` and ``sigma_r_quasi_static`` for reference, and
+  ``sigma_r_first_layer`` / ``failed_first_layer`` on ``velocity``: the first layer alone,
+  semi-infinite, for the crater stage;
 - attributes: the TOML text of the target and projectile, their fingerprint, the solver
   settings (JSON), package versions and the creation time.
 
@@ -29,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from cavex.analytic.cavity import cavity_stress
+from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.verification.cases import fe_case, make_fe_cases
 from cavex.verification.cases import projectile_table as projectile_to_table
@@ -173,9 +174,11 @@ def table_cases(target, projectile, velocities, depths, nu, numerics):
 
 
 def _cells(results, cases, velocities, depths):
-    """Grid arrays ``sigma_r``, ``S``, ``error_estimate``, ``failed`` and the failure list."""
+    """Grid arrays ``sigma_r``, ``S``, ``error_estimate``, ``plastic_radius``, ``failed`` and the
+    failure list."""
     shape = (len(velocities), len(depths))
-    out = {k: np.full(shape, np.nan) for k in ("sigma_r", "S", "error_estimate")}
+    out = {k: np.full(shape, np.nan) for k in ("sigma_r", "S", "error_estimate",
+                                                "plastic_radius")}
     failed = np.zeros(shape, dtype=bool)
     failures = []
     for case, result in zip(cases, results, strict=True):
@@ -188,6 +191,7 @@ def _cells(results, cases, velocities, depths):
             continue
         out["sigma_r"][i, j] = result["fe_sigma_r"]
         out["S"][i, j] = result["S"]
+        out["plastic_radius"][i, j] = result["fe_plastic_radius"]
         estimate = result.get("error_estimate")
         out["error_estimate"][i, j] = np.nan if estimate is None else estimate
     return {**out, "failed": failed, "failures": failures}
@@ -205,17 +209,18 @@ def analytic_table(target, projectile, velocities, depths, boundary="quasi-stati
                    refine=SWITCH_REFINEMENT):
     """A table filled from the closed form instead of the FE (for tests and comparisons).
 
-    ``sigma_r`` is :func:`cavex.analytic.cavity_stress` with ``boundary``; the grid is built as
-    :func:`build_table` builds it.
+    ``sigma_r`` and ``plastic_radius`` are the closed form's (:func:`cavex.analytic.cavity_solution`
+    with ``boundary``); the grid is built as :func:`build_table` builds it.
     """
     check_grid(velocities, depths)
     v = np.unique(np.asarray(velocities, dtype=float))
     d = grid_depths(depths, target, projectile, refine)
 
     def cells(tgt, ds):
-        sigma = _analytic_grid(tgt, projectile, v, ds, boundary)
+        sigma, b = _analytic_grid(tgt, projectile, v, ds, boundary, ("stress", "plastic_radius"))
         tau = np.array([tgt.layers[wall_layer(tgt, projectile, L)].tau for L in ds])
         return {"sigma_r": sigma, "S": sigma / tau, "error_estimate": np.zeros_like(sigma),
+                "plastic_radius": b,
                 "failed": np.zeros(sigma.shape, dtype=bool), "failures": []}
 
     return assemble_table(target, projectile, v, d, cells(target, d),
@@ -223,13 +228,15 @@ def analytic_table(target, projectile, velocities, depths, boundary="quasi-stati
                           json.dumps({"analytic": boundary, "switch": "cavity"}))
 
 
-def _analytic_grid(target, projectile, velocities, depths, boundary):
-    out = np.empty((len(velocities), len(depths)))
+def _analytic_grid(target, projectile, velocities, depths, boundary, fields=None):
+    """Closed-form ``sigma_r`` on the grid, or one array per :class:`CavityState` field."""
+    out = np.empty((len(fields or ("stress",)), len(velocities), len(depths)))
     for j, L in enumerate(depths):
         layers, interfaces = spherical_problem(target, projectile, L)
         for i, V in enumerate(velocities):
-            out[i, j] = cavity_stress(layers, interfaces, V, projectile.r, boundary=boundary)
-    return out
+            state = cavity_solution(layers, interfaces, V, projectile.r, boundary=boundary)
+            out[:, i, j] = [getattr(state, f) for f in fields or ("stress",)]
+    return out[0] if fields is None else tuple(out)
 
 
 def assemble_table(target, projectile, velocities, depths, cells, crater, settings):
@@ -243,6 +250,8 @@ def assemble_table(target, projectile, velocities, depths, cells, crater, settin
         "S": (grid, cells["S"], _attrs("1", "sigma_r / tau of the wall layer")),
         "error_estimate": (grid, cells["error_estimate"],
                            _attrs("1", "FE relative discretisation error (Richardson)")),
+        "plastic_radius": (grid, cells["plastic_radius"],
+                           _attrs("m", "FE elastic-plastic boundary radius b")),
         "failed": (grid, cells["failed"], _attrs("1", "FE run failed (cell is NaN)")),
         "wall_layer": ("depth", np.array([wall_layer(target, projectile, L) for L in d],
                                          dtype=np.int32),
