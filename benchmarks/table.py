@@ -18,9 +18,10 @@ depth from ``spherical_problem``, every case at the default settings (error esti
   the nodal displacements;
 - the largest error estimate of the table and the failed cases (V = 0 in soil: the
   quasi-static Newton iteration fails in the one-case path as well);
-- scaling: the same table on a local Dask cluster of 1..N single-threaded workers through
-  :func:`cavex.verification.runner.run_cases` (chunks of ``--chunk`` cases), speed-up and
-  efficiency ``T1 / (N T_N)``.
+- scaling: the same table on a local Dask cluster of 1..N single-threaded workers, and on 1..N
+  local processes, through :func:`cavex.verification.runner.run_cases` (chunks of ``--chunk``
+  consecutive cases), speed-up and efficiency ``T1 / (N T_N)``; the results are checked equal
+  to the in-process ones.
 
 Run: ``python benchmarks/table.py [--repeats 3] [--baseline 24] [--workers 2] [--chunk 50]``.
 Also prints the load average before and after (the machine is shared).
@@ -107,27 +108,40 @@ def identity(subset, batched):
     return worst
 
 
-def dask_scaling(problems, workers, chunk):
+def scaling(problems, workers, chunk, reference, kind):
+    """The table through ``run_cases`` on 1..``workers`` local Dask workers (one thread each)
+    or local processes; checks the results equal the in-process ``reference`` stresses."""
+    import dask
     from cavex.fem.batch import expand_chunk
     from cavex.verification.runner import run_cases
     from dask.distributed import Client, LocalCluster
 
     cases = chunks(problems, chunk)
+    # no statistical profiler in the workers, and no aggressive heap trimming (Dask's default
+    # MALLOC_TRIM_THRESHOLD_ = 64 kB makes every large numpy temporary fault its pages in)
+    config = {"distributed.worker.profile.enabled": False,
+              "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": 2**28}
     seconds = {}
-    reference = None
     for n in range(1, workers + 1):
-        with LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                          dashboard_address=None) as cluster, Client(cluster) as client:
-            run_cases(expand_chunk, chunks(problems[:4], 4), scheduler=client, progress=False)
+        if kind == "dask":
+            with dask.config.set(config), LocalCluster(
+                    n_workers=n, threads_per_worker=1, processes=True,
+                    dashboard_address=None) as cluster, Client(cluster) as client:
+                run_cases(expand_chunk, chunks(problems[:4], 4), scheduler=client,
+                          progress=False)
+                started = time.perf_counter()
+                out = run_cases(expand_chunk, cases, scheduler=client, progress=False)
+                seconds[n] = time.perf_counter() - started
+        else:
             started = time.perf_counter()
-            out = run_cases(expand_chunk, cases, scheduler=client, progress=False)
+            out = run_cases(expand_chunk, cases, workers=n, progress=False)
             seconds[n] = time.perf_counter() - started
         stresses = [x for r in out for x in r["cavity_stress"]]
-        reference = reference or stresses
-        assert stresses == reference, "Dask results differ between worker counts"
-        print(f"dask {n} worker(s)    : {seconds[n]:.1f} s, {len(problems) / seconds[n]:.1f} "
-              f"cases/s, speed-up {seconds[1] / seconds[n]:.2f}, efficiency "
-              f"{seconds[1] / (n * seconds[n]):.2f}   ({load()})", flush=True)
+        assert stresses == reference, f"{kind} results differ from the in-process ones"
+        print(f"{kind + f' {n} worker(s)':21}: {seconds[n]:.1f} s, "
+              f"{len(problems) / seconds[n]:.1f} cases/s, speed-up "
+              f"{seconds[1] / seconds[n]:.2f}, efficiency {seconds[1] / (n * seconds[n]):.2f}"
+              f"   ({load()})", flush=True)
     return seconds
 
 
@@ -198,7 +212,9 @@ def main():
           + f" ({len(pick)} cases)")
     print(f"identity vs forms    : cavity_stress {vs_forms:.1e}")
     if args.workers:
-        dask_scaling(problems, args.workers, args.chunk)
+        reference = [None if not r.ok else r.cavity_stress for r in results]
+        scaling(problems, args.workers, args.chunk, reference, "dask")
+        scaling(problems, args.workers, args.chunk, reference, "processes")
     print(f"end: {load()}")
 
 

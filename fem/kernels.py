@@ -1,14 +1,14 @@
 """Compiled (numba) point and element kernels of a stack of cases: one pass per Newton iteration.
 
-:func:`assemble_stack` computes, case by case, what :meth:`Stack.respond` and
-:meth:`~cavex.fem.discretisation.FastAssembly.assemble_response` compute with numpy: the
-displacement gradients, the Hencky/Mohr-Coulomb return map of :mod:`cavex.fem.constitutive`
+:func:`assemble_stack` computes, case by case, what :meth:`cavex.fem.batch.Stack.respond` and
+:meth:`~cavex.fem.discretisation.FastAssembly.assemble_response` compute with numpy from the
+displacement gradients: the Hencky/Mohr-Coulomb return map of :mod:`cavex.fem.constitutive`
 (the Mohr-Coulomb-only closed form, or the multi-surface one for every point of a case in which
 some point needs it, as the numpy code decides per case), the internal force, the banded
-consistent tangent, the force yardstick and the folded-element flag. The formulas are written
-in the same order as the numpy expressions, so the two agree to rounding (measured: results of
-whole runs identical to 1e-10 relative; see tests/test_throughput.py). Only the quantities the
-batch needs are returned (no energies or dissipation).
+consistent tangent, the force yardstick and the folded-element flag. Every formula is written
+in the order of the numpy expression it replaces, which makes the results bit-for-bit those of
+the numpy kernels (measured on whole runs, benchmarks/table.py; tests/test_throughput.py checks
+1e-10). Only the quantities the batch needs are returned (no energies or dissipation).
 """
 
 import math
