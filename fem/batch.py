@@ -41,6 +41,7 @@ from cavex.fem.expansion import (
     expand_cavity,
     radius_schedule,
     richardson_error,
+    richardson_error_from_finer,
     wall_times,
 )
 from cavex.fem.fields import plastic_radius
@@ -74,9 +75,11 @@ class CaseResult:
     m) are those :func:`cavex.fem.expand_cavity` returns; NaN (``u`` None) when the case failed,
     and ``error`` then holds the :class:`~cavex.errors.CavexNumericalError` (naming V, the step's
     cavity radius and the wall radius). ``stats``: ``elements``, ``dofs``, ``steps``,
-    ``newton_iterations``, ``cutbacks`` of the main run, ``coarse_cavity_stress`` and
-    ``refinements`` (see ``error_target``). ``numerics``: the settings of the run (those given,
-    or refined ones), with which :func:`cavex.fem.expand_cavity` reproduces it.
+    ``newton_iterations``, ``cutbacks`` of the main run, ``error_companion`` (``"coarse"``, or
+    ``"finer"`` where the 2x coarser run failed) and its ``coarse_cavity_stress`` or
+    ``finer_cavity_stress``, and ``refinements`` (see ``error_target``). ``numerics``: the
+    settings of the run (those given, or refined ones), with which
+    :func:`cavex.fem.expand_cavity` reproduces it.
     """
 
     velocity: float
@@ -630,54 +633,76 @@ def _one_case(problem, settings):
         return CaseResult(velocity, radius, math.nan, None, math.nan, None, {}, exc)
     stats = {k: r.stats[k] for k in ("elements", "dofs", "steps", "newton_iterations",
                                      "cutbacks")}
-    stats["coarse_cavity_stress"] = r.stats.get("coarse_cavity_stress")
+    for name in ("coarse_cavity_stress", "finer_cavity_stress", "error_companion"):
+        if name in r.stats:
+            stats[name] = r.stats[name]
     return CaseResult(velocity, radius, r.cavity_stress, r.error_estimate, r.plastic_radius,
                       r.fields["u"], stats)
 
 
+def _run_all(problems, numerics, batch_size):
+    """One run of every problem at ``numerics`` (stacks of ``batch_size``); list of dicts."""
+
+    def disc(layers, interfaces, radius):
+        key = (layers, interfaces, radius, numerics)
+        if key not in _DISCS:
+            if len(_DISCS) >= DISC_CACHE:
+                _DISCS.clear()
+            _DISCS[key] = build_model(layers, interfaces, radius, numerics)[0]
+        return _DISCS[key]
+
+    out = [None] * len(problems)
+    for dynamic in (True, False):
+        group = [i for i, p in enumerate(problems) if (numerics.dynamic and p[2] > 0.0) == dynamic]
+        for start in range(0, len(group), batch_size):
+            chunk = group[start:start + batch_size]
+            models = [(disc(problems[i][0], problems[i][1], problems[i][3]), problems[i][2],
+                       problems[i][3]) for i in chunk]
+            for i, r in zip(chunk, _run_batch(models, numerics), strict=True):
+                out[i] = r
+    return out
+
+
 def _batched(problems, settings, batch_size):
-    runs = [settings] + ([settings.coarsened()] if settings.error_estimate else [])
-    outs = []
-    for numerics in runs:
-
-        def disc(layers, interfaces, radius, numerics=numerics):
-            key = (layers, interfaces, radius, numerics)
-            if key not in _DISCS:
-                if len(_DISCS) >= DISC_CACHE:
-                    _DISCS.clear()
-                _DISCS[key] = build_model(layers, interfaces, radius, numerics)[0]
-            return _DISCS[key]
-
-        out = [None] * len(problems)
-        for dynamic in (True, False):
-            group = [i for i, p in enumerate(problems)
-                     if (settings.dynamic and p[2] > 0.0) == dynamic]
-            for start in range(0, len(group), batch_size):
-                chunk = group[start:start + batch_size]
-                models = [(disc(problems[i][0], problems[i][1], problems[i][3]),
-                           problems[i][2], problems[i][3]) for i in chunk]
-                for i, r in zip(chunk, _run_batch(models, numerics), strict=True):
-                    out[i] = r
-        outs.append(out)
+    """Main runs, then the error-estimate companions as :func:`expand_cavity` does them: the
+    2x coarser run, or the 2x finer one where the coarser fails."""
+    fine = _run_all(problems, settings, batch_size)
+    companion = [None] * len(problems)
+    kind = [None] * len(problems)
+    if settings.error_estimate:
+        todo = [i for i, r in enumerate(fine) if r["error"] is None]
+        coarse = _run_all([problems[i] for i in todo], settings.coarsened(), batch_size)
+        retry = []
+        for i, r in zip(todo, coarse, strict=True):
+            if r["error"] is None:
+                companion[i], kind[i] = r, "coarse"
+            else:
+                retry.append(i)
+        finer = _run_all([problems[i] for i in retry], settings.coarsened(0.5), batch_size)
+        for i, r in zip(retry, finer, strict=True):
+            companion[i], kind[i] = r, "finer"
     results = []
     for i, (_, _, velocity, radius) in enumerate(problems):
-        fine = outs[0][i]
-        coarse = outs[1][i] if len(outs) > 1 else None
-        stats = dict(fine["stats"])
-        error = fine["error"]
+        main, other = fine[i], companion[i]
+        stats = dict(main["stats"])
+        error = main["error"]
         estimate = None
-        if coarse is not None:
-            stats["coarse_cavity_stress"] = coarse["cavity_stress"]
-            if error is None and coarse["error"] is not None:
-                error = coarse["error"]
-            elif error is None:
-                estimate = richardson_error(fine["cavity_stress"], coarse["cavity_stress"])
+        if other is not None:
+            stats[f"{kind[i]}_cavity_stress"] = other["cavity_stress"]
+            stats["error_companion"] = kind[i]
+            if other["error"] is not None:
+                error = other["error"]
+            elif kind[i] == "coarse":
+                estimate = richardson_error(main["cavity_stress"], other["cavity_stress"])
+            else:
+                estimate = richardson_error_from_finer(main["cavity_stress"],
+                                                       other["cavity_stress"])
         if error is not None:
             results.append(CaseResult(velocity, radius, math.nan, None, math.nan, None, stats,
                                       error))
         else:
-            results.append(CaseResult(velocity, radius, fine["cavity_stress"], estimate,
-                                      fine["plastic_radius"], fine["u"], stats))
+            results.append(CaseResult(velocity, radius, main["cavity_stress"], estimate,
+                                      main["plastic_radius"], main["u"], stats))
     return results
 
 

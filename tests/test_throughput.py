@@ -125,3 +125,13 @@ def test_error_target_refines_only_the_cases_above_it():
     assert refined.cavity_stress == one.cavity_stress
     assert refined.error_estimate == one.error_estimate < plain[above].error_estimate
     assert results[1 - above].cavity_stress == plain[1 - above].cavity_stress
+
+
+def test_finer_companion_where_the_coarser_run_fails():
+    # quasi-static soil: the half-resolution run fails, the estimate comes from a 2x finer run
+    args = problem(1.25, 0.0)
+    b, = expand_cavities([args])
+    one = expand_cavity(*args)
+    assert b.stats["error_companion"] == one.stats["error_companion"] == "finer"
+    assert b.cavity_stress == one.cavity_stress and b.error_estimate == one.error_estimate
+    assert b.stats["finer_cavity_stress"] == one.stats["finer_cavity_stress"]
