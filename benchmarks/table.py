@@ -16,8 +16,8 @@ depth from ``spherical_problem``, every case at the default settings (error esti
   same subset plus four refined cases (and the wall stress against the forms baseline):
   largest relative difference of the wall stress, the error estimate, the plastic radius and
   the nodal displacements;
-- the largest error estimate of the table and the failed cases (V = 0 in soil: the
-  quasi-static Newton iteration fails in the one-case path as well);
+- the largest error estimate of the table, the cases whose estimate comes from a 2x finer
+  companion run (V = 0 in soil, where the 2x coarser run fails) and any failed cases;
 - scaling: the same table on a local Dask cluster of 1..N single-threaded workers, and on 1..N
   local processes, through :func:`cavex.verification.runner.run_cases` (chunks of ``--chunk``
   consecutive cases), speed-up and efficiency ``T1 / (N T_N)``; the results are checked equal
@@ -182,6 +182,8 @@ def main():
           f"{100 * ERROR_TARGET:g} %; {len(refined)} cases refined (2x space and time)"
           + "".join(f"\n    V = {r.velocity:g} m/s: {100 * r.error_estimate:.3f} % after "
                     f"{r.stats['refinements']} refinement(s)" for r in refined))
+    finer = sum(r.stats.get("error_companion") == "finer" for r in results)
+    print(f"finer companions     : {finer} cases (their 2x coarser run failed)")
     print(f"failed cases         : {len(failed)}"
           + "".join(f"\n    {r.error}" for r in failed[:6]))
     steps = np.array([r.stats["newton_iterations"] for r in results if r.ok])
