@@ -91,7 +91,9 @@ def render_sphere(fields, path, title):
     half = grid.clip(normal=(0.0, -1.0, 0.0), origin=(0.0, 0.0, 0.0))
     plotter = pv.Plotter(off_screen=True, window_size=(900, 750))
     plotter.add_mesh(half, scalars="sigma_r (MPa)", cmap="inferno", log_scale=True,
-                     scalar_bar_args={"title": "sigma_r (MPa)", "vertical": True})
+                     scalar_bar_args={"title": "sigma_r (MPa)", "vertical": True,
+                                      "position_x": 0.8, "position_y": 0.1, "width": 0.08,
+                                      "height": 0.7, "fmt": "%.0f"})
     outer = picture_extent(fields)
     for h in fields["interfaces"]:
         if h < outer:
