@@ -8,10 +8,18 @@ single-medium (first layer) model that the crater stage uses (paper Eq. 34).
 from cavex.analytic.cavity import quasi_static_coefficients, solve_checked, wall_stress
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.analytic.nose import nose_force, ogive_coefficients
+from cavex.analytic.paper_model import paper_coefficients
 
 from cavex.errors import require, require_choice
 
 MODELS = ("derived", "paper")
+
+
+def check_model(model, boundary):
+    """The model is known, and the paper model is only offered with its quasi-static boundary."""
+    require_choice(model, MODELS, "model")
+    require(model != "paper" or boundary == "quasi-static", "boundary",
+            "'quasi-static' for the paper model", boundary)
 
 
 class ClosedFormResistance:
@@ -32,9 +40,7 @@ class ClosedFormResistance:
 
     def __init__(self, target, projectile, model="derived", boundary="quasi-static",
                  switch=None, epsilon="quasi-static"):
-        require_choice(model, MODELS, "model")
-        require(not (model == "paper" and boundary != "quasi-static"), "boundary",
-                "'quasi-static' for the paper model", boundary)
+        check_model(model, boundary)
         self.target, self.projectile = target, projectile
         self.model, self.boundary, self.epsilon = model, boundary, epsilon
         self.switch = switch or ("cavity" if model == "derived" else "nose-tip")
@@ -61,8 +67,6 @@ class ClosedFormResistance:
         return c_a + c_b * velocity ** 2
 
     def _paper_force(self, depth, velocity):
-        from cavex.analytic.paper_model import paper_coefficients
-
         c = paper_coefficients(self.target, self.projectile, depth, epsilon=self.epsilon)
         c_a, c_b = ogive_coefficients(self.projectile, c.A, c.B, c.tau, c.rho)
         return c_a + c_b * velocity ** 2
@@ -70,8 +74,6 @@ class ClosedFormResistance:
     def label(self, depth, velocity):
         """Phase label: wall layer name and response state (or the paper's equation)."""
         if self.model == "paper":
-            from cavex.analytic.paper_model import paper_coefficients
-
             c = paper_coefficients(self.target, self.projectile, depth, epsilon=self.epsilon)
             return f"Eq. {c.equation} ({c.state})"
         layers, interfaces = spherical_problem(self.target, self.projectile, depth, self.switch)

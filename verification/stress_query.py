@@ -5,6 +5,7 @@ import math
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.analytic.paper_model import paper_coefficients
+from cavex.analytic.resistance import check_model
 
 from cavex.errors import require
 
@@ -14,8 +15,7 @@ def stress_at_depth(target, projectile, depth, velocity, *, model="derived",
     """JSON-able description of the cavity-wall stress at nose depth ``depth`` (m)."""
     require(math.isfinite(velocity) and velocity >= 0.0, "velocity", "a finite number >= 0",
             velocity)
-    require(model != "paper" or boundary == "quasi-static", "boundary",
-            "'quasi-static' for the paper model", boundary)
+    check_model(model, boundary)
     if model == "paper":
         return _paper(target, projectile, depth, velocity, epsilon)
     layers, interfaces = spherical_problem(target, projectile, depth)
