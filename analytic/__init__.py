@@ -1,5 +1,24 @@
 """Closed-form layered cavity expansion, nose resistance and the rigid-projectile integrator."""
 
-from cavex.analytic.cavity import CavityState, cavity_solution, cavity_stress, plastic_radius
+from cavex.analytic.cavity import (
+    CavityState,
+    cavity_solution,
+    cavity_stress,
+    plastic_radius,
+    quasi_static_coefficients,
+)
+from cavex.analytic.geometry import spherical_problem
+from cavex.analytic.nose import nose_force, ogive_coefficients
+from cavex.analytic.paper_model import (
+    PaperCoefficients,
+    paper_coefficients,
+    paper_phase_depths,
+    paper_stress,
+)
+from cavex.analytic.penetration import Trajectory, penetrate
+from cavex.analytic.resistance import ClosedFormResistance
 
-__all__ = ["CavityState", "cavity_solution", "cavity_stress", "plastic_radius"]
+__all__ = ["CavityState", "ClosedFormResistance", "PaperCoefficients", "Trajectory",
+           "cavity_solution", "cavity_stress", "nose_force", "ogive_coefficients",
+           "paper_coefficients", "paper_phase_depths", "paper_stress", "penetrate",
+           "plastic_radius", "quasi_static_coefficients", "spherical_problem"]
