@@ -22,6 +22,8 @@ case by case (measured: identical to 1e-10 relative, in practice to the last bit
   the times ``t_k = (a_k - a0)/V`` of its velocity) and its own recursive step halving; a round
   advances every unfinished case by one (sub-)step, so cases whose cut-backs differ stay
   independent. The return-map branch (Mohr-Coulomb only, or multi-surface) is chosen per case.
+  A case whose step still fails at the deepest cut-back gets the one-case path's last attempt,
+  Newton with a line search (:func:`cavex.fem.solver.line_search_newton`), on a one-case stack.
 
 Energies, field snapshots and histories are not kept; use :func:`cavex.fem.expand_cavity` (the
 one-case path, also the debugging path) for those.
@@ -46,7 +48,7 @@ from cavex.fem.expansion import (
 )
 from cavex.fem.fields import plastic_radius
 from cavex.fem.settings import make_numerics
-from cavex.fem.solver import Newmark
+from cavex.fem.solver import Newmark, StepFailure, failure_message, line_search_newton
 from scipy.linalg import LinAlgError, solve_banded
 from scipy.sparse import csr_matrix
 
@@ -289,50 +291,20 @@ def _newton(stack, w, params, dynamic, tol, first_iteration=1):
     iterations, reasons)``; ``reasons[c]`` is None for a converged case, else why it failed.
     Inactive cases come back as converged (their values are not to be used).
     """
-    p = params
     k = stack.n_cases
     dof_case = stack.dof_case
-    dt_d = w["dt"][dof_case]
-    if first_iteration == 1:
-        u0 = w["u0"]
-        u = u0.copy()
-        u[stack.wall] = w["load"]
-        if dynamic:
-            guess = u0 + dt_d * w["v0"]
-        else:
-            guess = u0
-        ratio = (w["dt"] / w["dt_old"])[dof_case]
-        predicted = np.where(w["has_prev"][dof_case], u0 + ratio * w["du_prev"], guess)
-        u = np.where(stack.free & w["active"][dof_case], predicted, u)
-    else:
-        u = w["u"]
+    u = _predict(stack, w, dynamic) if first_iteration == 1 else w["u"]
     done = ~w["active"]
     reasons = np.full(k, None, dtype=object)
     iterations = np.zeros(k, dtype=int)
-    if dynamic:
-        c_m = ((1.0 - p.alpha_m) / (p.beta * w["dt"] * w["dt"]))[dof_case]
     buffers = None
     for iteration in range(first_iteration, MAX_ITERATIONS + 1):
         buffers = stack.assemble(u, w["theta_p"], w["gamma_p"], done, buffers)
         f, band, resp, folded, force_scale = buffers
         _fail(reasons, done, folded, "non-positive stretch")
-        if dynamic:
-            a = ((u - w["u0"] - dt_d * w["v0"]) / (p.beta * dt_d * dt_d)
-                 - (0.5 / p.beta - 1.0) * w["a0"])
-            inertia = stack.mass @ ((1.0 - p.alpha_m) * a + p.alpha_m * w["a0"])
-            residual = inertia + (1.0 - p.alpha_f) * f + p.alpha_f * w["f0"]
-            jac = (1.0 - p.alpha_f) * band + c_m[None, :] * stack.mass_band
-        else:
-            a = np.zeros_like(u)
-            residual = f
-            jac = band.copy()
-        r_free = np.where(stack.free, residual, 0.0)
+        a, r_free, jac, scale = _equations(stack, w, params, dynamic, u, f, band, force_scale)
         _fail(reasons, done, ~stack.per_case_all(np.isfinite(r_free)), "non-finite residual")
         with np.errstate(invalid="ignore"):
-            fixed = np.abs(residual[stack.wall])
-            if stack.outer_fixed:
-                fixed = np.maximum(fixed, np.abs(residual[stack.outer]))
-            scale = np.maximum(np.maximum(force_scale, fixed), 1e-300)
             converged = stack.per_case_max(np.abs(r_free)) <= tol * scale
         if iteration > 1:
             newly = converged & ~done
@@ -352,6 +324,86 @@ def _newton(stack, w, params, dynamic, tol, first_iteration=1):
     for c in np.flatnonzero(~done):
         reasons[c] = f"Newton did not converge in {MAX_ITERATIONS} iterations"
     return u, a, f, resp, iterations, reasons
+
+
+def _predict(stack, w, dynamic):
+    """First Newton iterate of every active case (the predictor, as the one-case path)."""
+    dof_case = stack.dof_case
+    dt_d = w["dt"][dof_case]
+    u0 = w["u0"]
+    u = u0.copy()
+    u[stack.wall] = w["load"]
+    if dynamic:
+        guess = u0 + dt_d * w["v0"]
+    else:
+        guess = u0
+    ratio = (w["dt"] / w["dt_old"])[dof_case]
+    predicted = np.where(w["has_prev"][dof_case], u0 + ratio * w["du_prev"], guess)
+    return np.where(stack.free & w["active"][dof_case], predicted, u)
+
+
+def _equations(stack, w, params, dynamic, u, f, band, force_scale):
+    """``(a, r_free, jac, scale)`` of the step's equations at the iterate ``u`` (stack layout;
+    ``r_free`` is zero at the prescribed dofs, ``scale`` per case)."""
+    p = params
+    if dynamic:
+        dt_d = w["dt"][stack.dof_case]
+        c_m = ((1.0 - p.alpha_m) / (p.beta * w["dt"] * w["dt"]))[stack.dof_case]
+        a = ((u - w["u0"] - dt_d * w["v0"]) / (p.beta * dt_d * dt_d)
+             - (0.5 / p.beta - 1.0) * w["a0"])
+        inertia = stack.mass @ ((1.0 - p.alpha_m) * a + p.alpha_m * w["a0"])
+        residual = inertia + (1.0 - p.alpha_f) * f + p.alpha_f * w["f0"]
+        jac = (1.0 - p.alpha_f) * band + c_m[None, :] * stack.mass_band
+    else:
+        a = np.zeros_like(u)
+        residual = f
+        jac = band.copy()
+    r_free = np.where(stack.free, residual, 0.0)
+    with np.errstate(invalid="ignore"):
+        fixed = np.abs(residual[stack.wall])
+        if stack.outer_fixed:
+            fixed = np.maximum(fixed, np.abs(residual[stack.outer]))
+        scale = np.maximum(np.maximum(force_scale, fixed), 1e-300)
+    return a, r_free, jac, scale
+
+
+def _newton_line_search(stack, w, params, dynamic, tol):
+    """The Newton iteration of the one case of ``stack`` with the line search of
+    :func:`cavex.fem.solver.line_search_newton`, as :meth:`RadialSolver.advance` does it at the
+    deepest cut-back. Returns ``(u, a, f, response, iteration count, reason)`` (reason None
+    when converged)."""
+    start = _predict(stack, w, dynamic)
+    free = stack.free
+    no_skip = np.zeros(1, dtype=bool)
+
+    def evaluate(x):
+        u = start.copy()
+        u[free] = x
+        f, band, resp, folded, force_scale = stack.assemble(u, w["theta_p"], w["gamma_p"],
+                                                             no_skip)
+        if folded[0]:
+            raise StepFailure("non-positive stretch")
+        a, r_free, jac, scale = _equations(stack, w, params, dynamic, u, f, band, force_scale)
+        r = r_free[free]
+        if not np.all(np.isfinite(r)):
+            raise StepFailure("non-finite residual")
+        return r, scale[0], jac, u, a, f, resp
+
+    def solve(out, r):
+        rhs = np.zeros(stack.ndof)
+        rhs[free] = r
+        du, singular = stack.solve(out[2], rhs, no_skip)
+        if singular[0]:
+            raise StepFailure("singular tangent")
+        return du[free]
+
+    try:
+        _, out, iterations = line_search_newton(evaluate, solve, start[free], tol,
+                                                MAX_ITERATIONS)
+    except StepFailure as exc:
+        return start, np.zeros_like(start), np.zeros_like(start), None, 0, str(exc)
+    _, _, _, u, a, f, resp = out
+    return u, a, f, resp, iterations, None
 
 
 def _fail(reasons, done, flags, why):
@@ -424,13 +476,15 @@ def _run_batch(models, numerics):
     finished = np.zeros(k, dtype=bool)
     errors = [None] * k
     task_load, task_dt, task_depth = np.zeros(k), np.zeros(k), np.zeros(k, dtype=int)
+    task_search = np.zeros(k, dtype=bool)   # the task is the line-searched last attempt
+    plain_reason = [None] * k               # why its plain Newton attempt failed
     stack, cases, dofs, elements = root, np.arange(k), np.arange(root.ndof), \
         np.arange(root.el_count.sum())
     while True:
         # next (sub-)step of every unfinished case
         for c in np.flatnonzero(~finished):
             if pending[c]:
-                task_load[c], task_dt[c], task_depth[c] = pending[c].pop()
+                task_load[c], task_dt[c], task_depth[c], task_search[c] = pending[c].pop()
             elif next_step[c] == n_steps[c]:
                 finished[c] = True
             else:
@@ -438,6 +492,7 @@ def _run_batch(models, numerics):
                 task_load[c] = radii[c][s] - seeds[c]
                 task_dt[c] = times[c][s] - t[c] if dynamic else 1.0
                 task_depth[c] = 0
+                task_search[c] = False
                 next_step[c] += 1
         if finished.all():
             break
@@ -451,7 +506,25 @@ def _run_batch(models, numerics):
              "theta_p": state["theta_p"][elements], "gamma_p": state["gamma_p"][elements],
              "load": task_load[cases], "dt": task_dt[cases], "dt_old": dt_old[cases],
              "has_prev": has_prev[cases], "active": active}
+        search = active & task_search[cases]
+        if search.any():
+            w["active"] = active & ~search
         u, a, f, resp, its, reasons = _newton(stack, w, params, dynamic, numerics.newton_tol)
+        if search.any():  # the line-searched last attempts, case by case
+            w["active"] = active
+            u, a, f = u.copy(), a.copy(), f.copy()
+            resp = SimpleNamespace(**{name: value.copy() for name, value in vars(resp).items()})
+            for i in np.flatnonzero(search):
+                sub, sdofs, selements = stack.subset([i])
+                sw = {name: w[name][sdofs] for name in ("u0", "v0", "a0", "f0", "du_prev")}
+                sw.update({name: w[name][selements] for name in ("theta_p", "gamma_p")})
+                sw.update({name: w[name][[i]] for name in ("load", "dt", "dt_old", "has_prev",
+                                                           "active")})
+                su, sa, sf, sresp, its[i], reasons[i] = _newton_line_search(
+                    sub, sw, params, dynamic, numerics.newton_tol)
+                if reasons[i] is None:
+                    u[sdofs], a[sdofs], f[sdofs] = su, sa, sf
+                    _scatter_response(resp, selements, sresp)
         ok = active & np.array([r is None for r in reasons])
         # commit the converged cases
         if dynamic:
@@ -482,20 +555,24 @@ def _run_batch(models, numerics):
         for i in np.flatnonzero(active & ~ok):
             c = cases[i]
             depth = task_depth[c]
+            if depth >= numerics.max_cutbacks and not task_search[c]:
+                # last resort, as RadialSolver.advance: the same task with the line search
+                plain_reason[c] = reasons[i]
+                pending[c].append((task_load[c], task_dt[c], depth, True))
+                continue
             if depth >= numerics.max_cutbacks:
                 wall = seeds[c] + state["u"][root.wall[c]]
                 errors[c] = CavexNumericalError(
                     f"V = {velocity[c]:g} m/s, step to cavity radius "
-                    f"{radii[c][next_step[c] - 1]:.6g}"
-                    f" m: Newton failed after {depth} step cut-backs at t = {t[c]:.6g} s, wall "
-                    f"radius {wall:.6g} m, wall load {task_load[c]:.6g} (dt = {task_dt[c]:.3g} s)"
-                    f": {reasons[i]}")
+                    f"{radii[c][next_step[c] - 1]:.6g} m: "
+                    + failure_message(depth, t[c], wall, task_load[c], task_dt[c],
+                                      plain_reason[c], reasons[i]))
                 finished[c] = True
                 continue
             cutbacks[c] += 1
             half = 0.5 * task_dt[c]
-            pending[c].append((task_load[c], half, depth + 1))
-            pending[c].append((0.5 * (load[c] + task_load[c]), half, depth + 1))
+            pending[c].append((task_load[c], half, depth + 1, False))
+            pending[c].append((0.5 * (load[c] + task_load[c]), half, depth + 1, False))
     out = []
     for c, disc in enumerate(discs):
         stats = {"elements": disc.n_elements, "dofs": disc.ndof, "steps": int(steps[c]),

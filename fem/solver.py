@@ -22,10 +22,15 @@ suddenly at ``t = 0`` (Blake's problem) needs :meth:`RadialSolver.start_under_lo
 solves ``M a_0 = r - f(u_0)`` on the free dofs (the solver otherwise starts from ``a_0 = 0``).
 
 A step whose Newton iteration fails (no convergence, folded element or non-finite value) is
-retried as two half steps, recursively, up to ``max_cutbacks`` times; then
-:class:`~cavex.errors.CavexNumericalError` is raised.
+retried as two half steps, recursively, up to ``max_cutbacks`` times. A step that still fails
+at the deepest cut-back is tried once more with an energy line search
+(:func:`line_search_newton`), which cures the two-cycle of plain Newton steps around the
+Mohr-Coulomb apex (docs/fem.md); only then is :class:`~cavex.errors.CavexNumericalError`
+raised. Steps that plain Newton solves, with or without cut-backs, never reach the line search,
+so their results are those of plain Newton to the last bit.
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -53,6 +58,86 @@ class Newmark:
 
 class StepFailure(Exception):
     """A Newton iteration that did not converge (internal: triggers a cut-back)."""
+
+
+LINE_SEARCH_EVALUATIONS = 20  # residual evaluations per line search (Illinois steps)
+LINE_SEARCH_TOLERANCE = 0.5   # accept s once |G(s)| <= this * |G(0)|
+
+
+def _dot(x, y):
+    """``x . y`` correctly rounded (``math.fsum``): the same bits whatever the array layout."""
+    return math.fsum(x * y)
+
+
+def line_search_newton(evaluate, solve, x, tol, max_iterations):
+    """Newton iteration with an energy line search; the last resort of a failing step.
+
+    ``evaluate(x)`` returns a tuple starting with the free-dof residual ``r`` and the force
+    yardstick ``scale`` at the free-dof iterate ``x`` (it raises :class:`StepFailure` where the
+    equations cannot be evaluated); ``solve(out, r)`` returns the Newton increment ``J^-1 r``
+    for the tangent of ``out``. Converged: ``max |r| <= tol * scale`` from the second
+    iteration on, as :meth:`RadialSolver._newton`. Returns ``(x, out, iterations)``.
+
+    The full step ``d = -J^-1 r`` is taken unless it increases ``max |r|``; then ``s`` in
+    ``(0, 1)`` is sought with ``G(s) = d . r(x + s d) = 0`` (the energy along the step is
+    stationary; ``G(0) = -r^T J^-1 r < 0``), by regula falsi with the Illinois modification
+    on the bracket ``[0, 1]`` when ``G(1) > 0``, until ``|G(s)| <= 0.5 |G(0)|``. This reaches
+    the narrow set of states in which a point lies on the Mohr-Coulomb face next to the apex
+    of the cone, which plain Newton steps over in both directions (a two-cycle between an
+    elastic and an apex state; docs/fem.md) and which halving the step on the residual norm
+    does not find.
+    """
+    out = evaluate(x)
+    for iteration in range(1, max_iterations + 1):
+        r, scale = out[0], out[1]
+        norm = np.max(np.abs(r))
+        if iteration > 1 and norm <= tol * scale:
+            return x, out, iteration - 1
+        d = -solve(out, r)
+        if not np.all(np.isfinite(d)):
+            raise StepFailure("non-finite increment")
+        trial = evaluate(x + d)
+        s = 1.0
+        if np.max(np.abs(trial[0])) > norm:
+            s, trial = _illinois(evaluate, x, d, _dot(d, r), _dot(d, trial[0]), trial)
+        x = x + s * d
+        out = trial
+    raise StepFailure(f"Newton with line search did not converge in {max_iterations} "
+                      "iterations")
+
+
+def _illinois(evaluate, x, d, g0, g1, out1):
+    """``(s, evaluate(x + s d))`` with ``|G(s)| <= 0.5 |G(0)|`` (see :func:`line_search_newton`);
+    the full step when ``[0, 1]`` does not bracket a root of ``G``."""
+    if not g0 < 0.0 < g1:
+        return 1.0, out1
+    lo, g_lo, hi, g_hi = 0.0, g0, 1.0, g1
+    side = 0
+    s, out = 1.0, out1
+    for _ in range(LINE_SEARCH_EVALUATIONS):
+        s = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+        out = evaluate(x + s * d)
+        g = _dot(d, out[0])
+        if abs(g) <= LINE_SEARCH_TOLERANCE * abs(g0):
+            break
+        if g > 0.0:
+            hi, g_hi = s, g
+            if side > 0:
+                g_lo *= 0.5
+            side = 1
+        else:
+            lo, g_lo = s, g
+            if side < 0:
+                g_hi *= 0.5
+            side = -1
+    return s, out
+
+
+def failure_message(depth, t, wall_radius, load, dt, plain, line_searched):
+    """Why a step failed for good (the same words in the one-case and the batched path)."""
+    return (f"Newton failed after {depth} step cut-backs at t = {t:.6g} s, wall radius "
+            f"{wall_radius:.6g} m, wall load {load:.6g} (dt = {dt:.3g} s): {plain}; "
+            f"{line_searched}")
 
 
 class RadialSolver:
@@ -106,13 +191,11 @@ class RadialSolver:
         self.newton_iterations = 0
         self.steps = 0
         self.cutbacks = 0
+        self.line_search_steps = 0
 
     # -------------------------------------------------------------- one step
-    def _newton(self, load, dt):
-        """Converged ``(u, a, f, response)`` at ``t + dt``; ``load`` is the wall's prescribed
-        displacement, or its pressure under pressure control."""
-        d, p = self.disc, self.params
-        M = d.mass
+    def _start(self, load, dt):
+        """First Newton iterate of the step to ``load`` over ``dt``: the predictor."""
         u = self.u.copy()
         if not self.pressure_control:
             u[0] = load
@@ -121,33 +204,45 @@ class RadialSolver:
             u[self.free] = self.u[self.free] + (dt / dt_old) * du[self.free]
         elif self.dynamic:
             u[self.free] = self.u[self.free] + dt * self.v[self.free]
-        scale = None
+        return u
+
+    def _evaluate(self, u, load, dt):
+        """``(r_free, scale, jac, a, f, response)`` of the step's equations at the iterate ``u``."""
+        d, p = self.disc, self.params
+        M = d.mass
+        try:
+            f, band, resp = self.assemble(u, self.state)
+        except FloatingPointError as exc:
+            raise StepFailure(str(exc)) from None
+        if self.dynamic:
+            a = (u - self.u - dt * self.v) / (p.beta * dt * dt) - (0.5 / p.beta - 1.0) * self.a
+            inertia = M @ ((1.0 - p.alpha_m) * a + p.alpha_m * self.a)
+            residual = inertia + (1.0 - p.alpha_f) * f + p.alpha_f * self.f
+            c_m = (1.0 - p.alpha_m) / (p.beta * dt * dt)
+            jac = (1.0 - p.alpha_f) * band + c_m * d.mass_band
+        else:
+            a = np.zeros_like(u)
+            residual = f.copy()
+            jac = band
+        if self.pressure_control:
+            r_wall = d.R_dofs[0] + u[0]
+            residual[0] -= load * 4.0 * np.pi * r_wall ** 2
+            jac = jac.copy()
+            jac[d.degree, 0] -= load * 8.0 * np.pi * r_wall
+        r_free = residual[self.free]
+        if not np.all(np.isfinite(r_free)):
+            raise StepFailure("non-finite residual")
+        scale = max(d.force_scale(resp), np.max(np.abs(residual[self.fixed]), initial=0.0),
+                    abs(load) * 4.0 * np.pi * d.R_dofs[0] ** 2 * self.pressure_control,
+                    1e-300)
+        return r_free, scale, jac, a, f, resp
+
+    def _newton(self, load, dt):
+        """Converged ``(u, a, f, response)`` at ``t + dt``; ``load`` is the wall's prescribed
+        displacement, or its pressure under pressure control."""
+        u = self._start(load, dt)
         for iteration in range(1, self.max_iterations + 1):
-            try:
-                f, band, resp = self.assemble(u, self.state)
-            except FloatingPointError as exc:
-                raise StepFailure(str(exc)) from None
-            if self.dynamic:
-                a = (u - self.u - dt * self.v) / (p.beta * dt * dt) - (0.5 / p.beta - 1.0) * self.a
-                inertia = M @ ((1.0 - p.alpha_m) * a + p.alpha_m * self.a)
-                residual = inertia + (1.0 - p.alpha_f) * f + p.alpha_f * self.f
-                c_m = (1.0 - p.alpha_m) / (p.beta * dt * dt)
-                jac = (1.0 - p.alpha_f) * band + c_m * d.mass_band
-            else:
-                a = np.zeros_like(u)
-                residual = f.copy()
-                jac = band
-            if self.pressure_control:
-                r_wall = d.R_dofs[0] + u[0]
-                residual[0] -= load * 4.0 * np.pi * r_wall ** 2
-                jac = jac.copy()
-                jac[d.degree, 0] -= load * 8.0 * np.pi * r_wall
-            r_free = residual[self.free]
-            if not np.all(np.isfinite(r_free)):
-                raise StepFailure("non-finite residual")
-            scale = max(d.force_scale(resp), np.max(np.abs(residual[self.fixed]), initial=0.0),
-                        abs(load) * 4.0 * np.pi * d.R_dofs[0] ** 2 * self.pressure_control,
-                        1e-300)
+            r_free, scale, jac, a, f, resp = self._evaluate(u, load, dt)
             if iteration > 1 and np.max(np.abs(r_free)) <= self.newton_tol * scale:
                 self.newton_iterations += iteration - 1
                 return u, a, f, resp
@@ -156,6 +251,23 @@ class RadialSolver:
                 raise StepFailure("non-finite increment")
             u[self.free] -= du
         raise StepFailure(f"Newton did not converge in {self.max_iterations} iterations")
+
+    def _newton_line_search(self, load, dt):
+        """:meth:`_newton` with the line search of :func:`line_search_newton` (the last resort
+        of :meth:`advance`)."""
+        start = self._start(load, dt)
+
+        def evaluate(x):
+            u = start.copy()
+            u[self.free] = x
+            return self._evaluate(u, load, dt) + (u,)
+
+        x, out, iterations = line_search_newton(evaluate, lambda out, r: self._solve(out[2], r),
+                                                start[self.free], self.newton_tol,
+                                                self.max_iterations)
+        self.newton_iterations += iterations
+        _, _, _, a, f, resp, u = out
+        return u, a, f, resp
 
     def _solve(self, band, rhs):
         p = self.disc.degree
@@ -187,15 +299,21 @@ class RadialSolver:
         self.steps += 1
 
     def advance(self, load, dt, depth=0):
-        """Step to the wall load (displacement, or pressure) over ``dt``, with cut-backs."""
+        """Step to the wall load (displacement, or pressure) over ``dt``, with cut-backs; a step
+        that still fails at the deepest cut-back is tried once more with a line search."""
         try:
             self._commit(*self._newton(load, dt), dt, load)
         except StepFailure as exc:
             if depth >= self.max_cutbacks:
-                raise CavexNumericalError(
-                    f"Newton failed after {depth} step cut-backs at t = {self.t:.6g} s, "
-                    f"wall radius {self.disc.R_dofs[0] + self.u[0]:.6g} m, wall load {load:.6g} "
-                    f"(dt = {dt:.3g} s): {exc}") from None
+                try:
+                    result = self._newton_line_search(load, dt)
+                except StepFailure as again:
+                    raise CavexNumericalError(failure_message(
+                        depth, self.t, self.disc.R_dofs[0] + self.u[0], load, dt, exc,
+                        again)) from None
+                self.line_search_steps += 1
+                self._commit(*result, dt, load)
+                return
             self.cutbacks += 1
             previous = self.load
             self.advance(0.5 * (previous + load), 0.5 * dt, depth + 1)

@@ -5,8 +5,9 @@ import json
 import numpy as np
 import pytest
 from cavex.analytic.geometry import spherical_problem
-from cavex.fem import batch, expand_cavity
+from cavex.fem import batch, expand_cavity, solver
 from cavex.fem.batch import expand_cavities, expand_chunk
+from cavex.fem.solver import StepFailure
 
 from cavex import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
@@ -22,9 +23,22 @@ def problem(depth, velocity):
     return layers, interfaces, velocity, RADIUS
 
 
-# three, two and one layers at the wall; quasi-static, slow (many cut-backs) and fast cases
+# three, two and one layers at the wall; quasi-static, slow (many cut-backs) and fast cases;
+# quasi-static soil, whose half-resolution error-estimate run needs the line-searched last
+# attempt (tests/test_fem_newton.py)
 MIXED = [problem(0.30, 500.0), problem(0.64, 1200.0), problem(1.00, 40.0),
-         problem(1.25, 150.0), ([CONCRETE], [], 0.0, RADIUS)]
+         problem(1.25, 150.0), ([CONCRETE], [], 0.0, RADIUS), problem(1.25, 0.0)]
+
+
+@pytest.fixture
+def no_line_search(monkeypatch):
+    """The line-searched last attempt of a failing step switched off (fails at once)."""
+
+    def fail(*args, **kwargs):
+        raise StepFailure("line search switched off")
+
+    monkeypatch.setattr(solver, "line_search_newton", fail)
+    monkeypatch.setattr(batch, "line_search_newton", fail)
 
 
 def relative(a, b):
@@ -33,7 +47,7 @@ def relative(a, b):
 
 @pytest.fixture(scope="module")
 def mixed():
-    return expand_cavities(MIXED, batch_size=3)  # two stacks: 3 dynamic + 1, 1 quasi-static
+    return expand_cavities(MIXED, batch_size=3)  # stacks: 3 dynamic + 1, 2 quasi-static
 
 
 def test_batched_equals_one_case_path_to_1e10(mixed):
@@ -57,9 +71,9 @@ def test_numpy_kernels_give_the_same_batch(monkeypatch, mixed):
         assert relative(a.cavity_stress, b.cavity_stress) <= 1e-10
 
 
-def test_newton_failure_is_reported_for_its_case_only():
+def test_newton_failure_is_reported_for_its_case_only(no_line_search):
     # quasi-static expansion in soil on a coarse mesh with large steps fails in the one-case
-    # path too (after the cut-backs); the other cases run
+    # path too (after the cut-backs, without the line-searched last attempt); the others run
     settings = {"max_cutbacks": 2, "error_estimate": False, "growth_per_step": 0.06,
                 "elements_per_decade": 15.0}
     cases = [problem(0.30, 500.0), problem(1.25, 0.0), problem(1.25, 300.0),
@@ -73,6 +87,7 @@ def test_newton_failure_is_reported_for_its_case_only():
     assert str(failed.error) == str(one.value)
     assert str(failed.error).startswith("V = 0 m/s, step to cavity radius")
     assert "wall radius" in str(failed.error) and "cut-backs" in str(failed.error)
+    assert str(failed.error).endswith("iterations; line search switched off")
     for args, r in zip(cases, results, strict=True):
         if r.ok:
             assert relative(r.cavity_stress,
@@ -127,8 +142,9 @@ def test_error_target_refines_only_the_cases_above_it():
     assert results[1 - above].cavity_stress == plain[1 - above].cavity_stress
 
 
-def test_finer_companion_where_the_coarser_run_fails():
-    # quasi-static soil: the half-resolution run fails, the estimate comes from a 2x finer run
+def test_finer_companion_where_the_coarser_run_fails(no_line_search):
+    # quasi-static soil without the line search: the half-resolution run fails, the estimate
+    # comes from a 2x finer run
     args = problem(1.25, 0.0)
     b, = expand_cavities([args])
     one = expand_cavity(*args)

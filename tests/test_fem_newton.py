@@ -1,0 +1,103 @@
+"""The line-searched last attempt of a failing step (cavex.fem.solver.line_search_newton).
+
+Quasi-static soil (Table 1, E/tau = 20) at half the default resolution used to fail: a point at
+the Mohr-Coulomb apex whose solution lies on the cone's face just next to the apex made plain
+Newton alternate between an elastic and an apex state (docs/fem.md, "Newton at the apex").
+"""
+
+import numpy as np
+import pytest
+from cavex.fem import batch, expand_cavity, solver
+from cavex.fem.batch import expand_cavities
+from cavex.fem.expansion import richardson_error, richardson_error_from_finer
+from cavex.fem.solver import StepFailure, line_search_newton
+
+from cavex import load_config
+
+SOIL = load_config()[0].layers[2]
+ARGS = ([SOIL], [], 0.0, 0.0125)
+HALF = {"elements_per_decade": 15.0, "growth_per_step": 0.06, "error_estimate": False}
+
+
+@pytest.fixture
+def line_searches(monkeypatch):
+    """Counts the calls of the line-searched Newton iteration (one-case and batched path)."""
+    calls = []
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return line_search_newton(*args, **kwargs)
+
+    monkeypatch.setattr(solver, "line_search_newton", counted)
+    monkeypatch.setattr(batch, "line_search_newton", counted)
+    return calls
+
+
+def kinked(x):
+    """1-D model of the soil failure in the point's pressure coordinate (Pa beyond the apex):
+    apex (x < 0, slope 3.8e-4), Mohr-Coulomb face (0 <= x < 18800, slope 1, root at 37.8),
+    elastic (slope 1/1.08). Returns ``(r, scale, slope)``."""
+    x = float(x[0])
+    if x < 0.0:
+        r, k = -37.8 + 3.8e-4 * x, 3.8e-4
+    elif x < 18800.0:
+        r, k = x - 37.8, 1.0
+    else:
+        r, k = 18800.0 - 37.8 + (x - 18800.0) / 1.08, 1.0 / 1.08
+    return np.array([r]), 1e6, k
+
+
+def test_plain_newton_two_cycles_where_the_line_search_converges():
+    x = np.array([98400.0])  # elastic start, as the soil point at the failing step
+    seen = []
+    for _ in range(6):
+        r, _, k = kinked(x)
+        seen.append(round(float(x[0]), 6))
+        x = x - r / k
+    assert seen[1] == seen[3] == seen[5] < 0 < seen[2] == seen[4]  # apex <-> elastic, forever
+    x, out, iterations = line_search_newton(kinked, lambda out, r: r / out[2],
+                                            np.array([98400.0]), 1e-12, 30)
+    assert abs(x[0] - 37.8) < 1e-9 and iterations <= 4
+
+
+def test_line_search_failure_is_a_step_failure():
+    with pytest.raises(StepFailure, match="line search did not converge in 3"):
+        line_search_newton(kinked, lambda out, r: r / out[2], np.array([98400.0]), 0.0, 3)
+
+
+def test_half_resolution_quasi_static_soil_converges(line_searches):
+    half = expand_cavity(*ARGS, **HALF)
+    assert line_searches  # the failing step was rescued by the line search
+    default = expand_cavity(*ARGS, error_estimate=False)
+    finer = expand_cavity(*ARGS, elements_per_decade=60.0, growth_per_step=0.015,
+                          error_estimate=False)
+    # measured: 18.73130 (half), 18.71114 (default), 18.71614 MPa (2x finer), i.e. the
+    # half-resolution run is 1.08e-3 above the default one
+    assert half.cavity_stress == pytest.approx(18.7313e6, rel=1e-5)
+    assert abs(half.cavity_stress / default.cavity_stress - 1.0) < 1.5e-3
+    # the default run's Richardson error from the half-resolution run (3.591e-4) agrees with
+    # the one from the 2x finer run (3.566e-4): the half-resolution result is in the
+    # asymptotic range, second order
+    from_coarse = richardson_error(default.cavity_stress, half.cavity_stress)
+    from_finer = richardson_error_from_finer(default.cavity_stress, finer.cavity_stress)
+    assert from_coarse == pytest.approx(from_finer, rel=0.05)
+    assert from_coarse < 0.005
+
+
+def test_error_estimate_uses_the_coarse_companion_again():
+    result = expand_cavity(*ARGS)
+    assert result.stats["error_companion"] == "coarse"
+    assert result.error_estimate == richardson_error(result.cavity_stress,
+                                                     result.stats["coarse_cavity_stress"])
+    assert result.error_estimate == pytest.approx(3.59e-4, rel=0.01)  # measured 3.591e-4
+
+
+def test_batched_path_rescues_the_same_step_bit_for_bit(line_searches):
+    b, = expand_cavities([ARGS], **HALF)
+    assert len(line_searches) == 1
+    one = expand_cavity(*ARGS, **HALF)
+    assert len(line_searches) == 2
+    assert b.ok and b.cavity_stress == one.cavity_stress
+    assert np.array_equal(b.u, one.fields["u"])
+    assert b.stats["newton_iterations"] == one.stats["newton_iterations"]
+    assert b.stats["cutbacks"] == one.stats["cutbacks"]
