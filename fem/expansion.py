@@ -144,8 +144,8 @@ def companion_estimate(layers, interfaces, velocity, radius, settings, result):
     """Richardson error estimate of ``result`` and the companion run it came from.
 
     The companion is the 2x coarser run (space and time); where that one fails numerically
-    (a Newton failure that survives the cut-backs, seen for quasi-static soil at half
-    resolution), a 2x finer run is used instead, which over- rather than under-estimates.
+    (a Newton failure that survives the cut-backs and the last-resort line search), a 2x finer
+    run is used instead, which over- rather than under-estimates.
     """
     try:
         coarse = run_expansion(layers, interfaces, velocity, radius, settings.coarsened())
