@@ -36,7 +36,7 @@ from types import SimpleNamespace
 
 import numpy as np
 from cavex.analytic.cavity import check_problem
-from cavex.fem.constitutive import PointMaterial, hencky_mohr_coulomb
+from cavex.fem.constitutive import PointMaterial, hencky_mohr_coulomb, replace_points
 from cavex.fem.discretisation import FastAssembly
 from cavex.fem.expansion import (
     build_model,
@@ -274,14 +274,6 @@ class Stack(FastAssembly):
 
 
 # ---------------------------------------------------------------------------------- Newton
-def _scatter_response(response, elements, part):
-    for name, value in vars(response).items():
-        if name == "tangent":
-            value[:, :, elements] = part.tangent
-        else:
-            value[elements] = getattr(part, name)
-
-
 def _newton(stack, w, params, dynamic, tol, first_iteration=1):
     """Generalized-alpha Newton iteration of every case of ``stack`` with ``w["active"]``.
 
@@ -429,7 +421,7 @@ def _continue_on_subset(stack, w, params, dynamic, tol, iteration, cases, u, a, 
     u, a, f = u.copy(), a.copy(), f.copy()
     u[dofs], a[dofs], f[dofs] = su, sa, sf
     resp = SimpleNamespace(**{name: value.copy() for name, value in vars(resp).items()})
-    _scatter_response(resp, elements, sresp)
+    replace_points(resp, elements, sresp)
     iterations[cases] = sit
     reasons[cases] = sreasons
     return u, a, f, resp, iterations, reasons
@@ -524,7 +516,7 @@ def _run_batch(models, numerics):
                     sub, sw, params, dynamic, numerics.newton_tol)
                 if reasons[i] is None:
                     u[sdofs], a[sdofs], f[sdofs] = su, sa, sf
-                    _scatter_response(resp, selements, sresp)
+                    replace_points(resp, selements, sresp)
         ok = active & np.array([r is None for r in reasons])
         # commit the converged cases
         if dynamic:

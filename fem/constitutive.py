@@ -182,13 +182,14 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat, groups=None):
                        mat)
     if groups is not None and np.any(general):
         redo = np.isin(groups, np.unique(groups[general]))
-        _replace(response, redo, _general_return(theta[redo], gamma[redo], J[redo],
-                                                 theta_p[redo], gamma_p[redo], mat.take(redo)))
+        replace_points(response, redo, _general_return(theta[redo], gamma[redo], J[redo],
+                                                       theta_p[redo], gamma_p[redo],
+                                                       mat.take(redo)))
     return response
 
 
-def _replace(response, where, other):
-    """Overwrite ``response`` at the points ``where`` (boolean) by ``other`` (those points)."""
+def replace_points(response, where, other):
+    """Overwrite ``response`` at the points ``where`` (boolean or indices) by ``other``."""
     for name, value in vars(response).items():
         if name == "tangent":
             value[:, :, where] = other.tangent
