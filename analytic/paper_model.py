@@ -201,19 +201,28 @@ def paper_coefficients(target, projectile, depth, epsilon="quasi-static"):
     for h in heights:
         require(h > r, "depth", f"such that the next interface is beyond the cavity (h = {h} m "
                 f"<= r = {r} m: nose length l shorter than r)", depth)
-    if len(layers) == 1:
-        return single_medium_coefficients(layers[0], eps[0])
-    reached = [H + projectile.l - r / eps[k] for k, H in enumerate(target.interface_depths[first:])]
-    yields = [H + projectile.l - r / eps[k + 1]
-              for k, H in enumerate(target.interface_depths[first:])]
-    index = response_index(depth, reached, yields)
-    if len(layers) == 2:
-        equation, state = TWO_LAYER_EQUATIONS[index]
-        A, B, tau, rho = TWO_LAYER_FORMS[equation](*layers, *eps, r, heights[0])
-    else:
-        equation, state = THREE_LAYER_EQUATIONS[index]
-        A, B, tau, rho = THREE_LAYER_FORMS[equation](*layers, *eps, r, *heights)
+    A, B, tau, rho, equation, state = select_equation(
+        layers, eps, r, projectile.l, depth, target.interface_depths[first:])
     return PaperCoefficients(A=A, B=B, tau=tau, rho=rho, equation=equation, state=state)
+
+
+def select_equation(layers, eps, r, nose, depth, interface_depths, forms=None):
+    """The paper's case selection: ``(A, B, tau, rho, equation, state)`` at nose depth ``depth``.
+
+    ``layers`` and their ``eps`` surround the cavity (innermost first), ``interface_depths`` are
+    their interface depths ``H_i``; ``forms`` overrides printed equations by number (readings of
+    the Table 2 study).
+    """
+    forms = {**FORMS, **(forms or {})}
+    if len(layers) == 1:
+        return (*forms[29](layers[0], eps[0]), 29, "single")
+    heights = [H - depth + nose for H in interface_depths]
+    reached = [H + nose - r / eps[k] for k, H in enumerate(interface_depths)]
+    yields = [H + nose - r / eps[k + 1] for k, H in enumerate(interface_depths)]
+    index = response_index(depth, reached, yields)
+    equations = TWO_LAYER_EQUATIONS if len(layers) == 2 else THREE_LAYER_EQUATIONS
+    equation, state = equations[index]
+    return (*forms[equation](*layers, *eps, r, *heights), equation, state)
 
 
 def paper_stress(target, projectile, depth, velocity, epsilon="quasi-static"):
@@ -382,3 +391,4 @@ def single_medium_coefficients(material, eps):
 
 THREE_LAYER_FORMS = {19: eq19, 21: eq21, 23: eq23, 24: eq24, 25: eq25}
 TWO_LAYER_FORMS = {26: eq26, 27: eq27, 28: eq28}
+FORMS = {**THREE_LAYER_FORMS, **TWO_LAYER_FORMS, 29: eq29}

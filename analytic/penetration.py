@@ -24,6 +24,8 @@ from cavex.errors import CavexNumericalError, require_choice
 
 CRATER_MODES = ("nose-base", "nose-tip")
 CRATER_RATIO = 4.5
+STOPPED = "projectile stopped"
+STATE_CHANGED = "response state changed"
 MAX_PHASE_DURATION = 10.0  # s; a phase that has not ended by then is a numerical failure
 
 
@@ -135,7 +137,9 @@ def _tunnel(target, projectile, resistance, start, columns, phases, rtol, atol):
         which = next(i for i, te in enumerate(sol.t_events) if te.size)
         t_end, (depth_end, v_end) = sol.t_events[which][0], sol.y_events[which][0]
         reason = events[which][1]
-        if reason == "projectile stopped":
+        if reason == STATE_CHANGED and ahead and abs(depth_end - ahead[0]) <= 1e-12 * ahead[0]:
+            reason = events[1][1]  # a state change at the interface itself (nose-tip switch)
+        if reason == STOPPED:
             v_end = 0.0
         elif reason.startswith("nose tip"):
             ahead.pop(0)
@@ -160,11 +164,11 @@ def _phase_events(resistance, ahead, n_interfaces, label):
         return 1.0 if resistance.label(y[0], max(y[1], 0.0)) == label else -1.0
 
     stopped.direction = state_changed.direction = -1.0
-    events = [(stopped, "projectile stopped")]
+    events = [(stopped, STOPPED)]
     if ahead:  # before the state change: where both coincide, the interface names the phase end
         number = n_interfaces - len(ahead) + 1
         events.append((_depth_event(ahead[0]), f"nose tip reached interface {number}"))
-    events.append((state_changed, "response state changed"))
+    events.append((state_changed, STATE_CHANGED))
     for event, _ in events:
         event.terminal = True
     return events

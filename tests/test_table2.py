@@ -7,7 +7,7 @@ values (``PAPER_TABLE2``) are typed in, as reference values.
 import pytest
 from cavex.analytic.paper_model import layer_epsilon
 from cavex.analytic.penetration import crater_depth
-from cavex.verification.table2 import PAPER_TABLE2
+from cavex.verification.table2 import PAPER_TABLE2, table2_rows
 from cavex.verification.table2_study import (
     ADMISSIBLE,
     PRINT_HALF_UNIT,
@@ -18,7 +18,6 @@ from cavex.verification.table2_study import (
     relative_error,
     run_reading,
     segment_rows,
-    study_rows,
     table2_study,
     within_print,
 )
@@ -37,7 +36,7 @@ def default():
 
 def _rows(default, reading):
     target, projectile = default
-    return study_rows(run_reading(target, projectile, reading), target)
+    return table2_rows(run_reading(target, projectile, reading))
 
 
 def _paired(rows):

@@ -36,6 +36,7 @@ isolates the law of each phase from the error accumulated before it.
 import itertools
 import math
 from dataclasses import asdict, dataclass, replace
+from functools import partial
 
 from cavex.analytic import paper_model as pm
 from cavex.analytic.nose import ogive_coefficients
@@ -164,23 +165,12 @@ class ReadingResistance:
     def coefficients(self, depth):
         """``(A, B, tau, rho, equation, state)`` at nose-tip depth ``depth``."""
         first = self.first_layer(depth)
-        layers, eps = self.target.layers[first:], self.eps[first:]
-        if len(layers) == 1:
-            return (*eq29_reading(layers[0], eps[0], self.reading.eq29), 29, "single")
-        r, nose = self.projectile.r, self.projectile.l
-        interfaces = self.target.interface_depths[first:]
-        heights = [H - depth + nose for H in interfaces]
-        reached = [H + nose - r / eps[k] for k, H in enumerate(interfaces)]
-        yields = [H + nose - r / eps[k + 1] for k, H in enumerate(interfaces)]
-        index = pm.response_index(depth, reached, yields)
-        if len(layers) == 2:
-            equation, state = pm.TWO_LAYER_EQUATIONS[index]
-            form = pm.TWO_LAYER_FORMS[equation]
-        else:
-            equation, state = pm.THREE_LAYER_EQUATIONS[index]
-            form = eq19_printed if (equation == 19 and self.reading.eq19 == "printed") \
-                else pm.THREE_LAYER_FORMS[equation]
-        return (*form(*layers, *eps, r, *heights), equation, state)
+        forms = {29: partial(eq29_reading, variant=self.reading.eq29)}
+        if self.reading.eq19 == "printed":
+            forms[19] = eq19_printed
+        return pm.select_equation(self.target.layers[first:], self.eps[first:], self.projectile.r,
+                                  self.projectile.l, depth, self.target.interface_depths[first:],
+                                  forms)
 
     def _force_coefficients(self, depth):
         A, B, tau, rho, _, _ = self.coefficients(depth)
@@ -231,25 +221,6 @@ class CraterAsTunnel:
     def crater_force(self, velocity):
         """The wrapped crater force."""
         return self.inner.crater_force(velocity)
-
-
-def study_rows(trajectory, target, tol=1e-9):
-    """The four Table 2 rows of a trajectory, robust to coincident phase-end events.
-
-    As :func:`cavex.verification.table2.table2_rows`, except that row 3 is the phase end at
-    ``H1`` whatever event ended it: where a response state changes exactly at ``H1`` (the
-    nose-tip switch), the integrator may report "response state changed" instead of "nose tip
-    reached interface 1".
-    """
-    rows = table2_rows(trajectory)
-    if rows[2] is None:
-        h1 = target.interface_depths[0]
-        at_h1 = next((p for p in trajectory.phases
-                      if abs(p.end_depth - h1) <= tol and p.end_velocity > 0.0), None)
-        if at_h1 is not None:
-            rows[2] = {"depth_m": at_h1.end_depth, "velocity_m_s": at_h1.end_velocity,
-                       "time_s": at_h1.end_time}
-    return rows
 
 
 def run_reading(target, projectile, reading, rtol=1e-9, atol=1e-12):
@@ -340,7 +311,7 @@ def table2_study(target, projectile, readings=READINGS, derived=("quasi-static",
     """
     rows = []
     for reading in readings:
-        full = study_rows(run_reading(target, projectile, reading), target)
+        full = table2_rows(run_reading(target, projectile, reading))
         rows += _compare(reading.name, full, "full")
         if segments:
             rows += _compare(reading.name, [full[0], *segment_rows(target, projectile, reading)],
@@ -349,7 +320,7 @@ def table2_study(target, projectile, readings=READINGS, derived=("quasi-static",
         resistance = ClosedFormResistance(target, projectile, "derived", boundary)
         trajectory = penetrate(target, projectile, resistance, crater="nose-base")
         rows += _compare(f"derived ({boundary}), Lc from nose base",
-                         study_rows(trajectory, target),
+                         table2_rows(trajectory),
                          "full")
     return rows
 
