@@ -20,7 +20,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from cavex.fem.settings import make_numerics
 from cavex.verification.cases import config_tables, fe_case, fe_case_id, numerics_names
-from cavex.verification.runner import read_store, run_cases
+from cavex.verification.runner import read_store, run_cases, write_text_atomic
+from cavex.verification.table import write_table
 
 from cavex.config import parse_projectile, parse_target
 from cavex.errors import CavexInputError, check_keys, is_finite_number, prefixed, require
@@ -371,13 +372,14 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
     cases = sweep_cases(sweep)
     out_dir = os.fspath(out_dir)
     os.makedirs(out_dir, exist_ok=True)
-    _write_json(os.path.join(out_dir, SWEEP_FILE), _description(sweep, cases))
+    description = _description(sweep, cases)
+    write_text_atomic(os.path.join(out_dir, SWEEP_FILE), json.dumps(description, indent=1))
     results = run_cases(fe_case, cases, store=os.path.join(out_dir, STORE_DIR),
                         scheduler=scheduler if scheduler is not None else sweep.scheduler,
                         workers=workers if workers is not None else sweep.workers,
                         progress=progress)
-    dataset = _dataset(_description(sweep, cases), {r["id"]: r for r in results})
-    dataset.to_netcdf(os.path.join(out_dir, RESULTS_FILE), engine="scipy")
+    dataset = _dataset(description, {r["id"]: r for r in results})
+    write_table(dataset, os.path.join(out_dir, RESULTS_FILE))
     return dataset
 
 
@@ -416,15 +418,6 @@ def _description(sweep, cases):
              "projectile": sweep.projectile}
     return {"name": sweep.name, "axes": axes, "fixed": fixed,
             "case_ids": [case["id"] for case in cases]}
-
-
-def _write_json(path, value):
-    tmp = path + ".tmp"
-    with open(tmp, "w", encoding="utf-8") as handle:
-        json.dump(value, handle, indent=1)
-        handle.flush()
-        os.fsync(handle.fileno())
-    os.replace(tmp, path)
 
 
 def _dataset(description, results):

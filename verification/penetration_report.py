@@ -1,11 +1,13 @@
 """The ``cavex penetrate`` job: trajectories, the Table 2 comparison, CSV and PNG outputs."""
 
 import csv
+import io
 import os
 from pathlib import Path
 
 from cavex.analytic.penetration import penetrate
 from cavex.analytic.resistance import ClosedFormResistance
+from cavex.verification.runner import write_text_atomic
 from cavex.verification.table2 import table2_comparison
 
 
@@ -61,12 +63,11 @@ def _columns(rows):
 
 
 def _write_csv(path, columns):
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    with open(tmp, "w", newline="", encoding="utf-8") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(columns)
-        writer.writerows(zip(*columns.values(), strict=True))
-    os.replace(tmp, path)
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow(columns)
+    writer.writerows(zip(*columns.values(), strict=True))
+    write_text_atomic(path, text.getvalue())
     return path
 
 

@@ -16,7 +16,7 @@ from cavex.verification import report_plots as plots
 from cavex.verification import report_text as text
 from cavex.verification.report_analysis import all_stats, analyse, layer_names
 from cavex.verification.report_html import markdown_to_html
-from cavex.verification.table import build_table
+from cavex.verification.table import build_table, write_table
 
 from cavex.errors import CavexInputError
 
@@ -93,8 +93,7 @@ def write_grid(grid, path, extra):
     ds = grid.copy()
     for key, value in extra.items():
         ds.attrs[key] = value if isinstance(value, str) else json.dumps(value)
-    ds.to_netcdf(path, engine="scipy")
-    return path
+    return write_table(ds, path)
 
 
 def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=None,

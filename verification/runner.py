@@ -106,20 +106,23 @@ def case_path(store, case_id):
 
 
 def write_case(store, case, result):
-    """Atomically write ``{"case": case, "result": result}`` to ``store/<id>.json``.
+    """Atomically write ``{"case": case, "result": result}`` to ``store/<id>.json``."""
+    write_text_atomic(case_path(store, case["id"]),
+                      json.dumps({"case": case, "result": result}, indent=1))
+    _fsync_dir(store)
 
-    The text goes to ``<id>.json.tmp``, is flushed and fsynced, then ``os.replace``-d onto the
-    final name, so a reader (or a resumed run after ``kill -9``) never sees a partial file.
+
+def write_text_atomic(path, text):
+    """Write ``text`` so that no reader (or a run resumed after ``kill -9``) sees a partial file.
+
+    The text goes to ``<path>.tmp``, is flushed and fsynced, then ``os.replace``-d onto ``path``.
     """
-    final = case_path(store, case["id"])
-    tmp = os.path.join(os.fspath(store), case["id"] + TMP_SUFFIX)
-    text = json.dumps({"case": case, "result": result}, indent=1)
-    with open(tmp, "w", encoding="utf-8") as handle:
+    tmp = os.fspath(path) + ".tmp"
+    with open(tmp, "w", encoding="utf-8", newline="") as handle:
         handle.write(text)
         handle.flush()
         os.fsync(handle.fileno())
-    os.replace(tmp, final)
-    _fsync_dir(store)
+    os.replace(tmp, path)
 
 
 def read_store(store):
