@@ -9,7 +9,6 @@ from cavex.analytic.cavity import quasi_static_coefficients, solve_checked, wall
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.analytic.nose import nose_force, ogive_coefficients
 from cavex.analytic.paper_model import paper_coefficients
-
 from cavex.errors import require, require_choice
 
 MODELS = ("derived", "paper")

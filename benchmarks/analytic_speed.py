@@ -11,7 +11,6 @@ from cavex.analytic.cavity import cavity_stress
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.penetration import penetrate
 from cavex.analytic.resistance import ClosedFormResistance
-
 from cavex.config import load_config
 
 

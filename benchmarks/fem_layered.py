@@ -10,9 +10,9 @@ import sys
 import time
 
 import numpy as np
-from cavex.fem import compare_at_depth
 
 from cavex import load_config
+from cavex.fem import compare_at_depth
 
 LEVELS = [(15.0, 0.06), (30.0, 0.03), (60.0, 0.015)]
 

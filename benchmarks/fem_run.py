@@ -11,8 +11,8 @@ import time
 import tracemalloc
 
 import numpy as np
-from cavex.fem import expand_cavity
 
+from cavex.fem import expand_cavity
 from cavex.materials import Material
 
 CONCRETE = Material(E=25e9, nu=0.4999, rho=2500.0, lam=0.15, tau=25e6, name="concrete")

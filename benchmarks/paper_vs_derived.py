@@ -14,6 +14,8 @@ Run: ``python benchmarks/paper_vs_derived.py`` (the embedded default target, the
 
 import math
 
+from scipy.integrate import solve_ivp
+
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.paper_model import (
@@ -25,8 +27,6 @@ from cavex.analytic.paper_model import (
     paper_phase_depths,
     paper_single_coefficients,
 )
-from scipy.integrate import solve_ivp
-
 from cavex.config import load_config
 from cavex.materials import Material, Projectile, Target
 

@@ -37,11 +37,11 @@ import time
 import tracemalloc
 
 import numpy as np
+
+from cavex import load_config
 from cavex.analytic.geometry import spherical_problem
 from cavex.fem import expand_cavity
 from cavex.fem.batch import expand_cavities
-
-from cavex import load_config
 
 ERROR_TARGET = 0.005  # cases estimated above it are re-run at twice the resolution
 VELOCITIES = np.linspace(0.0, 1200.0, 30)
@@ -112,9 +112,10 @@ def scaling(problems, workers, chunk, reference, kind):
     """The table through ``run_cases`` on 1..``workers`` local Dask workers (one thread each)
     or local processes; checks the results equal the in-process ``reference`` stresses."""
     import dask
+    from dask.distributed import Client, LocalCluster
+
     from cavex.fem.batch import expand_chunk
     from cavex.verification.runner import run_cases
-    from dask.distributed import Client, LocalCluster
 
     cases = chunks(problems, chunk)
     # no statistical profiler in the workers, and no aggressive heap trimming (Dask's default

@@ -1,15 +1,20 @@
-"""Spherically symmetric Lagrangian elastoplastic finite-element solver (scikit-fem).
+"""Spherically symmetric Lagrangian elastoplastic finite-element solver (scikit-fem, numba).
 
-Public entry points: :func:`expand_cavity` (one case), :func:`expand_cavities` (many cases in
-one batched assembly), :func:`write_result`, :func:`compare_at_depth`.
+One solver (:class:`cavex.fem.solver.RadialSolver`) runs every computation on a stack of cases;
+public entry points: :func:`expand_cavities` (many problems), :func:`expand_cavity` (one
+problem, with its history and fields recorded) and :func:`write_result`.
+
+Layout, one idea per module: ``mesh`` (graded radial meshes), ``discretisation`` (bases,
+quadrature, mass), ``constitutive`` (the compiled point kernel: Hencky/Mohr-Coulomb return map),
+``element`` (the compiled element kernel: force and tangent), ``stack`` (cases concatenated,
+block-banded solve), ``newton`` (per-case Newton, line search), ``solver`` (stepping, cut-backs,
+observers), ``estimate`` (error companion and refinement policies), ``expansion`` (the problems
+and the public API), ``fields``/``output`` (post-processing, ParaView files).
 """
 
-from cavex.fem.batch import expand_cavities
-from cavex.fem.compare import compare_at_depth
-from cavex.fem.expansion import expand_cavity
+from cavex.fem.expansion import expand_cavities, expand_cavity
 from cavex.fem.output import write_result
 from cavex.fem.result import ExpansionResult
 from cavex.fem.settings import Numerics
 
-__all__ = ["ExpansionResult", "Numerics", "compare_at_depth", "expand_cavities", "expand_cavity",
-           "write_result"]
+__all__ = ["ExpansionResult", "Numerics", "expand_cavities", "expand_cavity", "write_result"]

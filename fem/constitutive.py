@@ -38,14 +38,27 @@ backward-Euler return solves, for the active set ``A`` (one surface or the corne
 with ``sigma = (P, Q)``, ``f_k = a_k . sigma - k_k J``, ``d_l = (-K g_l[0], -2G g_l[1])``. It is
 linear, so solved in closed form; the consistent tangent is its exact derivative
 ``d sigma / d(theta, gamma) = E - D G^{-1} (A E - k J e_theta^T)``, ``E = diag(-K, -2G)``.
+
+Implementation: one compiled (numba) kernel per point, :func:`return_point`, used by the element
+loop of :mod:`cavex.fem.element` for every case. It tries the Mohr-Coulomb-only return first (one
+multiplier, the common case) and falls back, for that point only, to the multi-surface return
+when the trial state or the Mohr-Coulomb-returned one violates the tension cut-off.
+:func:`return_map` applies it to arrays of points (for tests and post-processing). An
+independent numpy implementation of the same equations is kept in ``tests/oracles.py`` and
+compared with this kernel point by point (``tests/test_fem_kernels.py``).
 """
 
+
+import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
-# (theta, gamma) = TO_INVARIANTS @ (eps_r, eps_t)
-TO_INVARIANTS = np.array([[1.0, 2.0], [1.0, -1.0]])
+TWO_THIRDS = 2.0 / 3.0
+#: Per-point outputs of :func:`return_point`, in order (``out[i]``).
+OUTPUTS = ("tau_r", "tau_t", "C_rr", "C_rt", "C_tr", "C_tt", "yield_ratio", "theta_p",
+           "gamma_p")
 
 
 @dataclass
@@ -91,192 +104,164 @@ class PointMaterial:
         return PointMaterial(**{name: value[index] for name, value in vars(self).items()})
 
 
-@dataclass
-class PointResponse:
-    """Stress, tangent and updated internal variables at the quadrature points.
 
-    ``tau_r``, ``tau_t`` are Kirchhoff stresses, tension positive; ``tangent[i, j]`` is
-    ``d tau_i / d eps_j`` for ``i, j`` in ``(r, t)``.
-    """
-
-    tau_r: np.ndarray
-    tau_t: np.ndarray
-    tangent: np.ndarray
-    theta_p: np.ndarray
-    gamma_p: np.ndarray
-    plastic: np.ndarray
-    dissipation: np.ndarray
-    energy: np.ndarray
-    yield_ratio: np.ndarray
-
-
-def _surfaces(sign, mat):
-    """Normals ``a``, intercepts ``k`` and flow vectors ``g`` of (MC, TC), each shape (2, ...)."""
-    pos = sign > 0
-    c_mc = np.where(pos, 1.0, (3.0 + mat.lam) / 3.0)
-    c_psi = np.where(pos, 1.0, (3.0 + mat.lam_psi) / 3.0)
-    a_mc = np.array([-mat.lam, c_mc * sign])
-    g_mc = np.array([mat.lam_psi, -1.5 * c_psi * sign])
-    a_tc = np.array([-np.ones_like(sign), np.where(pos, 1.0 / 3.0, -2.0 / 3.0)])
-    g_tc = np.array([np.ones_like(sign), np.where(pos, -0.5, 1.0)])
-    return (a_mc, mat.tau, g_mc), (a_tc, mat.tension, g_tc)
+@njit(cache=True, error_model="numpy", inline="always")
+def _finish_point(P, Q, T00, T01, T10, T11, lam, tau, J, out):
+    """Kirchhoff stresses ``tau_r, tau_t`` (tension positive), the tangent
+    ``d tau_i / d eps_j`` (from ``T = d(P, Q)/d(theta, gamma)``) and the yield ratio
+    (deviator over strength) into ``out[0..6]``."""
+    out[0] = -(P + 2.0 * Q / 3.0)
+    out[1] = -(P - Q / 3.0)
+    a_t = -T00 - TWO_THIRDS * T10
+    a_g = -T01 - TWO_THIRDS * T11
+    b_t = -T00 + T10 / 3.0
+    b_g = -T01 + T11 / 3.0
+    out[2] = a_t + a_g
+    out[3] = 2.0 * a_t - a_g
+    out[4] = b_t + b_g
+    out[5] = 2.0 * b_t - b_g
+    c = 1.0 if Q >= 0.0 else (3.0 + lam) / 3.0
+    strength = lam * P + tau * J
+    out[6] = c * abs(Q) / strength if strength > 0.0 else 1.0
 
 
-def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat, groups=None):
-    """Return-map the trial state; see the module docstring for the equations solved.
-
-    Parameters
-    ----------
-    eps_r, eps_t : ndarray
-        Total logarithmic strains at the points.
-    theta_p, gamma_p : ndarray
-        Plastic volumetric and deviatoric log strains at the start of the step.
-    mat : PointMaterial
-    groups : ndarray of int, optional
-        Group (independent model, e.g. one case of a batch) of every point. The Mohr-Coulomb-
-        only return is used for all points unless some point needs the multi-surface one;
-        that choice is made per group, so each group gets exactly the arithmetic it would get
-        if it were return-mapped alone. None: all points form one group.
-
-    Returns
-    -------
-    PointResponse
-    """
-    theta = eps_r + 2.0 * eps_t
-    gamma = eps_r - eps_t
-    J = np.exp(theta)
-    K, G = mat.K, mat.G
+@njit(cache=True, error_model="numpy")
+def _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension,
+                        out):
+    """Mohr-Coulomb-only return; returns ``(plastic, needs_multi_surface)``."""
     P = -K * (theta - theta_p)
     Q = -2.0 * G * (gamma - gamma_p)
     positive = Q >= 0.0
-    sign = np.where(positive, 1.0, -1.0)
-    c_mc = np.where(positive, 1.0, 1.0 + mat.lam / 3.0)
-    tol = 1e-12 * mat.tau * J
-    f_mc = c_mc * sign * Q - mat.lam * P - mat.tau * J
-    with np.errstate(invalid="ignore"):
-        sigma_3 = np.where(positive, P - Q / 3.0, P + 2.0 * Q / 3.0)
-        f_tc = -sigma_3 - mat.tension * J
-    plastic = (f_mc > tol) | (f_tc > tol)
-    general = f_tc > tol
-    if groups is None and np.any(general):
-        return _general_return(theta, gamma, J, theta_p, gamma_p, mat)
-    # Mohr-Coulomb alone (tension cut-off inactive everywhere): one multiplier per point
-    c_psi = np.where(positive, 1.0, 1.0 + mat.lam_psi / 3.0)
-    d_P, d_Q = -K * mat.lam_psi, 3.0 * G * c_psi * sign          # stress correction direction
-    g = -mat.lam * d_P + c_mc * sign * d_Q                       # a . d
-    dl = np.where(plastic, f_mc / g, 0.0)
+    sign = 1.0 if positive else -1.0
+    c_mc = 1.0 if positive else 1.0 + lam / 3.0
+    tol = 1e-12 * tau * J
+    f_mc = c_mc * sign * Q - lam * P - tau * J
+    sigma_3 = P - Q / 3.0 if positive else P + 2.0 * Q / 3.0
+    f_tc = -sigma_3 - tension * J
+    plastic = (f_mc > tol) or (f_tc > tol)
+    if f_tc > tol:
+        return plastic, True
+    c_psi = 1.0 if positive else 1.0 + lam_psi / 3.0
+    d_P = -K * lam_psi                      # stress correction direction d = (d_P, d_Q)
+    d_Q = 3.0 * G * c_psi * sign
+    g = -lam * d_P + c_mc * sign * d_Q      # a . d
+    dl = f_mc / g if plastic else 0.0
     P_new = P - dl * d_P
     Q_new = Q - dl * d_Q
-    trial_ok = _tension_ok(P_new, Q_new, J, mat)
-    general |= plastic & ~trial_ok
-    if groups is None and np.any(general):
-        return _general_return(theta, gamma, J, theta_p, gamma_p, mat)
-    th_p = theta_p + dl * mat.lam_psi
-    ga_p = gamma_p - dl * 1.5 * c_psi * sign
-    # tangent d(P, Q)/d(theta, gamma): E - d (a^T E - k J e_theta^T) / g on plastic points
-    pl = plastic / g
-    row_t = (mat.lam * K - mat.tau * J) * pl
+    s3 = P_new - Q_new / 3.0 if Q_new >= 0.0 else P_new + 2.0 * Q_new / 3.0
+    if plastic and not (-s3 - tension * J <= 1e-12 * tau * J):
+        return plastic, True
+    out[7] = theta_p + dl * lam_psi
+    out[8] = gamma_p - dl * 1.5 * c_psi * sign
+    # tangent d(P, Q)/d(theta, gamma) = E - d (a^T E - k J e_theta^T) / g on plastic points
+    pl = (1.0 if plastic else 0.0) / g
+    row_t = (lam * K - tau * J) * pl
     row_g = (-2.0 * G * c_mc * sign) * pl
-    T = np.array([[-K - d_P * row_t, -d_P * row_g], [-d_Q * row_t, -2.0 * G - d_Q * row_g]])
-    response = _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P_new, Q_new, T, plastic, J,
-                       mat)
-    if groups is not None and np.any(general):
-        redo = np.isin(groups, np.unique(groups[general]))
-        replace_points(response, redo, _general_return(theta[redo], gamma[redo], J[redo],
-                                                       theta_p[redo], gamma_p[redo],
-                                                       mat.take(redo)))
-    return response
+    _finish_point(P_new, Q_new, -K - d_P * row_t, -d_P * row_g, -d_Q * row_t,
+                  -2.0 * G - d_Q * row_g, lam, tau, J, out)
+    return plastic, False
 
 
-def replace_points(response, where, other):
-    """Overwrite ``response`` at the points ``where`` (boolean or indices) by ``other``."""
-    for name, value in vars(response).items():
-        if name == "tangent":
-            value[:, :, where] = other.tangent
-        else:
-            value[where] = getattr(other, name)
-
-
-def _tension_ok(P, Q, J, mat):
-    with np.errstate(invalid="ignore"):
-        sigma_3 = np.where(Q >= 0.0, P - Q / 3.0, P + 2.0 * Q / 3.0)
-        return -sigma_3 - mat.tension * J <= 1e-12 * mat.tau * J
-
-
-def _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P, Q, T, plastic, J, mat):
-    """Principal Kirchhoff stresses, tangent in (eps_r, eps_t), energies, yield ratio."""
-    K, G = mat.K, mat.G
-    tau_r = -(P + 2.0 * Q / 3.0)
-    tau_t = -(P - Q / 3.0)
-    # d tau / d eps = TO_TAU . T . TO_INVARIANTS, written out
-    a_t = -T[0, 0] - (2.0 / 3.0) * T[1, 0]
-    a_g = -T[0, 1] - (2.0 / 3.0) * T[1, 1]
-    b_t = -T[0, 0] + T[1, 0] / 3.0
-    b_g = -T[0, 1] + T[1, 1] / 3.0
-    tangent = np.array([[a_t + a_g, 2.0 * a_t - a_g], [b_t + b_g, 2.0 * b_t - b_g]])
-    dissipation = -P * (th_p - theta_p) - (2.0 / 3.0) * Q * (ga_p - gamma_p)
-    energy = 0.5 * K * (theta - th_p) ** 2 + (2.0 / 3.0) * G * (gamma - ga_p) ** 2
-    c_mc = np.where(Q >= 0.0, 1.0, (3.0 + mat.lam) / 3.0)
-    strength = mat.lam * P + mat.tau * J
-    with np.errstate(divide="ignore", invalid="ignore"):
-        yield_ratio = np.where(strength > 0.0, c_mc * np.abs(Q) / strength, 1.0)
-    return PointResponse(tau_r=tau_r, tau_t=tau_t, tangent=tangent, theta_p=th_p,
-                         gamma_p=ga_p, plastic=plastic, dissipation=dissipation,
-                         energy=energy, yield_ratio=yield_ratio)
-
-
-def _general_return(theta, gamma, J, theta_p, gamma_p, mat):
-    """Multi-surface return (Mohr-Coulomb, tension cut-off, or their corner)."""
-    K, G = mat.K, mat.G
+@njit(cache=True, error_model="numpy")
+def _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension,
+                         out):
+    """Multi-surface return (Mohr-Coulomb, tension cut-off or their corner); returns
+    ``plastic``."""
     P_tr = -K * (theta - theta_p)
     Q_tr = -2.0 * G * (gamma - gamma_p)
-    sign = np.where(Q_tr >= 0.0, 1.0, -1.0)
-    (a1, k1, g1), (a2, k2, g2) = _surfaces(sign, mat)
-    d1 = np.array([-K * g1[0], -2.0 * G * g1[1]])
-    d2 = np.array([-K * g2[0], -2.0 * G * g2[1]])
-    s_tr = np.array([P_tr, Q_tr])
-    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-        f1 = (a1 * s_tr).sum(0) - k1 * J
-        f2 = (a2 * s_tr).sum(0) - k2 * J
-        g11, g12 = (a1 * d1).sum(0), (a1 * d2).sum(0)
-        g21, g22 = (a2 * d1).sum(0), (a2 * d2).sum(0)
-        tol = 1e-12 * mat.tau * J
-        dl1 = f1 / g11
-        ok1 = (dl1 > 0) & (f2 - g21 * dl1 <= tol)
-        dl2 = f2 / g22
-        ok2 = (dl2 > 0) & (f1 - g12 * dl2 <= tol)
+    pos = Q_tr >= 0.0
+    sign = 1.0 if pos else -1.0
+    c_mc = 1.0 if pos else (3.0 + lam) / 3.0
+    c_psi = 1.0 if pos else (3.0 + lam_psi) / 3.0
+    # surface normals a_k, flow vectors g_k and stress corrections d_k = E g_k
+    a10, a11 = -lam, c_mc * sign
+    g10, g11_ = lam_psi, -1.5 * c_psi * sign
+    a20, a21 = -1.0, (1.0 / 3.0 if pos else -2.0 / 3.0)
+    g20, g21_ = 1.0, (-0.5 if pos else 1.0)
+    d10, d11 = -K * g10, -2.0 * G * g11_
+    d20, d21 = -K * g20, -2.0 * G * g21_
+    f1 = (a10 * P_tr + a11 * Q_tr) - tau * J
+    f2 = (a20 * P_tr + a21 * Q_tr) - tension * J
+    g11 = a10 * d10 + a11 * d11
+    g12 = a10 * d20 + a11 * d21
+    g21 = a20 * d10 + a21 * d11
+    g22 = a20 * d20 + a21 * d21
+    tol = 1e-12 * tau * J
+    elastic = (f1 <= tol) and (f2 <= tol)
+    m1 = m2 = 0.0
+    E00, E11 = -K, -2.0 * G
+    T00, T01, T10, T11 = E00, 0.0, 0.0, E11
+    dl1 = f1 / g11
+    dl2 = f2 / g22
+    if not elastic and dl1 > 0 and f2 - g21 * dl1 <= tol:          # Mohr-Coulomb alone
+        m1 = dl1
+        r0, r1 = a10 * E00 - tau * J, a11 * E11
+        T00, T01, T10, T11 = E00 - d10 * r0 / g11, -d10 * r1 / g11, -d11 * r0 / g11, \
+            E11 - d11 * r1 / g11
+    elif not elastic and dl2 > 0 and f1 - g12 * dl2 <= tol:        # tension cut-off alone
+        m2 = dl2
+        r0, r1 = a20 * E00 - tension * J, a21 * E11
+        T00, T01, T10, T11 = E00 - d20 * r0 / g22, -d20 * r1 / g22, -d21 * r0 / g22, \
+            E11 - d21 * r1 / g22
+    elif not elastic:                                                # the corner
         det = g11 * g22 - g12 * g21
-        c1 = (g22 * f1 - g12 * f2) / det
-        c2 = (g11 * f2 - g21 * f1) / det
-    elastic = (f1 <= tol) & (f2 <= tol)
-    use1 = ~elastic & ok1
-    use2 = ~elastic & ~use1 & ok2
-    use3 = ~elastic & ~use1 & ~use2
-    z = np.zeros_like(theta)
-    m1 = np.where(use1, dl1, np.where(use3, c1, z))
-    m2 = np.where(use2, dl2, np.where(use3, c2, z))
-    P = P_tr - m1 * d1[0] - m2 * d2[0]
-    Q = Q_tr - m1 * d1[1] - m2 * d2[1]
-    th_p = theta_p + m1 * g1[0] + m2 * g2[0]
-    ga_p = gamma_p + m1 * g1[1] + m2 * g2[1]
-    E = np.array([[-K, z], [z, -2.0 * G]])
-    T = E.copy()
-    for mask, a, k, d, g in ((use1, a1, k1, d1, g11), (use2, a2, k2, d2, g22)):
-        row = np.array([a[0] * E[0, 0] - k * J, a[1] * E[1, 1]])
-        with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-            corr = d[:, None] * row[None, :] / g
-        T = np.where(mask, E - corr, T)
-    if np.any(use3):
-        with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-            inv = np.array([[g22, -g12], [-g21, g11]]) / det
-            A = np.array([[a1[0] * E[0, 0] - k1 * J, a1[1] * E[1, 1]],
-                          [a2[0] * E[0, 0] - k2 * J, a2[1] * E[1, 1]]])
-            D = np.array([[d1[0], d2[0]], [d1[1], d2[1]]])
-            corr = np.einsum("ik...,kl...,lj...->ij...", D, inv, A)
-        T = np.where(use3, E - corr, T)
-    return _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P, Q, T, ~elastic, J, mat)
+        m1 = (g22 * f1 - g12 * f2) / det
+        m2 = (g11 * f2 - g21 * f1) / det
+        i00, i01, i10, i11 = g22 / det, -g12 / det, -g21 / det, g11 / det
+        A00, A01 = a10 * E00 - tau * J, a11 * E11
+        A10, A11 = a20 * E00 - tension * J, a21 * E11
+        # T = E - D G^-1 A with D = [[d10, d20], [d11, d21]]
+        T00 = E00 - (d10 * (i00 * A00 + i01 * A10) + d20 * (i10 * A00 + i11 * A10))
+        T01 = -(d10 * (i00 * A01 + i01 * A11) + d20 * (i10 * A01 + i11 * A11))
+        T10 = -(d11 * (i00 * A00 + i01 * A10) + d21 * (i10 * A00 + i11 * A10))
+        T11 = E11 - (d11 * (i00 * A01 + i01 * A11) + d21 * (i10 * A01 + i11 * A11))
+    out[7] = theta_p + m1 * g10 + m2 * g20
+    out[8] = gamma_p + m1 * g11_ + m2 * g21_
+    _finish_point(P_tr - m1 * d10 - m2 * d20, Q_tr - m1 * d11 - m2 * d21, T00, T01, T10, T11,
+                  lam, tau, J, out)
+    return not elastic
 
 
-def equivalent_plastic_strain(gamma_p, theta_p):
-    """``sqrt(2/3 eps_p : eps_p)`` of the plastic log strain (deviatoric and volumetric parts)."""
-    return np.sqrt((2.0 / 3.0) * ((2.0 / 3.0) * gamma_p ** 2 + theta_p ** 2 / 3.0))
+@njit(cache=True, error_model="numpy")
+def return_point(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, out):
+    """Return map of one point from its total log strains; writes :data:`OUTPUTS` into
+    ``out`` (length 9) and returns whether the point is plastic in this step."""
+    theta = eps_r + 2.0 * eps_t
+    gamma = eps_r - eps_t
+    J = math.exp(theta)
+    plastic, multi = _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
+                                         lam_psi, tension, out)
+    if multi:
+        plastic = _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
+                                       lam_psi, tension, out)
+    return plastic
+
+
+@njit(cache=True, error_model="numpy")
+def _return_points(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, out,
+                   plastic):
+    row = np.empty(9)
+    for i in range(eps_r.size):
+        plastic[i] = return_point(eps_r[i], eps_t[i], theta_p[i], gamma_p[i], K[i], G[i],
+                                  lam[i], tau[i], lam_psi[i], tension[i], row)
+        out[:, i] = row
+
+
+def return_map(eps_r, eps_t, theta_p, gamma_p, material):
+    """:func:`return_point` at every point of the arrays (all of one shape).
+
+    Returns a dict of arrays of that shape: the :data:`OUTPUTS` and ``plastic``.
+    """
+    shape = np.shape(eps_r)
+    flat = [np.ascontiguousarray(np.broadcast_to(x, shape), dtype=float).ravel()
+            for x in (eps_r, eps_t, theta_p, gamma_p)]
+    props = [np.ascontiguousarray(np.broadcast_to(getattr(material, name), shape),
+                                  dtype=float).ravel()
+             for name in ("K", "G", "lam", "tau", "lam_psi", "tension")]
+    out = np.empty((len(OUTPUTS), flat[0].size))
+    plastic = np.empty(flat[0].size, dtype=np.bool_)
+    _return_points(*flat, *props, out, plastic)
+    result = {name: out[i].reshape(shape) for i, name in enumerate(OUTPUTS)}
+    result["plastic"] = plastic.reshape(shape)
+    return result
+

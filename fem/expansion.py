@@ -1,9 +1,15 @@
-"""``expand_cavity``: a spherical cavity driven at constant velocity from a seed radius.
+"""Cavity expansions: a spherical cavity driven at constant velocity from a seed radius.
 
 The cavity wall (reference radius ``a0 = radius / seed_ratio``) moves outwards at ``velocity``
 until the cavity radius is ``radius``; the material starts at rest and unstressed. Time steps
 grow with the cavity (``da = growth_per_step * a``), so every step is a fixed fraction of the
 self-similar process. With ``velocity = 0`` the run is quasi-static.
+
+:func:`expand_cavities` runs any number of such problems with shared numerical settings on the
+one solver (:class:`cavex.fem.solver.RadialSolver`, stacks of ``batch_size`` cases);
+:func:`expand_cavity` is the same on one problem, recording its history and fields through
+observers of the run. The error-estimate companion and the refinement of cases above an error
+target are policies of :mod:`cavex.fem.estimate`, applied here to every problem alike.
 """
 
 import math
@@ -11,17 +17,24 @@ import time
 from dataclasses import asdict
 
 import numpy as np
+
 from cavex.analytic.cavity import check_problem
+from cavex.errors import CavexInputError, require
 from cavex.fem.discretisation import Discretisation
-from cavex.fem.fields import cauchy_stresses, current_point_radii, plastic_radius, wall_stress
+from cavex.fem.estimate import estimate_errors, refine_above
+from cavex.fem.fields import cauchy_stresses, current_point_radii, plastic_radius
 from cavex.fem.mesh import element_layers, reference_mesh
 from cavex.fem.result import ExpansionResult
 from cavex.fem.settings import make_numerics
 from cavex.fem.solver import RadialSolver
 
-from cavex.errors import CavexNumericalError, require
+DEFAULT_BATCH = 200     # cases per stack (measured optimum on a 2-core machine: 100-400)
+ON_ERROR = ("return", "raise")
+MODEL_CACHE = 1024      # discretisations kept per process (a table has 2-3 per depth)
+_MODELS = {}            # (layers, interfaces, radius, numerics) -> (Discretisation, vertices)
 
 
+# ---------------------------------------------------------------------------------- problem set-up
 def radius_schedule(radius, seed_radius, growth_per_step):
     """Cavity radii of the step ends, geometric from ``seed_radius`` to ``radius``."""
     n = max(1, math.ceil(math.log(radius / seed_radius) / math.log1p(growth_per_step) - 1e-9))
@@ -60,118 +73,250 @@ def wall_times(radii, seed, velocity, ramp):
 
 
 def build_model(layers, interfaces, radius, numerics):
-    """Reference mesh and discretisation of the problem; also the interface vertex indices."""
-    mesh, iface_vertices = reference_mesh(radius, seed_radius(radius, numerics), interfaces,
-                                          outer_radius(radius, interfaces, numerics),
-                                          numerics.elements_per_decade)
-    disc = Discretisation(mesh, numerics.degree, element_layers(mesh, iface_vertices), layers,
-                          numerics.dilatancy_deg, numerics.tension_cutoff)
-    return disc, iface_vertices
+    """Discretisation of the problem and the mesh vertex index of every interface inside it
+    (cached per process: a table reuses one model for every velocity)."""
+    key = (tuple(layers), tuple(interfaces), radius, numerics)
+    if key not in _MODELS:
+        if len(_MODELS) >= MODEL_CACHE:
+            _MODELS.clear()
+        mesh, vertices = reference_mesh(radius, seed_radius(radius, numerics), interfaces,
+                                        outer_radius(radius, interfaces, numerics),
+                                        numerics.elements_per_decade)
+        disc = Discretisation(mesh, numerics.degree, element_layers(mesh, vertices), layers,
+                              numerics.dilatancy_deg, numerics.tension_cutoff)
+        _MODELS[key] = (disc, vertices)
+    return _MODELS[key]
 
 
-def run_expansion(layers, interfaces, velocity, radius, numerics):
-    """One run at the given settings; returns the result without an error estimate."""
+def is_dynamic(velocity, numerics):
+    return numerics.dynamic and velocity > 0.0
+
+
+# ---------------------------------------------------------------------------------- observers
+class Recorder:
+    """Observer of one case: the step history and evenly spread field snapshots."""
+
+    def __init__(self, case, n_steps, snapshots, dynamic):
+        self.case = case
+        self.dynamic = dynamic
+        self.keep = set(np.linspace(0, n_steps - 1, min(snapshots, n_steps)).astype(int))
+        self.history = None
+        self.snapshots = []
+
+    def start(self, solver):
+        one = solver.case(self.case)
+        a0 = float(one.disc.R_dofs[0])
+        self.history = {"time": [0.0], "radius": [a0], "wall_stress": [0.0],
+                        "plastic_radius": [a0]}
+
+    def __call__(self, solver, case, step):
+        if case != self.case:
+            return
+        one = solver.case(case)
+        disc = one.disc
+        a = float(disc.R_dofs[0] + one.u[0])
+        self.history["time"].append(one.t if self.dynamic else 0.0)
+        self.history["radius"].append(a)
+        self.history["wall_stress"].append(one.wall_force / (4.0 * np.pi * a * a))
+        self.history["plastic_radius"].append(plastic_radius(disc, one.u, one.response,
+                                                             one.state))
+        if step in self.keep:
+            sigma_r, sigma_t = cauchy_stresses(disc, one.u, one.response)
+            self.snapshots.append({"time": one.t, "u": one.u[::disc.degree].copy(),
+                                   "sigma_r": sigma_r.mean(axis=1),
+                                   "sigma_theta": sigma_t.mean(axis=1),
+                                   "plastic_strain": one.state["eq_p"].mean(axis=1)})
+
+
+# ---------------------------------------------------------------------------------- runs
+def run_problems(problems, numerics, batch_size=DEFAULT_BATCH, record=False):
+    """One run of every problem at ``numerics`` (no error estimate): stacks of ``batch_size``
+    cases, dynamic and quasi-static ones apart. Returns a list of :class:`ExpansionResult`."""
+    out = [None] * len(problems)
+    for dynamic in (True, False):
+        group = [i for i, p in enumerate(problems) if is_dynamic(p[2], numerics) == dynamic]
+        for start in range(0, len(group), batch_size):
+            chunk = group[start:start + batch_size]
+            for i, result in zip(chunk, _run_stack([problems[i] for i in chunk], numerics,
+                                                   dynamic, record), strict=True):
+                out[i] = result
+    return out
+
+
+def _run_stack(problems, numerics, dynamic, record):
     started = time.perf_counter()
-    disc, iface_vertices = build_model(layers, interfaces, radius, numerics)
-    dynamic = numerics.dynamic and velocity > 0.0
-    solver = RadialSolver(disc, dynamic=dynamic, rho_inf=numerics.rho_inf, outer=numerics.outer,
-                          assembly=numerics.assembly, newton_tol=numerics.newton_tol,
+    models = [build_model(layers, interfaces, radius, numerics)
+              for layers, interfaces, _, radius in problems]
+    velocity = np.array([p[2] for p in problems])
+    solver = RadialSolver([m[0] for m in models], dynamic=dynamic, rho_inf=numerics.rho_inf,
+                          outer=numerics.outer, newton_tol=numerics.newton_tol,
                           max_cutbacks=numerics.max_cutbacks,
-                          wall_velocity=velocity if dynamic and numerics.start_ramp == 0 else 0.0)
-    seed = disc.R_dofs[0]
-    radii = radius_schedule(radius, seed, numerics.growth_per_step)
-    times = wall_times(radii, seed, velocity, numerics.start_ramp) if dynamic else None
-    history = {"time": [0.0], "radius": [seed], "wall_stress": [0.0], "plastic_radius": [seed]}
-    keep = set(np.linspace(0, len(radii) - 1, min(numerics.snapshots, len(radii))).astype(int))
-    snapshots = []
-    for step, a in enumerate(radii):
-        dt = times[step] - solver.t if dynamic else 1.0
-        try:
-            solver.advance(a - seed, dt)
-        except CavexNumericalError as exc:
-            raise CavexNumericalError(f"V = {velocity:g} m/s, step to cavity radius {a:.6g} m: "
-                                      f"{exc}") from None
-        history["time"].append(solver.t if dynamic else 0.0)
-        history["radius"].append(a)
-        history["wall_stress"].append(wall_stress(disc, solver.u, solver.wall_force))
-        history["plastic_radius"].append(plastic_radius(disc, solver.u, solver.response,
-                                                        solver.state))
-        if step in keep:
-            snapshots.append(snapshot(disc, solver))
-    sigma_r, sigma_t = cauchy_stresses(disc, solver.u, solver.response)
-    r_nodes = disc.R_dofs + solver.u
-    fields = {"r": current_point_radii(disc, solver.u).ravel(), "sigma_r": sigma_r.ravel(),
-              "sigma_theta": sigma_t.ravel(), "plastic_strain": solver.state["eq_p"].ravel(),
-              "layer": disc.point_layer.ravel(), "r_nodes": r_nodes, "R_nodes": disc.R_dofs.copy(),
-              "u": solver.u.copy(), "snapshots": snapshots}
-    ends = tuple(float(r_nodes[disc.degree * v]) for v in iface_vertices)
+                          wall_velocity=velocity if dynamic and numerics.start_ramp == 0
+                          else 0.0)
+    seeds = [float(m[0].R_dofs[0]) for m in models]
+    radii = [radius_schedule(p[3], s, numerics.growth_per_step)
+             for p, s in zip(problems, seeds, strict=True)]
+    times = ([wall_times(r, s, v, numerics.start_ramp)
+              for r, s, v in zip(radii, seeds, velocity, strict=True)] if dynamic else None)
+    recorders = [Recorder(c, len(r), numerics.snapshots, dynamic)
+                 for c, r in enumerate(radii)] if record else []
+    for recorder in recorders:
+        recorder.start(solver)
+
+    def describe(c, step):
+        return f"V = {velocity[c]:g} m/s, step to cavity radius {radii[c][step]:.6g} m"
+
+    errors = solver.run([r - s for r, s in zip(radii, seeds, strict=True)], times,
+                        observers=recorders, describe=describe)
+    seconds = time.perf_counter() - started
+    return [_result(solver, c, problems[c], models[c][1], numerics, errors[c], seconds,
+                    recorders[c] if record else None) for c in range(len(problems))]
+
+
+def _result(solver, c, problem, vertices, numerics, error, seconds, recorder):
+    layers, interfaces, velocity, radius = problem
+    one = solver.case(c)
+    disc = one.disc
     settings = {"layers": [asdict(m) for m in layers], "interfaces": [float(h) for h in interfaces],
                 "velocity": float(velocity), "radius": float(radius),
                 "numerics": numerics.as_dict()}
-    energy = {"work": solver.work, "kinetic": solver.kinetic_energy(),
-              "stored": solver.stored_energy(), "dissipated": solver.dissipated}
-    stats = {"elements": disc.n_elements, "dofs": disc.ndof, "steps": solver.steps,
-             "newton_iterations": solver.newton_iterations, "cutbacks": solver.cutbacks,
-             "seconds": time.perf_counter() - started}
-    return ExpansionResult(cavity_stress=float(history["wall_stress"][-1]),
-                           history={k: np.asarray(v) for k, v in history.items()},
-                           fields=fields, error_estimate=None,
-                           plastic_radius=float(history["plastic_radius"][-1]),
-                           interfaces_final=ends, settings=settings, energy=energy, stats=stats)
+    stats = {"elements": disc.n_elements, "dofs": disc.ndof,
+             **{name: getattr(one, name) for name in ("steps", "newton_iterations", "cutbacks",
+                                                      "line_search_steps")},
+             "seconds": seconds, "refinements": 0}
+    if error is not None:
+        return ExpansionResult(math.nan, None, math.nan, (), settings, stats=stats, error=error)
+    a = float(disc.R_dofs[0] + one.u[0])
+    r_nodes = disc.R_dofs + one.u
+    fields = {"u": one.u.copy(), "r_nodes": r_nodes, "R_nodes": disc.R_dofs.copy()}
+    energy = {"work": one.work, "kinetic": solver.kinetic_energy(c),
+              "stored": solver.stored_energy(c), "dissipated": one.dissipated}
+    history = None
+    if recorder is not None:
+        sigma_r, sigma_t = cauchy_stresses(disc, one.u, one.response)
+        fields.update(r=current_point_radii(disc, one.u).ravel(), sigma_r=sigma_r.ravel(),
+                      sigma_theta=sigma_t.ravel(), plastic_strain=one.state["eq_p"].ravel(),
+                      layer=disc.point_layer.ravel(), snapshots=recorder.snapshots)
+        history = {k: np.asarray(v) for k, v in recorder.history.items()}
+    return ExpansionResult(
+        cavity_stress=float(one.wall_force / (4.0 * np.pi * a * a)), error_estimate=None,
+        plastic_radius=plastic_radius(disc, one.u, one.response, one.state),
+        interfaces_final=tuple(float(r_nodes[disc.degree * v]) for v in vertices),
+        settings=settings, fields=fields, history=history, energy=energy, stats=stats)
 
 
-def snapshot(disc, solver):
-    """Element-averaged fields and nodal displacement of the current state (for output)."""
-    sigma_r, sigma_t = cauchy_stresses(disc, solver.u, solver.response)
-    return {"time": solver.t, "u": solver.u[::disc.degree].copy(),
-            "sigma_r": sigma_r.mean(axis=1), "sigma_theta": sigma_t.mean(axis=1),
-            "plastic_strain": solver.state["eq_p"].mean(axis=1)}
-
-
-def richardson_error(fine, coarse, order=2.0, refinement=2.0):
-    """Relative error of ``fine`` estimated from ``coarse`` (``refinement``-times coarser)."""
-    return abs(fine - coarse) / (refinement ** order - 1.0) / abs(fine)
-
-
-def richardson_error_from_finer(result, finer, order=2.0, refinement=2.0):
-    """Relative error of ``result`` from a ``refinement``-times finer run:
-    ``S_h - S_{h/q} = C h^p (1 - q^-p)``, so ``err(S_h) = |S_h - S_{h/q}| q^p / (q^p - 1)``."""
-    q = refinement ** order
-    return abs(result - finer) * q / (q - 1.0) / abs(result)
-
-
-def companion_estimate(layers, interfaces, velocity, radius, settings, result):
-    """Richardson error estimate of ``result`` and the companion run it came from.
-
-    The companion is the 2x coarser run (space and time); where that one fails numerically
-    (a Newton failure that survives the cut-backs and the last-resort line search), a 2x finer
-    run is used instead, which over- rather than under-estimates.
-    """
+# ---------------------------------------------------------------------------------- public API
+def _problem(i, problem):
+    """``(layers, interfaces, velocity, radius)`` of one entry, checked."""
+    if isinstance(problem, dict):
+        unknown = set(problem) - {"layers", "interfaces", "velocity", "radius"}
+        require(not unknown, f"problems[{i}]", "a dict with keys layers, interfaces, velocity, "
+                "radius", sorted(unknown))
+        problem = (problem.get("layers"), problem.get("interfaces", ()),
+                   problem.get("velocity"), problem.get("radius"))
+    require(isinstance(problem, (tuple, list)) and len(problem) == 4, f"problems[{i}]",
+            "(layers, interfaces, velocity, radius) or a dict of those", problem)
+    layers, interfaces, velocity, radius = problem
     try:
-        coarse = run_expansion(layers, interfaces, velocity, radius, settings.coarsened())
-        return richardson_error(result.cavity_stress, coarse.cavity_stress), coarse, "coarse"
-    except CavexNumericalError:
-        finer = run_expansion(layers, interfaces, velocity, radius, settings.coarsened(0.5))
-        return (richardson_error_from_finer(result.cavity_stress, finer.cavity_stress), finer,
-                "finer")
+        require(isinstance(velocity, (int, float)) and not isinstance(velocity, bool),
+                "velocity", "a number", velocity)
+        require(isinstance(radius, (int, float)) and not isinstance(radius, bool),
+                "radius", "a number", radius)
+        layers = tuple(layers)
+        interfaces = tuple(float(h) for h in interfaces)
+        check_problem(layers, interfaces, float(velocity), float(radius), "dynamic")
+    except (CavexInputError, TypeError) as exc:
+        raise CavexInputError(f"problems[{i}]: {exc}") from None
+    return layers, interfaces, float(velocity), float(radius)
 
 
-def expand_cavity(layers, interfaces, velocity, radius, **numerics):
-    """Expand a spherical cavity at constant velocity and return the FE solution.
+def expand_cavities(problems, *, batch_size=DEFAULT_BATCH, on_error="return", error_target=None,
+                    max_refinements=2, record=False, **numerics):
+    """Expand many spherical cavities with shared settings on the one FE solver.
 
     Parameters
     ----------
-    layers : sequence of Material
-        ``layers[0]`` surrounds the cavity; the last extends to the outer boundary.
-    interfaces : sequence of float
-        Interface radii (m) in the current configuration at the final radius, as for
-        :func:`cavex.analytic.cavity.cavity_stress`.
-    velocity : float
-        Constant cavity-wall velocity ``V`` (m/s), >= 0 (0: quasi-static).
-    radius : float
-        Final cavity radius ``a`` (m).
+    problems : sequence
+        Each ``(layers, interfaces, velocity, radius)`` (or a dict with those keys):
+        ``layers[0]`` surrounds the cavity, the last extends to the outer boundary;
+        ``interfaces`` are radii (m) in the current configuration at the final radius, as for
+        :func:`cavex.analytic.cavity.cavity_stress`; ``velocity`` the constant wall velocity
+        (m/s, >= 0; 0 is quasi-static); ``radius`` the final cavity radius (m).
+    batch_size : int
+        Cases advanced together in one stack (memory grows linearly with it), >= 1.
+    on_error : {"return", "raise"}
+        A case whose Newton iteration fails after the cut-backs and the line search comes back
+        with ``error`` set (the others are unaffected), or, with ``"raise"``, the first such
+        error is raised after the whole list has run.
+    error_target : float, optional
+        With the error estimate on, a case whose estimate exceeds this relative error is run
+        again at twice the space and time resolution, up to ``max_refinements`` times
+        (:func:`cavex.fem.estimate.refine_above`). None: every case at the given settings.
+    max_refinements : int
+        See ``error_target``, >= 0.
+    record : bool
+        Also keep every case's history, final point fields and snapshots (observers of the run).
     **numerics
-        Fields of :class:`cavex.fem.settings.Numerics`.
+        Fields of :class:`cavex.fem.settings.Numerics`, shared by all cases.
+
+    Returns
+    -------
+    list of ExpansionResult
+        In the order of ``problems``.
+
+    Raises
+    ------
+    CavexInputError
+        A bad problem (the message names its index and the parameter) or bad numerics.
+    CavexNumericalError
+        With ``on_error="raise"``, when some case failed.
+    """
+    require(isinstance(batch_size, int) and not isinstance(batch_size, bool) and batch_size >= 1,
+            "batch_size", "an integer >= 1", batch_size)
+    require(on_error in ON_ERROR, "on_error", " or ".join(map(repr, ON_ERROR)), on_error)
+    settings = make_numerics(**numerics)
+    problems = [_problem(i, p) for i, p in enumerate(problems)]
+    for i, (_, _, _, radius) in enumerate(problems):
+        require(settings.seed_radius is None or settings.seed_radius < radius,
+                f"problems[{i}]: seed_radius", f"in (0, radius = {radius})",
+                settings.seed_radius)
+    require(error_target is None or (isinstance(error_target, float) and 0 < error_target < 1),
+            "error_target", "None or a float in (0, 1)", error_target)
+    require(isinstance(max_refinements, int) and not isinstance(max_refinements, bool)
+            and max_refinements >= 0, "max_refinements", "an integer >= 0", max_refinements)
+
+    def run(subset, numerics):
+        return run_problems(subset, numerics, batch_size, record)
+
+    def run_estimated(subset, numerics):
+        results = run(subset, numerics)
+        if numerics.error_estimate:
+            estimate_errors(subset, results, numerics,
+                            lambda p, n: run_problems(p, n, batch_size))
+        return results
+
+    results = run_estimated(problems, settings)
+    if error_target is not None and settings.error_estimate:
+        refine_above(problems, results, settings, error_target, max_refinements,
+                     run_estimated)
+    if on_error == "raise":
+        for r in results:
+            if r.error is not None:
+                raise r.error
+    return results
+
+
+def expand_cavity(layers, interfaces, velocity, radius, **numerics):
+    """Expand one spherical cavity at constant velocity: :func:`expand_cavities` on one problem
+    with its history and fields recorded.
+
+    Parameters
+    ----------
+    layers, interfaces, velocity, radius
+        One problem, as in :func:`expand_cavities`.
+    **numerics
+        Fields of :class:`cavex.fem.settings.Numerics`, and ``error_target`` /
+        ``max_refinements`` of :func:`expand_cavities`.
 
     Returns
     -------
@@ -182,20 +327,19 @@ def expand_cavity(layers, interfaces, velocity, radius, **numerics):
     CavexInputError
         Bad problem or numerics (the message names the parameter and its range).
     CavexNumericalError
-        Newton failed even after step cut-backs (the message names V, the step and the radius).
+        Newton failed even after step cut-backs and the line search (the message names V, the
+        step and the wall radius).
     """
     layers = list(layers)
     interfaces = [float(h) for h in interfaces]
     check_problem(layers, interfaces, float(velocity), float(radius), "dynamic")
-    settings = make_numerics(**numerics)
+    settings = make_numerics(**{k: v for k, v in numerics.items()
+                                if k not in ("error_target", "max_refinements")})
     require(settings.seed_radius is None or settings.seed_radius < radius, "seed_radius",
             f"in (0, radius = {radius})", settings.seed_radius)
-    result = run_expansion(layers, interfaces, float(velocity), float(radius), settings)
-    if settings.error_estimate:
-        estimate, companion, kind = companion_estimate(layers, interfaces, float(velocity),
-                                                       float(radius), settings, result)
-        result.error_estimate = estimate
-        result.stats[f"{kind}_cavity_stress"] = companion.cavity_stress
-        result.stats["error_companion"] = kind
-        result.stats["seconds"] += companion.stats["seconds"]
+    try:
+        result, = expand_cavities([(layers, interfaces, float(velocity), float(radius))],
+                                  on_error="raise", record=True, **numerics)
+    except CavexInputError as exc:  # one problem: its index says nothing
+        raise CavexInputError(str(exc).removeprefix("problems[0]: ")) from None
     return result

@@ -5,7 +5,6 @@ from dataclasses import asdict, dataclass, fields, replace
 from cavex.errors import is_finite_number as _finite
 from cavex.errors import require, require_choice
 
-ASSEMBLIES = ("fast", "forms")
 OUTER_BOUNDARIES = ("fixed", "free")
 
 
@@ -34,8 +33,6 @@ class Numerics:
         Inertia on (True) or quasi-static load stepping (False).
     outer : {"fixed", "free"}
         Outer boundary condition.
-    assembly : {"fast", "forms"}
-        Vectorised assembly or the scikit-fem forms re-assembled every iteration.
     dilatancy_deg : float
         Dilatancy angle (degrees), in [0, 45); 0 is volume-preserving plastic flow.
     tension_cutoff : float or None
@@ -61,7 +58,6 @@ class Numerics:
     rho_inf: float = 0.0
     dynamic: bool = True
     outer: str = "fixed"
-    assembly: str = "fast"
     dilatancy_deg: float = 0.0
     tension_cutoff: float | None = None
     newton_tol: float = 1e-8
@@ -97,7 +93,6 @@ def check_numerics(n):
     require(_finite(n.rho_inf) and 0 <= n.rho_inf <= 1, "rho_inf", "in [0, 1]", n.rho_inf)
     require(isinstance(n.dynamic, bool), "dynamic", "True or False", n.dynamic)
     require_choice(n.outer, OUTER_BOUNDARIES, "outer")
-    require_choice(n.assembly, ASSEMBLIES, "assembly")
     require(_finite(n.dilatancy_deg) and 0 <= n.dilatancy_deg < 45, "dilatancy_deg",
             "in [0, 45)", n.dilatancy_deg)
     require(n.tension_cutoff is None or (_finite(n.tension_cutoff) and n.tension_cutoff > 0),

@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+
+from cavex.errors import CavexInputError
 from cavex.verification.batch import (
     batch_main,
     load_sweep,
@@ -19,9 +21,7 @@ from cavex.verification.batch import (
     run_sweep,
     sweep_cases,
 )
-from cavex.verification.cases import fe_case
-
-from cavex.errors import CavexInputError
+from cavex.verification.cases import fe_cases
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sweep.toml"
 
@@ -73,7 +73,7 @@ def test_example_sweep_is_one_dataset(example):
     case = next(c for c in sweep_cases(parse_sweep(EXAMPLE))
                 if c["id"] == str(ds.case_id.sel(velocity=800.0, depth=0.8, nu=0.4999,
                                                  concrete_E=20e9, elements_per_decade=20).item()))
-    alone = fe_case(case)
+    alone, = fe_cases([case])
     cell = ds.sel(velocity=800.0, depth=0.8, nu=0.4999, concrete_E=20e9, elements_per_decade=20)
     assert float(cell.fe_sigma_r) == alone["fe_sigma_r"]
     assert case["target"][2] == {"name": "soil", "E": 0.12e9, "nu": 0.4999, "rho": 1600.0,

@@ -22,9 +22,9 @@ import math
 
 import numpy as np
 import pytest
-from cavex.analytic.cavity import cavity_solution, cavity_stress, plastic_radius
 from scipy.integrate import solve_ivp
 
+from cavex.analytic.cavity import cavity_solution, cavity_stress, plastic_radius
 from cavex.errors import CavexInputError
 from cavex.materials import Material
 

@@ -12,12 +12,12 @@ import sys
 from pathlib import Path
 
 import pytest
+
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.paper_model import paper_coefficients
 from cavex.analytic.penetration import penetrate
 from cavex.analytic.resistance import ClosedFormResistance
-
 from cavex.cli import main
 from cavex.config import default_config_text, load_config
 

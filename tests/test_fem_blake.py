@@ -47,10 +47,10 @@ import functools
 
 import numpy as np
 import pytest
-from cavex.fem.discretisation import Discretisation
-from cavex.fem.solver import RadialSolver
 from skfem import MeshLine
 
+from cavex.fem.discretisation import Discretisation
+from cavex.fem.solver import RadialSolver
 from cavex.materials import Material
 
 A, G, RHO, NU = 1.0, 1.0, 1.0, 0.25       # units: a, G, c_s = 1

@@ -10,10 +10,10 @@ the small-strain closed form only where E/tau is small (soil: up to 7 %).
 
 import numpy as np
 import pytest
+
 from cavex.analytic.cavity import cavity_stress
 from cavex.fem import expand_cavity
-from cavex.fem.finite_strain import finite_strain_cavity_stress
-
+from cavex.verification.finite_strain import finite_strain_cavity_stress
 from cavex.materials import Material
 
 RADIUS = 0.0125

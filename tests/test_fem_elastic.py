@@ -2,10 +2,10 @@
 
 import numpy as np
 import pytest
-from cavex.fem.discretisation import Discretisation, gauss_rule
-from cavex.fem.solver import RadialSolver
 from skfem import Basis, MeshLine
 
+from cavex.fem.discretisation import Discretisation, gauss_rule
+from cavex.fem.solver import RadialSolver
 from cavex.materials import Material
 
 A, B, E, P = 1.0, 2.0, 1.0, 1e-9  # tiny load: finite-strain effects ~1e-9, far below the errors
@@ -17,16 +17,14 @@ def lame_displacement(r, nu):
     return k * (1 - 2 * nu) / E * r + k * B ** 3 * (1 + nu) / (2 * E) / r ** 2
 
 
-def lame_error(n_elements, degree, nu, stiffness_points=None, assembly="fast",
-               control="displacement"):
+def lame_error(n_elements, degree, nu, stiffness_points=None, control="displacement"):
     """Relative L2 displacement error and wall-pressure error of a run driven by the exact wall
     displacement (or, with ``control="pressure"``, by the pressure ``P``)."""
     material = Material(E=E, nu=nu, rho=1.0, lam=0.0, tau=1e30)
     mesh = MeshLine(np.linspace(A, B, n_elements + 1))
     disc = Discretisation(mesh, degree, np.zeros(n_elements, int), [material],
                           stiffness_points=stiffness_points)
-    solver = RadialSolver(disc, dynamic=False, outer="free", assembly=assembly,
-                          wall_control=control)
+    solver = RadialSolver(disc, dynamic=False, outer="free", wall_control=control)
     solver.advance(lame_displacement(A, nu) if control == "displacement" else P, 1.0)
     fine = Basis(mesh, disc.basis.elem, quadrature=gauss_rule(6))
     u_h = np.asarray(fine.interpolate(disc.to_skfem(solver.u)))
@@ -69,8 +67,3 @@ def test_full_integration_locks_as_the_demonstration():
     assert locked > 0.5 and reduced < 0.01
     assert lame_error(4, 2, 0.4999, stiffness_points=3)[1] > 0.3
 
-
-def test_forms_path_equals_fast_path():
-    fast = np.array(lame_error(8, 2, 0.4999)) + 1.0
-    forms = np.array(lame_error(8, 2, 0.4999, assembly="forms")) + 1.0
-    assert np.allclose(fast, forms, rtol=1e-9, atol=0)

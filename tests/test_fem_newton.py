@@ -1,4 +1,4 @@
-"""The line-searched last attempt of a failing step (cavex.fem.solver.line_search_newton).
+"""The line-searched last attempt of a failing step (cavex.fem.newton.line_search_newton).
 
 Quasi-static soil (Table 1, E/tau = 20) at half the default resolution used to fail: a point at
 the Mohr-Coulomb apex whose solution lies on the cone's face just next to the apex made plain
@@ -7,12 +7,11 @@ Newton alternate between an elastic and an apex state (docs/fem.md, "Newton at t
 
 import numpy as np
 import pytest
-from cavex.fem import batch, expand_cavity, solver
-from cavex.fem.batch import expand_cavities
-from cavex.fem.expansion import richardson_error, richardson_error_from_finer
-from cavex.fem.solver import StepFailure, line_search_newton
 
 from cavex import load_config
+from cavex.fem import expand_cavities, expand_cavity, newton
+from cavex.fem.estimate import richardson_error, richardson_error_from_finer
+from cavex.fem.newton import StepFailure, line_search_newton
 
 SOIL = load_config()[0].layers[2]
 ARGS = ([SOIL], [], 0.0, 0.0125)
@@ -21,15 +20,14 @@ HALF = {"elements_per_decade": 15.0, "growth_per_step": 0.06, "error_estimate": 
 
 @pytest.fixture
 def line_searches(monkeypatch):
-    """Counts the calls of the line-searched Newton iteration (one-case and batched path)."""
+    """Counts the calls of the line-searched Newton iteration."""
     calls = []
 
     def counted(*args, **kwargs):
         calls.append(1)
         return line_search_newton(*args, **kwargs)
 
-    monkeypatch.setattr(solver, "line_search_newton", counted)
-    monkeypatch.setattr(batch, "line_search_newton", counted)
+    monkeypatch.setattr(newton, "line_search_newton", counted)
     return calls
 
 
@@ -92,12 +90,17 @@ def test_error_estimate_uses_the_coarse_companion_again():
     assert result.error_estimate == pytest.approx(3.59e-4, rel=0.01)  # measured 3.591e-4
 
 
-def test_batched_path_rescues_the_same_step_bit_for_bit(line_searches):
-    b, = expand_cavities([ARGS], **HALF)
-    assert len(line_searches) == 1
-    one = expand_cavity(*ARGS, **HALF)
+def test_the_rescue_is_the_same_inside_a_stack(line_searches):
+    # the same case alone and inside a stack with two others: one line search each, the same
+    # bits (the same code on the same data)
+    alone = expand_cavity(*ARGS, **HALF)
+    assert len(line_searches) == 1 and alone.stats["line_search_steps"] == 1
+    concrete = load_config()[0].layers[0]
+    stacked = expand_cavities([([concrete], [], 0.0, 0.0125), ARGS, ([concrete], [], 0.0, 0.02)],
+                              **HALF)
     assert len(line_searches) == 2
-    assert b.ok and b.cavity_stress == one.cavity_stress
-    assert np.array_equal(b.u, one.fields["u"])
-    assert b.stats["newton_iterations"] == one.stats["newton_iterations"]
-    assert b.stats["cutbacks"] == one.stats["cutbacks"]
+    b = stacked[1]
+    assert b.ok and b.cavity_stress == alone.cavity_stress
+    assert np.array_equal(b.u, alone.u)
+    assert b.stats["newton_iterations"] == alone.stats["newton_iterations"]
+    assert b.stats["cutbacks"] == alone.stats["cutbacks"]

@@ -2,12 +2,12 @@
 
 import numpy as np
 import pytest
+from skfem import MeshLine
+
 from cavex.fem import expand_cavity
 from cavex.fem.discretisation import Discretisation
 from cavex.fem.fields import plastic_radius, wall_stress
 from cavex.fem.solver import RadialSolver
-from skfem import MeshLine
-
 from cavex.materials import Material
 
 A, B, Y = 1.0, 3.0, 1e-6  # Y/E = 1e-6: small strain, as Hill's solution assumes

@@ -16,11 +16,11 @@ import math
 
 import numpy as np
 import pytest
+from scipy.integrate import quad
+
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.nose import QUADRATURE_POINTS, nose_force, nose_rule, ogive_coefficients
-from scipy.integrate import quad
-
 from cavex.materials import Material, Projectile, Target
 
 # Round-off level of a sum of 8 positive terms of size ~F (a few ulps): 1e-13 is ~500 ulps,

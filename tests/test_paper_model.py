@@ -9,6 +9,7 @@ of Eq. 29) are recomputed here from the derived solution, not copied from the im
 import math
 
 import pytest
+
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.paper_model import (
@@ -17,7 +18,6 @@ from cavex.analytic.paper_model import (
     paper_single_coefficients,
     paper_stress,
 )
-
 from cavex.config import load_config
 from cavex.errors import CavexInputError
 from cavex.materials import Material, Projectile, Target

@@ -17,6 +17,9 @@ import math
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
+from scipy.interpolate import BPoly
+
 from cavex.analytic.paper_model import paper_coefficients, paper_phase_depths
 from cavex.analytic.penetration import (
     crater_depth,
@@ -25,9 +28,6 @@ from cavex.analytic.penetration import (
     penetrate,
 )
 from cavex.analytic.resistance import ClosedFormResistance
-from scipy.integrate import solve_ivp
-from scipy.interpolate import BPoly
-
 from cavex.config import load_config
 from cavex.materials import Material, Projectile
 

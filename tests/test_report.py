@@ -6,11 +6,11 @@ import re
 import numpy as np
 import pytest
 import xarray as xr
+
+from cavex.config import default_config_text, load_config
 from cavex.verification import report, report_picture
 from cavex.verification import table as table_module
 from cavex.verification.report_analysis import TOLERANCES
-
-from cavex.config import default_config_text, load_config
 
 PNG = b"\x89PNG\r\n\x1a\n"
 PERCENT = re.compile(r"^([+-]\d+\.\d{3}) %$")
@@ -221,17 +221,18 @@ def test_validity_matches_recomputed_errors(quick_report):
 
 
 def test_failed_cell_and_renderer_failure(tmp_path, monkeypatch, capsys):
-    from cavex.verification.cases import fe_case
+    from cavex.verification.cases import fe_cases
 
-    def failing(case):
-        if case["velocity"] == 1000.0 and case["depth"] == 0.5:
-            raise RuntimeError("injected failure")
-        return fe_case(case)
+    def failing(chunk):
+        out = fe_cases(chunk)
+        return [RuntimeError("injected failure")
+                if case["velocity"] == 1000.0 and case["depth"] == 0.5 else result
+                for case, result in zip(chunk, out, strict=True)]
 
     def no_opengl(*args, **kwargs):
         raise RuntimeError("no OpenGL context\nsecond line")
 
-    monkeypatch.setattr(table_module, "fe_case", failing)  # workers=1: runs in this process
+    monkeypatch.setattr(table_module, "fe_cases", failing)  # workers=1: runs in this process
     monkeypatch.setattr(report_picture, "render_sphere", no_opengl)
     target, projectile = load_config()
     summary = report.verify(target, projectile, out_dir=tmp_path, workers=1,

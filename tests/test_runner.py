@@ -1,6 +1,6 @@
 """The case runner: identical results serially, on a process pool and on Dask; failures; resume.
 
-``probe_case`` (cheap, deterministic, can fail or leave a marker file per computation) checks the
+``probe_cases`` (cheap, deterministic, can fail or leave a marker file per computation) checks the
 machinery; three coarse FE cases check that real FE results are bit-for-bit the same everywhere.
 """
 
@@ -15,10 +15,10 @@ import textwrap
 import time
 
 import pytest
-from cavex.verification.cases import config_tables, fe_case, make_fe_cases, probe_case
-from cavex.verification.runner import read_store, run_cases, write_case
 
 from cavex.errors import CavexInputError
+from cavex.verification.cases import config_tables, fe_cases, make_fe_cases, probe_cases
+from cavex.verification.runner import read_store, run_cases, write_case
 
 COARSE = {"elements_per_decade": 8, "growth_per_step": 0.15, "seed_ratio": 5,
           "error_estimate": False, "snapshots": 1}
@@ -36,7 +36,7 @@ def probes(n, **extra):
     return [{"id": f"p{i:03d}", "x": 0.37 * i - 1.1, **extra} for i in range(n)]
 
 
-def fe_cases():
+def grid_cases():
     layers, projectile = config_tables()
     return make_fe_cases(layers, projectile, [300.0, 800.0], [0.3, 0.9],
                          numerics=COARSE)[:3]
@@ -49,9 +49,9 @@ def without_seconds(results):
 
 def test_probe_results_identical_serial_pool_and_dask(cluster):
     cases = probes(20) + [{"id": "boom", "x": 1.0, "fail": "Newton failed"}]
-    serial = run_cases(probe_case, cases, workers=1)
-    pool = run_cases(probe_case, cases, workers=2)
-    dask = run_cases(probe_case, cases, scheduler=cluster.scheduler_address)
+    serial = run_cases(probe_cases, cases, workers=1)
+    pool = run_cases(probe_cases, cases, workers=2)
+    dask = run_cases(probe_cases, cases, scheduler=cluster.scheduler_address)
     assert serial == pool == dask
     assert [r["id"] for r in dask] == [c["id"] for c in cases]
     x = 0.37 * 7 - 1.1
@@ -65,13 +65,13 @@ def test_probe_results_identical_serial_pool_and_dask(cluster):
 def test_fe_results_bitwise_identical_serial_pool_and_dask(cluster):
     from dask.distributed import Client
 
-    cases = fe_cases()
+    cases = grid_cases()
     assert [c["id"] for c in cases] == ["v0300.000_L0.30000", "v0300.000_L0.90000",
                                         "v0800.000_L0.30000"]
-    serial = without_seconds(run_cases(fe_case, cases, workers=1))
-    pool = without_seconds(run_cases(fe_case, cases, workers=2))
+    serial = without_seconds(run_cases(fe_cases, cases, workers=1))
+    pool = without_seconds(run_cases(fe_cases, cases, workers=2))
     with Client(cluster) as client:
-        dask = without_seconds(run_cases(fe_case, cases, scheduler=client))
+        dask = without_seconds(run_cases(fe_cases, cases, scheduler=client))
     assert serial == pool == dask
     hexes = [[r["fe_sigma_r"].hex(), r["S"].hex()] for r in serial]
     assert hexes == [[r["fe_sigma_r"].hex(), r["S"].hex()] for r in dask]
@@ -85,11 +85,11 @@ def test_fe_results_bitwise_identical_serial_pool_and_dask(cluster):
 
 def test_failing_case_is_recorded_and_the_others_finish():
     cases = probes(3) + [{"id": "bad", "x": 2.0, "fail": "singular tangent\nsecond line"}]
-    bad_fe = {**fe_cases()[0], "id": "fe_bad", "depth": -1.0}
-    results = run_cases(probe_case, cases, workers=2)
+    bad_fe = {**grid_cases()[0], "id": "fe_bad", "depth": -1.0}
+    results = run_cases(probe_cases, cases, workers=2)
     assert [r["status"] for r in results] == ["ok", "ok", "ok", "failed"]
     assert results[3]["reason"] == "CavexNumericalError: singular tangent"
-    broken = run_cases(fe_case, [bad_fe, fe_cases()[0]], workers=1)
+    broken = run_cases(fe_cases, [bad_fe, grid_cases()[0]], workers=1)
     assert broken[0]["status"] == "failed"
     assert re.fullmatch(r"CavexInputError: parameter 'depth' must be .*>= 0 \(got -1\.0\)",
                         broken[0]["reason"])
@@ -100,13 +100,13 @@ def test_store_resume_computes_only_missing_cases(tmp_path):
     store, markers = tmp_path / "store", tmp_path / "markers"
     markers.mkdir()
     cases = probes(10, marker_dir=str(markers), sleep=0.15)
-    reference = run_cases(probe_case, probes(10), workers=1)
-    run_cases(probe_case, cases[:2], store=store, workers=1)  # a subset first
+    reference = run_cases(probe_cases, probes(10), workers=1)
+    run_cases(probe_cases, cases[:2], store=store, workers=1)  # a subset first
     script = textwrap.dedent(f"""
         import json
-        from cavex.verification.cases import probe_case
+        from cavex.verification.cases import probe_cases
         from cavex.verification.runner import run_cases
-        run_cases(probe_case, json.loads({json.dumps(json.dumps(cases))}),
+        run_cases(probe_cases, json.loads({json.dumps(json.dumps(cases))}),
                   store={str(store)!r}, workers=1)
     """)
     # -P: import the installed package, not the checkout's cavex/ folder
@@ -119,14 +119,14 @@ def test_store_resume_computes_only_missing_cases(tmp_path):
     stored = set(read_store(store))
     assert 5 <= len(stored) < 10
     before = set(os.listdir(markers))
-    results = run_cases(probe_case, cases, store=store, workers=2)
+    results = run_cases(probe_cases, cases, store=store, workers=2)
     recomputed = {name.split(".")[0] for name in set(os.listdir(markers)) - before}
     assert recomputed == {c["id"] for c in cases} - stored
     assert len(set(os.listdir(markers)) - before) == len(recomputed)  # each once
     assert results == reference
     assert not [n for n in os.listdir(store) if n.endswith(".tmp")]
     before = set(os.listdir(markers))
-    assert run_cases(probe_case, cases, store=store, workers=1) == reference
+    assert run_cases(probe_cases, cases, store=store, workers=1) == reference
     assert set(os.listdir(markers)) == before  # all stored: nothing recomputed
 
 
@@ -147,8 +147,8 @@ def test_partial_files_are_never_read(tmp_path):
     (store / "p000.json.tmp").write_text('{"case": {"id": "p000"}, "result": {"val')
     (store / "p001.json").write_text('{"case": {"id": "p001", "x": -0.73}, "res')
     write_case(store, cases[2], {"id": "p002", "status": "ok", "value": 0.1})
-    results = run_cases(probe_case, cases, store=store, workers=1)
-    assert results[:2] == run_cases(probe_case, cases[:2], workers=1)
+    results = run_cases(probe_cases, cases, store=store, workers=1)
+    assert results[:2] == run_cases(probe_cases, cases[:2], workers=1)
     assert results[2] == {"id": "p002", "status": "ok", "value": 0.1}  # loaded, not recomputed
     assert sorted(os.listdir(store)) == ["p000.json", "p001.json", "p002.json"]
     entry = json.loads((store / "p001.json").read_text())
@@ -156,10 +156,10 @@ def test_partial_files_are_never_read(tmp_path):
 
 
 def test_store_with_a_different_case_under_the_same_id_is_an_error(tmp_path):
-    run_cases(probe_case, probes(2), store=tmp_path, workers=1)
+    run_cases(probe_cases, probes(2), store=tmp_path, workers=1)
     changed = [{"id": "p000", "x": 5.0}]
     with pytest.raises(CavexInputError, match="different case under id 'p000'"):
-        run_cases(probe_case, changed, store=tmp_path, workers=1)
+        run_cases(probe_cases, changed, store=tmp_path, workers=1)
 
 
 @pytest.mark.parametrize("cases, message", [
@@ -170,18 +170,18 @@ def test_store_with_a_different_case_under_the_same_id_is_an_error(tmp_path):
 ])
 def test_bad_cases_are_input_errors(cases, message):
     with pytest.raises(CavexInputError, match=message):
-        run_cases(probe_case, cases, workers=1)
+        run_cases(probe_cases, cases, workers=1)
 
 
 def test_bad_workers_is_an_input_error():
     with pytest.raises(CavexInputError, match="parameter 'workers' must be an integer >= 1"):
-        run_cases(probe_case, probes(1), workers=0)
+        run_cases(probe_cases, probes(1), workers=0)
 
 
 def test_progress_bar_on_request_only(capsys):
-    run_cases(probe_case, probes(3), workers=1, progress=True)
+    run_cases(probe_cases, probes(3), workers=1, progress=True)
     assert "3/3 100%" in capsys.readouterr().err
-    run_cases(probe_case, probes(3), workers=1)
+    run_cases(probe_cases, probes(3), workers=1)
     assert capsys.readouterr().err == ""  # stderr is not a terminal under pytest
 
 
@@ -202,4 +202,4 @@ def test_fe_case_ids_are_stable_and_unique():
 
 def test_bad_scheduler_address_is_an_input_error():
     with pytest.raises(CavexInputError, match="parameter 'scheduler' must be a reachable Dask"):
-        run_cases(probe_case, probes(1), scheduler="nonsense://nowhere")
+        run_cases(probe_cases, probes(1), scheduler="nonsense://nowhere")

@@ -13,11 +13,16 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import xarray as xr
+from scipy.interpolate import PchipInterpolator
+
 from cavex.analytic.cavity import cavity_solution, cavity_stress
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.penetration import penetrate
 from cavex.analytic.resistance import ClosedFormResistance
-from cavex.verification.cases import fe_case
+from cavex.config import load_config, parse_config
+from cavex.errors import CavexInputError
+from cavex.materials import Target
+from cavex.verification.cases import fe_cases
 from cavex.verification.runner import read_store, run_cases
 from cavex.verification.table import (
     DEFAULT_DEPTHS,
@@ -35,11 +40,6 @@ from cavex.verification.tabulated_resistance import (
     pchip,
     trajectory_summary,
 )
-from scipy.interpolate import PchipInterpolator
-
-from cavex.config import load_config, parse_config
-from cavex.errors import CavexInputError
-from cavex.materials import Target
 
 COARSE = {"elements_per_decade": 10, "growth_per_step": 0.1, "outer_ratio": 200,
           "seed_ratio": 5}
@@ -244,7 +244,7 @@ def test_fe_interpolation_error_against_extra_fe_points(runway):
     points += [(600.0, L) for L in (0.15, 0.25, 0.35, 0.45, 0.55)]
     cases = [c for v, L in points for c in table_cases(target, projectile, [v], [L], None,
                                                        COARSE)]
-    results = run_cases(fe_case, cases, workers=2, progress=False)
+    results = run_cases(fe_cases, cases, workers=2, progress=False)
     assert all(r["status"] == "ok" for r in results)
     fe_resistance = TabulatedResistance(table, target, projectile)
     dynamic = TabulatedResistance(analytic_table(target, projectile, velocities, depths,

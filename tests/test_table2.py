@@ -5,8 +5,10 @@ values (``PAPER_TABLE2``) are typed in, as reference values.
 """
 
 import pytest
+
 from cavex.analytic.paper_model import layer_epsilon
 from cavex.analytic.penetration import crater_depth
+from cavex.config import load_config
 from cavex.verification.table2 import PAPER_TABLE2, table2_rows
 from cavex.verification.table2_study import (
     ADMISSIBLE,
@@ -21,8 +23,6 @@ from cavex.verification.table2_study import (
     table2_study,
     within_print,
 )
-
-from cavex.config import load_config
 
 CYLINDRICAL = Reading("C")  # eps^2 = 3 tau/(2E), Lc from the nose base, paper's choices
 CYLINDRICAL_SC = Reading("Cs", epsilon="cylindrical-sigma_c")

@@ -18,13 +18,13 @@ import tomllib
 from dataclasses import dataclass, field
 
 import numpy as np
-from cavex.fem.settings import make_numerics
-from cavex.verification.cases import config_tables, fe_case, fe_case_id, numerics_names
-from cavex.verification.runner import read_store, run_cases, write_text_atomic
-from cavex.verification.table import write_table
 
 from cavex.config import parse_projectile, parse_target
 from cavex.errors import CavexInputError, check_keys, is_finite_number, prefixed, require
+from cavex.fem.settings import make_numerics
+from cavex.verification.cases import config_tables, fe_case_id, fe_cases, numerics_names
+from cavex.verification.runner import read_store, run_cases, write_text_atomic
+from cavex.verification.table import write_table
 
 SECTIONS = ("sweep", "target", "grid", "numerics", "materials")
 SWEEP_KEYS = ("name", "scheduler", "workers")
@@ -36,7 +36,7 @@ PROPERTY_UNITS = {"thickness": "m", "E": "Pa", "nu": "1", "rho": "kg m-3", "lam"
 NUMERICS_UNITS = {"seed_radius": "m", "tension_cutoff": "Pa", "dilatancy_deg": "degree"}
 SWEEP_FILE, STORE_DIR, RESULTS_FILE = "sweep.json", "cases", "results.nc"
 
-VARIABLES = {  # name: (path in the fe_case result, units, long name)
+VARIABLES = {  # name: (path in the fe_cases result, units, long name)
     "fe_sigma_r": (("fe_sigma_r",), "Pa", "FE radial stress at the cavity wall"),
     "S": (("S",), "1", "FE wall stress over the wall layer's tau"),
     "error_estimate": (("error_estimate",), "1",
@@ -374,7 +374,7 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
     os.makedirs(out_dir, exist_ok=True)
     description = _description(sweep, cases)
     write_text_atomic(os.path.join(out_dir, SWEEP_FILE), json.dumps(description, indent=1))
-    results = run_cases(fe_case, cases, store=os.path.join(out_dir, STORE_DIR),
+    results = run_cases(fe_cases, cases, store=os.path.join(out_dir, STORE_DIR),
                         scheduler=scheduler if scheduler is not None else sweep.scheduler,
                         workers=workers if workers is not None else sweep.workers,
                         progress=progress)

@@ -5,45 +5,74 @@ An FE case is a plain dict::
     {"id": "v0500.000_L0.30000", "velocity": 500.0, "depth": 0.3,
      "nu": 0.4999,                        # optional: Poisson's ratio for every layer
      "numerics": {"elements_per_decade": 10},   # optional: cavex.fem.Numerics settings
+     "error_target": 0.005,               # optional: refine above it (null: never)
      "target": [{"name": "concrete", "thickness": 0.65, "E": 25e9, ...}, ...],
      "projectile": {"r": 0.0125, "l": 0.06, "R": 0.075, "m": 0.505, "V0": 1000.0}}
 
 ``target`` is the list of ``[[layers]]`` tables and ``projectile`` the ``[projectile]`` table of
-the config TOML schema (``cavex/data/runway.toml``), so a case carries everything it needs.
+the config TOML schema (``core/data/runway.toml``), so a case carries everything it needs.
+FE cases are run in chunks (:func:`fe_cases`, the work unit of
+:func:`cavex.verification.runner.run_cases` for processes and Dask): the cases of a chunk that
+share their numerics run together on the one FE solver.
 """
 
+import json
 import math
 import os
 import time
 import uuid
 from dataclasses import fields
 
-from cavex.fem.settings import Numerics, make_numerics
-
 from cavex.config import load_config, parse_projectile, parse_target
 from cavex.errors import CavexInputError, CavexNumericalError, require
 from cavex.errors import is_finite_number as _finite
+from cavex.fem.estimate import DEFAULT_ERROR_TARGET
+from cavex.fem.settings import Numerics, make_numerics
 
-CASE_KEYS = {"id", "velocity", "depth", "nu", "numerics", "target", "projectile"}
+CASE_KEYS = {"id", "velocity", "depth", "nu", "numerics", "error_target", "target",
+             "projectile"}
 
 
-def fe_case(case):
-    """Run one FE case: :func:`cavex.fem.compare_at_depth`'s dict plus ``"id"``.
+def fe_cases(chunk):
+    """Run a chunk of FE cases: per case :func:`~cavex.verification.fe_comparison.
+    compare_at_depth`'s dict plus ``"id"``, or the exception the case failed with.
+
+    The cases that share their numerics and error target run together
+    (:func:`~cavex.verification.fe_comparison.compare_many`: stacks of the one FE solver); a
+    case computes the same bits in any chunk.
 
     Parameters
     ----------
-    case : dict
-        Keys ``id``, ``velocity`` (m/s), ``depth`` (nose-tip depth, m), optional ``nu``,
-        optional ``numerics`` (dict of :class:`cavex.fem.Numerics` settings), ``target`` (list
-        of layer tables, or ``{"layers": [...]}``) and ``projectile`` (table).
-
-    Returns
-    -------
-    dict
-        The JSON-able comparison (``fe_sigma_r``, ``S``, ``analytic_sigma_r``, ...).
+    chunk : list of dict
+        Cases with keys ``id``, ``velocity`` (m/s), ``depth`` (nose-tip depth, m), optional
+        ``nu``, optional ``numerics`` (dict of :class:`cavex.fem.Numerics` settings), optional
+        ``error_target`` (default :data:`cavex.fem.estimate.DEFAULT_ERROR_TARGET`; None: no
+        refinement), ``target`` (list of layer tables, or ``{"layers": [...]}``) and
+        ``projectile`` (table).
     """
-    from cavex.fem import compare_at_depth
+    from cavex.verification.fe_comparison import compare_many
 
+    out = [None] * len(chunk)
+    groups = {}
+    for i, case in enumerate(chunk):
+        try:
+            request, numerics, target = _fe_request(case)
+        except (CavexInputError, KeyError, TypeError, ValueError) as exc:
+            out[i] = exc
+            continue
+        key = json.dumps([numerics, target], sort_keys=True)
+        groups.setdefault(key, (numerics, target, []))[2].append((i, request))
+    for numerics, target, members in groups.values():
+        results = compare_many([request for _, request in members], error_target=target,
+                               **numerics)
+        for (i, _), result in zip(members, results, strict=True):
+            out[i] = result if isinstance(result, Exception) else {**result,
+                                                                  "id": chunk[i]["id"]}
+    return out
+
+
+def _fe_request(case):
+    """``((target, projectile, depth, velocity, nu), numerics, error_target)`` of a case."""
     unknown = sorted(set(case) - CASE_KEYS)
     if unknown:
         raise CavexInputError(f"unknown key '{unknown[0]}' in case "
@@ -51,12 +80,15 @@ def fe_case(case):
     target = parse_target(_layers(case["target"]))
     projectile = parse_projectile(case["projectile"])
     numerics = make_numerics(**case.get("numerics", {})).as_dict()
-    result = compare_at_depth(target, projectile, case["depth"], case["velocity"],
-                              nu=case.get("nu"), **numerics)
-    return {**result, "id": case["id"]}
+    error_target = case.get("error_target", DEFAULT_ERROR_TARGET)
+    require(error_target is None or (_finite(error_target) and 0 < error_target < 1),
+            "error_target", "null or a number in (0, 1)", error_target)
+    return ((target, projectile, case["depth"], case["velocity"], case.get("nu")), numerics,
+            None if error_target is None else float(error_target))
 
 
-def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, numerics=None):
+def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, numerics=None,
+                  error_target=DEFAULT_ERROR_TARGET):
     """FE cases on the grid ``velocities x depths`` (velocity outermost), with stable ids.
 
     Parameters
@@ -72,6 +104,8 @@ def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, n
         Poisson's ratio for every layer (default: each layer's own).
     numerics : dict, optional
         :class:`cavex.fem.Numerics` settings shared by all cases.
+    error_target : float or None
+        Refine an FE case while its error estimate exceeds this (None: never).
 
     Returns
     -------
@@ -105,6 +139,8 @@ def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, n
                 case["nu"] = float(nu)
             if numerics:
                 case["numerics"] = dict(numerics)
+            if error_target != DEFAULT_ERROR_TARGET:
+                case["error_target"] = error_target
             cases.append({**case, "target": layers, "projectile": projectile})
     check_unique_ids(cases)
     return cases
@@ -153,6 +189,17 @@ def projectile_table(projectile):
 def numerics_names():
     """Names of the :class:`cavex.fem.Numerics` settings."""
     return [f.name for f in fields(Numerics)]
+
+
+def probe_cases(chunk):
+    """:func:`probe_case` on every case of a chunk (the exception in place of a failed one)."""
+    out = []
+    for case in chunk:
+        try:
+            out.append(probe_case(case))
+        except CavexNumericalError as exc:
+            out.append(exc)
+    return out
 
 
 def probe_case(case):

@@ -12,13 +12,14 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+from cavex.errors import CavexInputError
+from cavex.fem.estimate import DEFAULT_ERROR_TARGET
 from cavex.verification import report_plots as plots
 from cavex.verification import report_text as text
 from cavex.verification.report_analysis import all_stats, analyse, layer_names
 from cavex.verification.report_html import markdown_to_html
 from cavex.verification.table import build_table, write_table
-
-from cavex.errors import CavexInputError
 
 DEFAULT_VELOCITIES = (0.0, 50.0, 100.0, 200.0, 300.0, 400.0, 500.0, 600.0, 800.0, 1000.0,
                       1200.0)
@@ -98,7 +99,7 @@ def write_grid(grid, path, extra):
 
 def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=None,
            config_text=None, velocities=None, depths=None, nu=None, numerics=None,
-           store=None, progress=None):
+           error_target=DEFAULT_ERROR_TARGET, store=None, progress=None):
     """Write the verification report of ``target`` into ``out_dir``; return its summary.
 
     Parameters
@@ -106,8 +107,8 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     target, projectile : Target, Projectile
     quick : bool
         A small grid (3 velocities x 3 depths, plus the table's switch depths) at half the FE
-        resolution, instead of the default (11 velocities 0-1200 m/s x 36 depths, plus the
-        switch depths).
+        resolution and without refinement, instead of the default (11 velocities 0-1200 m/s x
+        36 depths, plus the switch depths).
     out_dir : str or path
         Output folder (created).
     scheduler, workers
@@ -120,6 +121,9 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
         Poisson's ratio for every layer in the FE (default: each layer's own).
     numerics : dict, optional
         :class:`cavex.fem.Numerics` settings.
+    error_target : float or None
+        Refine the FE cells estimated above it (see :func:`build_table`); the quick report
+        does not refine.
     store : str or path, optional
         Case store of the runner (resumable); default: none (nothing kept on disk).
     progress : bool, optional
@@ -136,9 +140,10 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     out.mkdir(parents=True, exist_ok=True)
     v, d = grid_axes(quick, velocities, depths)
     if numerics is None and quick:
-        numerics = dict(QUICK_NUMERICS)
-    fe = build_table(target, projectile, v, d, nu=nu, numerics=numerics, scheduler=scheduler,
-                     workers=workers, store=store, progress=progress)
+        numerics, error_target = dict(QUICK_NUMERICS), None
+    fe = build_table(target, projectile, v, d, nu=nu, numerics=numerics,
+                     error_target=error_target, scheduler=scheduler, workers=workers,
+                     store=store, progress=progress)
     table_seconds = time.perf_counter() - started
     grid = analyse(fe, target, projectile)
     trajectory = trajectories(target, projectile, fe)

@@ -13,10 +13,10 @@ import math
 
 import numpy as np
 import xarray as xr
+
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.paper_model import paper_stress
-
 from cavex.errors import CavexInputError
 
 # (key, label, sigma_r variable) of each closed form, in report order.

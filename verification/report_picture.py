@@ -7,6 +7,7 @@ it; the plastic zone is also shown as a translucent red shell.
 """
 
 import numpy as np
+
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
 from cavex.fem.expansion import expand_cavity

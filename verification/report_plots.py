@@ -5,8 +5,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from cavex.verification.report_analysis import MODELS, TOLERANCES, layer_names  # noqa: E402
 from matplotlib.colors import BoundaryNorm, ListedColormap, TwoSlopeNorm  # noqa: E402
+
+from cavex.verification.report_analysis import MODELS, TOLERANCES, layer_names  # noqa: E402
 
 VALIDITY_COLOURS = ("#1a9850", "#fee08b", "#d73027", "#7f7f7f")  # 1 %, 5 %, beyond, failed
 

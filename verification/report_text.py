@@ -8,6 +8,7 @@ import json
 import math
 
 import numpy as np
+
 from cavex.verification.report_analysis import (
     ERROR_PARTS,
     MODELS,

@@ -1,9 +1,13 @@
 """Run many independent cases locally or on a Dask cluster, with a resumable on-disk store.
 
 One function does the work, :func:`run_cases`. A *case* is a JSON-able dict with a unique string
-``"id"``; the *function* is a picklable top-level callable ``case -> dict``. Every result is
-passed through JSON inside the worker, so a result read back from the store is bit-for-bit the
-one computed (floats are written with ``repr``, which round-trips exactly).
+``"id"``; the *function* is a picklable top-level callable that takes a *chunk* (a list of
+cases) and returns one entry per case: a JSON-able dict, or the exception that case failed
+with. The work unit sent to a process or a Dask worker is a chunk, so a function can treat its
+cases together (the FE cases run as stacks of one solver, :func:`cavex.verification.cases.
+fe_cases`). Every result is passed through JSON inside the worker, so a result read back from
+the store is bit-for-bit the one computed (floats are written with ``repr``, which round-trips
+exactly).
 """
 
 import json
@@ -22,13 +26,18 @@ TMP_SUFFIX = ".json.tmp"
 _BAD_ID_CHARS = set('/\\\0:*?"<>|')
 
 
-def run_cases(function, cases, *, store=None, scheduler=None, workers=None, progress=None):
+MAX_CHUNK = 200  # cases per work unit (the FE solver's stack size)
+
+
+def run_cases(function, cases, *, store=None, scheduler=None, workers=None, progress=None,
+              chunk_size=None):
     """Run ``function`` on every case and return the results in the order of ``cases``.
 
     Parameters
     ----------
     function : callable
-        Picklable top-level callable ``case(dict) -> dict`` (a JSON-able result).
+        Picklable top-level callable ``chunk(list of dict) -> list`` with, per case, a
+        JSON-able dict or the exception the case failed with.
     cases : list of dict
         JSON-able dicts, each with a unique string key ``"id"`` (used as a file name).
     store : str or os.PathLike, optional
@@ -42,12 +51,16 @@ def run_cases(function, cases, *, store=None, scheduler=None, workers=None, prog
         Dask scheduler it bounds nothing: the cluster's threads set the parallelism.
     progress : bool, optional
         Progress bar with ETA on stderr; None shows it when stderr is a terminal.
+    chunk_size : int, optional
+        Cases per work unit; default: about two work units per worker (at most
+        :data:`MAX_CHUNK` cases each), consecutive cases together.
 
     Returns
     -------
     list of dict
         The function's result plus ``"id"`` and ``"status"`` (``"ok"``), or
-        ``{"id", "status": "failed", "reason": "<one line>"}`` when the function raised.
+        ``{"id", "status": "failed", "reason": "<one line>"}`` for a case that failed (or whose
+        whole chunk raised).
 
     Raises
     ------
@@ -62,32 +75,45 @@ def run_cases(function, cases, *, store=None, scheduler=None, workers=None, prog
     todo = [case for case in cases if case["id"] not in results]
     bar = _Progress(len(cases), len(results), _show_progress(progress))
 
-    def finished(case, result):
-        if store is not None:
-            write_case(store, case, result)
-        results[case["id"]] = result
-        bar.update()
+    def finished(chunk, chunk_results):
+        for case, result in zip(chunk, chunk_results, strict=True):
+            if store is not None:
+                write_case(store, case, result)
+            results[case["id"]] = result
+            bar.update()
 
     try:
         if todo:
-            _execute(function, todo, scheduler, workers, finished)
+            _execute(function, todo, scheduler, workers, finished, chunk_size)
     finally:
         bar.close()
     return [results[case["id"]] for case in cases]
 
 
-def run_one(function, case):
-    """Call ``function(case)`` and return its JSON-normalised result with ``id`` and ``status``.
+def run_chunk(function, chunk):
+    """Call ``function(chunk)``; per case its JSON-normalised result with ``id`` and ``status``.
 
-    Any exception becomes ``{"status": "failed", "reason": "<ExceptionType: first line>"}``.
-    This is what the workers execute; it is public so that a case can be debugged alone.
+    A case's exception (returned in its place, or raised by the whole call) becomes
+    ``{"status": "failed", "reason": "<ExceptionType: first line>"}``. This is what the workers
+    execute; it is public so that cases can be debugged in this process.
     """
     try:
-        result = function(case)
+        results = list(function(chunk))
+        if len(results) != len(chunk):
+            raise TypeError(f"the chunk function returned {len(results)} results for "
+                            f"{len(chunk)} cases")
+    except Exception as exc:  # every failure is recorded, not raised
+        results = [exc] * len(chunk)
+    return [_normalised(case, result) for case, result in zip(chunk, results, strict=True)]
+
+
+def _normalised(case, result):
+    try:
+        if isinstance(result, Exception):
+            raise result
         if not isinstance(result, dict):
-            raise TypeError(f"the case function returned {type(result).__name__}, not a dict")
-        result = {**result, "id": case["id"], "status": "ok"}
-        return json.loads(json.dumps(result))
+            raise TypeError(f"the chunk function returned {type(result).__name__}, not a dict")
+        return json.loads(json.dumps({**result, "id": case["id"], "status": "ok"}))
     except Exception as exc:  # every failure of a case is recorded, not raised
         return {"id": case["id"], "status": "failed", "reason": one_line_reason(exc)}
 
@@ -225,14 +251,24 @@ def _check_workers(workers):
 
 # --- execution ----------------------------------------------------------------------------------
 
-def _execute(function, todo, scheduler, workers, finished):
+def chunks(todo, parallelism, chunk_size=None):
+    """Consecutive chunks of ``todo``: ``chunk_size`` cases, or about two per worker (at most
+    :data:`MAX_CHUNK`)."""
+    if chunk_size is None:
+        chunk_size = min(MAX_CHUNK, max(1, math.ceil(len(todo) / (2 * parallelism))))
+    require(isinstance(chunk_size, int) and not isinstance(chunk_size, bool) and chunk_size >= 1,
+            "chunk_size", "an integer >= 1", chunk_size)
+    return [todo[i:i + chunk_size] for i in range(0, len(todo), chunk_size)]
+
+
+def _execute(function, todo, scheduler, workers, finished, chunk_size):
     if scheduler is not None:
-        _run_dask(function, todo, scheduler, finished)
+        _run_dask(function, todo, scheduler, finished, chunk_size)
     elif workers == 1:
-        for case in todo:
-            finished(case, run_one(function, case))
+        for chunk in chunks(todo, 1, chunk_size):
+            finished(chunk, run_chunk(function, chunk))
     else:
-        _run_pool(function, todo, workers, finished)
+        _run_pool(function, chunks(todo, workers, chunk_size), workers, finished)
 
 
 def _pool_context():
@@ -245,19 +281,19 @@ def _pool_context():
 
 
 def _run_pool(function, todo, workers, finished):
-    """Local processes; at most ``2 * workers`` cases in flight."""
+    """Local processes; at most ``2 * workers`` chunks in flight."""
     pending = iter(todo)
     with ProcessPoolExecutor(max_workers=workers, mp_context=_pool_context()) as pool:
         try:
             running = {}
             _top_up(running, pending, 2 * workers,
-                    lambda case: pool.submit(run_one, function, case))
+                    lambda chunk: pool.submit(run_chunk, function, chunk))
             while running:
                 done, _ = wait(running, return_when=FIRST_COMPLETED)
                 for future in done:
                     finished(running.pop(future), future.result())
                 _top_up(running, pending, 2 * workers,
-                        lambda case: pool.submit(run_one, function, case))
+                        lambda chunk: pool.submit(run_chunk, function, chunk))
         except BaseException:
             pool.shutdown(wait=False, cancel_futures=True)
             raise
@@ -271,7 +307,7 @@ def _top_up(running, pending, limit, submit):
         running[submit(case)] = case
 
 
-def _run_dask(function, todo, scheduler, finished):
+def _run_dask(function, todo, scheduler, finished, chunk_size):
     """A Dask cluster: an address (a client is opened and closed here) or a ``Client``."""
     from dask.distributed import Client, as_completed
 
@@ -279,20 +315,23 @@ def _run_dask(function, todo, scheduler, finished):
     client = _connect(Client, scheduler) if own else scheduler
     try:
         with client.as_current():
-            _stream_dask(client, as_completed, function, todo, finished)
+            threads = max(1, sum(client.nthreads().values()))
+            _stream_dask(client, as_completed, function, chunks(todo, threads, chunk_size),
+                         finished)
     finally:
         if own:
             client.close()
 
 
 def _stream_dask(client, as_completed, function, todo, finished):
-    """Keep at most twice the cluster's threads in flight; hand results back as they finish."""
+    """Keep at most twice the cluster's threads of chunks in flight; hand results back as they
+    finish."""
     limit = 2 * max(1, sum(client.nthreads().values()))
     pending = iter(todo)
     running = {}
 
     def submit(case):
-        return client.submit(run_one, function, case, pure=False)
+        return client.submit(run_chunk, function, case, pure=False)
 
     _top_up(running, pending, limit, submit)
     stream = as_completed(list(running))

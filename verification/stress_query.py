@@ -6,7 +6,6 @@ from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.analytic.paper_model import paper_coefficients
 from cavex.analytic.resistance import check_model
-
 from cavex.errors import require
 
 

@@ -30,14 +30,15 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
+
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem, wall_layer
-from cavex.verification.cases import fe_case, make_fe_cases
+from cavex.errors import CavexInputError, require
+from cavex.fem.estimate import DEFAULT_ERROR_TARGET
+from cavex.verification.cases import fe_cases, make_fe_cases
 from cavex.verification.cases import projectile_table as projectile_to_table
 from cavex.verification.cases import target_table as target_to_table
 from cavex.verification.runner import run_cases
-
-from cavex.errors import CavexInputError, require
 
 DEFAULT_VELOCITIES = tuple(np.linspace(0.0, 1200.0, 13))
 DEFAULT_DEPTHS = tuple(np.round(np.linspace(0.10, 1.30, 31), 6))
@@ -128,8 +129,8 @@ def check_grid(velocities, depths):
 # --- building ---------------------------------------------------------------------------------
 
 def build_table(target, projectile, velocities, depths, *, nu=None, numerics=None,
-                scheduler=None, workers=None, store=None, progress=None,
-                refine=SWITCH_REFINEMENT):
+                error_target=DEFAULT_ERROR_TARGET, scheduler=None, workers=None, store=None,
+                progress=None, refine=SWITCH_REFINEMENT):
     """FE cavity-wall stress on the ``(velocity, depth)`` grid, as an :class:`xarray.Dataset`.
 
     Parameters
@@ -143,6 +144,9 @@ def build_table(target, projectile, velocities, depths, *, nu=None, numerics=Non
         Poisson's ratio for every layer (default: each layer's own).
     numerics : dict, optional
         Settings of :class:`cavex.fem.Numerics`.
+    error_target : float or None
+        A cell whose estimated FE error exceeds this is refined (twice the space and time
+        resolution, at most twice; default 0.5 %); None: every cell at ``numerics``.
     scheduler, workers, store, progress
         Passed to :func:`cavex.verification.runner.run_cases`.
     refine : sequence of float
@@ -157,20 +161,23 @@ def build_table(target, projectile, velocities, depths, *, nu=None, numerics=Non
     check_grid(velocities, depths)
     v = np.unique(np.asarray(velocities, dtype=float))
     d = grid_depths(depths, target, projectile, refine)
-    grid = table_cases(target, projectile, v, d, nu, numerics)
+    grid = table_cases(target, projectile, v, d, nu, numerics, error_target)
     first = [{**case, "id": f"first-layer-{case['id']}"} for case in
-             table_cases(target.single(0), projectile, v, [FIRST_LAYER_DEPTH], nu, numerics)]
-    results = run_cases(fe_case, grid + first, store=store, scheduler=scheduler,
+             table_cases(target.single(0), projectile, v, [FIRST_LAYER_DEPTH], nu, numerics,
+                         error_target)]
+    results = run_cases(fe_cases, grid + first, store=store, scheduler=scheduler,
                         workers=workers, progress=progress)
     cells = _cells(results[:len(grid)], grid, v, d)
     crater = _cells(results[len(grid):], first, v, [FIRST_LAYER_DEPTH])
-    return assemble_table(target, projectile, v, d, cells, crater, settings_json(nu, numerics))
+    return assemble_table(target, projectile, v, d, cells, crater,
+                          settings_json(nu, numerics, error_target))
 
 
-def table_cases(target, projectile, velocities, depths, nu, numerics):
+def table_cases(target, projectile, velocities, depths, nu, numerics,
+                error_target=DEFAULT_ERROR_TARGET):
     """FE cases in the order velocity-major, depth-minor (``V = 0`` is a quasi-static run)."""
     return make_fe_cases(target_to_table(target), projectile_to_table(projectile), velocities,
-                         depths, nu=nu, numerics=numerics)
+                         depths, nu=nu, numerics=numerics, error_target=error_target)
 
 
 def _cells(results, cases, velocities, depths):
@@ -197,12 +204,13 @@ def _cells(results, cases, velocities, depths):
     return {**out, "failed": failed, "failures": failures}
 
 
-def settings_json(nu, numerics):
-    """Solver settings (``nu`` and every :class:`~cavex.fem.Numerics` value) as JSON."""
+def settings_json(nu, numerics, error_target=DEFAULT_ERROR_TARGET):
+    """Solver settings (``nu``, every :class:`~cavex.fem.Numerics` value and the error target)
+    as JSON."""
     from cavex.fem.settings import make_numerics
 
     return json.dumps({"nu": nu, "numerics": make_numerics(**(numerics or {})).as_dict(),
-                       "switch": "cavity"}, sort_keys=True)
+                       "error_target": error_target, "switch": "cavity"}, sort_keys=True)
 
 
 def analytic_table(target, projectile, velocities, depths, boundary="quasi-static",

@@ -38,14 +38,14 @@ import math
 from dataclasses import asdict, dataclass, replace
 from functools import partial
 
+from scipy.integrate import solve_ivp
+
 from cavex.analytic import paper_model as pm
 from cavex.analytic.nose import ogive_coefficients
 from cavex.analytic.penetration import crater_depth, penetrate
 from cavex.analytic.resistance import ClosedFormResistance
-from cavex.verification.table2 import PAPER_REF10_EXIT_VELOCITY, PAPER_TABLE2, table2_rows
-from scipy.integrate import solve_ivp
-
 from cavex.errors import CavexNumericalError, require
+from cavex.verification.table2 import PAPER_REF10_EXIT_VELOCITY, PAPER_TABLE2, table2_rows
 
 CHOICES = {
     "epsilon": pm.EPSILON_READINGS,

@@ -25,14 +25,14 @@ cells, or queried outside its depth or velocity range, with a one-line
 import json
 
 import numpy as np
+from scipy.interpolate import PchipInterpolator
+
 from cavex.analytic.geometry import wall_layer
 from cavex.analytic.nose import nose_rule
 from cavex.analytic.penetration import penetrate
 from cavex.analytic.resistance import ClosedFormResistance
-from cavex.verification.table import fingerprint, fingerprint_data, load_table, switch_depths
-from scipy.interpolate import PchipInterpolator
-
 from cavex.errors import CavexInputError, require_choice
+from cavex.verification.table import fingerprint, fingerprint_data, load_table, switch_depths
 
 METHODS = ("pchip", "linear")
 NODE_TOLERANCE = 1e-6  # m: a switch node this close to a segment end belongs to both segments

@@ -142,7 +142,7 @@ def _stress(args, target, projectile):
 
 
 def _fem(args, target, projectile):
-    from cavex.fem import compare_at_depth
+    from cavex.verification.fe_comparison import compare_at_depth
 
     result = compare_at_depth(target, projectile, args.depth, args.velocity, nu=args.nu)
     if args.json:
@@ -160,7 +160,8 @@ def _fem(args, target, projectile):
                      f"{result['analytic_plastic_radius'][boundary]:10.5f}")
     estimate = result["error_estimate"]
     lines.append("FE estimated discretisation error: "
-                 + ("not estimated" if estimate is None else f"{estimate:.3%}"))
+                 + ("not estimated" if estimate is None else f"{estimate:.3%}")
+                 + f" ({result['refinements']} refinement(s) of the default resolution)")
     return "\n".join(lines)
 
 

@@ -1,0 +1,116 @@
+r"""The compiled element kernel: internal force, consistent tangent and point response of a stack.
+
+Reference radius ``R``, displacement ``u(R)``, current radius ``r = R + u``. Principal stretches
+``lambda_r = 1 + du/dR`` and ``lambda_t = 1 + u/R``, log strains ``eps = ln lambda`` (formed as
+``log1p`` of the displacement gradients, which keeps full relative precision at tiny strains).
+With Kirchhoff stresses ``tau_r``, ``tau_t`` (tension positive) and ``dV = 4 pi R^2 dR``, the
+virtual work of the internal forces is
+
+.. math:: \delta W_{int} = \int (\tau_r\, \delta\varepsilon_r + 2\tau_t\, \delta\varepsilon_t)\,dV,
+          \quad \delta\varepsilon_r = \frac{\delta u'}{\lambda_r},\quad
+          \delta\varepsilon_t = \frac{\delta u}{R\lambda_t},
+
+and its linearisation (``C_ij = d tau_i / d eps_j`` from the return map,
+:func:`cavex.fem.constitutive.return_point`) is
+
+.. math:: \int \Big[\delta\varepsilon_r (C_{rr}\Delta\varepsilon_r + C_{rt}\Delta\varepsilon_t)
+          + 2\delta\varepsilon_t (C_{tr}\Delta\varepsilon_r + C_{tt}\Delta\varepsilon_t)
+          - \tau_r \frac{\delta u'\,\Delta u'}{\lambda_r^2}
+          - 2\tau_t \frac{\delta u\,\Delta u}{R^2\lambda_t^2}\Big]\,dV .
+
+Both are integrated with the reduced Gauss rule of :mod:`cavex.fem.discretisation` (``degree``
+points per element, the locking-free rule) and scattered in *radial* dof order into LAPACK band
+storage (``p`` sub- and super-diagonals). The inertia ``int rho_0 u'' du dV`` is the scikit-fem
+mass form of :mod:`cavex.fem.forms`, assembled once.
+
+:func:`assemble_cases` runs over a stack of disconnected cases (:class:`cavex.fem.stack.Stack`),
+skipping the cases flagged ``skip`` (their outputs are left as they are). A case in which some
+point has a non-positive stretch is *folded*: it is flagged and evaluated at zero strain (its
+Newton iteration is then abandoned by the caller). The scikit-fem forms of the same weak form
+are kept in ``tests/oracles.py`` and compared with this kernel in ``tests/test_fem_kernels.py``.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from cavex.fem.constitutive import return_point
+
+
+@njit(cache=True, error_model="numpy")
+def assemble_cases(Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_weights, K, G, lam,
+                   tau, lam_psi, tension, theta_p, gamma_p, el_start, el_count, skip, p, f, band,
+                   tau_r, tau_t, th_p_new, ga_p_new, plastic, yield_ratio, folded, force_scale):
+    """Response, internal force and banded tangent of every case ``c`` with ``not skip[c]``.
+
+    ``Gr``, ``Gt`` (element, point) are the displacement gradients ``du/dR``, ``u/R``; those of
+    a folded case are overwritten by zero. ``f`` and ``band`` must be zero on the cases
+    evaluated; the per-point outputs (``tau_r`` ... ``yield_ratio``) and per-case ``folded``
+    and ``force_scale`` (the largest nodal force one point contributes: Newton's yardstick)
+    are written in place.
+    """
+    nb = element_dofs.shape[1]
+    nq = R_points.shape[1]
+    out = np.empty(9)
+    C = np.empty((4, nq))
+    Br = np.empty((nb, nq))
+    Bt = np.empty((nb, nq))
+    for c in range(el_start.size):
+        if skip[c]:
+            continue
+        e0, e1 = el_start[c], el_start[c] + el_count[c]
+        bad = False
+        for e in range(e0, e1):
+            for q in range(nq):
+                if not (Gr[e, q] > -1.0 and Gt[e, q] > -1.0):
+                    bad = True
+        folded[c] = bad
+        if bad:
+            Gr[e0:e1] = 0.0
+            Gt[e0:e1] = 0.0
+        scale = 0.0
+        for e in range(e0, e1):
+            for q in range(nq):
+                plastic[e, q] = return_point(math.log1p(Gr[e, q]), math.log1p(Gt[e, q]),
+                                             theta_p[e, q], gamma_p[e, q], K[e, q], G[e, q],
+                                             lam[e, q], tau[e, q], lam_psi[e, q],
+                                             tension[e, q], out)
+                tau_r[e, q] = out[0]
+                tau_t[e, q] = out[1]
+                for i in range(4):
+                    C[i, q] = out[2 + i]
+                yield_ratio[e, q] = out[6]
+                th_p_new[e, q] = out[7]
+                ga_p_new[e, q] = out[8]
+                s = (abs(out[0]) + 2.0 * abs(out[1])) * force_weights[e, q]
+                if s > scale or s != s:
+                    scale = s
+            _element(e, Gr, Gt, C, tau_r, tau_t, element_dofs, dNdR, N, R_points, weights, p,
+                     Br, Bt, f, band)
+        force_scale[c] = scale
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _element(e, Gr, Gt, C, tau_r, tau_t, element_dofs, dNdR, N, R_points, weights, p, Br, Bt,
+             f, band):
+    """Add element ``e``'s internal force and tangent (module docstring) to ``f``, ``band``."""
+    nb, nq = Br.shape
+    for b in range(nb):
+        for q in range(nq):
+            Br[b, q] = dNdR[e, b, q] / (1.0 + Gr[e, q])                 # d eps_r / d u_b
+            Bt[b, q] = N[b, q] / (R_points[e, q] * (1.0 + Gt[e, q]))    # d eps_t / d u_b
+    for a in range(nb):
+        row = element_dofs[e, a]
+        fe = 0.0
+        for q in range(nq):
+            fe += weights[e, q] * (tau_r[e, q] * Br[a, q] + 2.0 * tau_t[e, q] * Bt[a, q])
+        f[row] += fe
+        for b in range(nb):
+            col = element_dofs[e, b]
+            k = 0.0
+            for q in range(nq):
+                X = (C[0, q] - tau_r[e, q]) * Br[b, q] + C[1, q] * Bt[b, q]
+                Y = C[2, q] * Br[b, q] + (C[3, q] - tau_t[e, q]) * Bt[b, q]
+                k += weights[e, q] * (Br[a, q] * X + 2.0 * Bt[a, q] * Y)
+            band[p + row - col, col] += k

@@ -1,0 +1,306 @@
+r"""One Newton iteration for every case of a stack: generalized-alpha step equations, per-case
+convergence, and the line-searched last attempt.
+
+The semi-discrete equations in radial dof order are ``M a + f_int(u) = r`` with ``r`` the
+reaction at the prescribed dofs (the cavity wall under displacement control, the outer boundary
+when fixed) or the follower wall load ``p 4 pi r_wall^2`` under pressure control. One step
+``n -> n+1`` solves, on the free dofs,
+
+.. math:: M[(1-\alpha_m) a_{n+1} + \alpha_m a_n] + (1-\alpha_f) f(u_{n+1}) + \alpha_f f(u_n) = 0,
+
+with the Newmark updates
+``a_{n+1} = (u_{n+1} - u_n - dt v_n)/(beta dt^2) - (1/(2 beta) - 1) a_n``,
+``v_{n+1} = v_n + dt[(1 - gamma) a_n + gamma a_{n+1}]`` and
+``alpha_m = (2 rho_inf - 1)/(rho_inf + 1)``, ``alpha_f = rho_inf/(rho_inf + 1)``,
+``gamma = 1/2 - alpha_m + alpha_f``, ``beta = (1 - alpha_m + alpha_f)^2/4`` (Chung-Hulbert,
+second order; ``rho_inf`` is the spectral radius at infinite frequency). The plastic state is
+return-mapped at ``u_{n+1}`` (backward Euler), so ``f(u_n)`` is the converged force of the
+previous step. The Newton matrix is ``(1-alpha_m)/(beta dt^2) M + (1-alpha_f) K_T``; without
+inertia (quasi-static load stepping) it is ``K_T`` and the residual ``f(u_{n+1})``.
+
+Convergence, the force yardstick and failures (folded element, non-finite value, singular
+tangent, no convergence) are decided per case (:func:`newton`); a converged case is frozen and
+a failed one drops out. When few cases are left iterating they continue on a smaller stack, so
+one hard case does not make the whole stack iterate. :func:`newton_line_search` is the last
+attempt of a step that fails at the deepest cut-back (:mod:`cavex.fem.solver`).
+"""
+
+import math
+from dataclasses import dataclass
+from types import SimpleNamespace
+
+import numpy as np
+
+MAX_ITERATIONS = 30     # Newton iterations per attempt
+SHRINK_FRACTION = 0.25  # continue on a smaller stack when at most this fraction still iterates
+MIN_SHRINK = 8          # ... and the stack has at least this many cases
+LINE_SEARCH_EVALUATIONS = 20  # residual evaluations per line search (Illinois steps)
+LINE_SEARCH_TOLERANCE = 0.5   # accept s once |G(s)| <= this * |G(0)|
+#: Start-of-step data of a Newton call (see :func:`newton`), by where it lives in the stack.
+DOF_INPUTS = ("u0", "v0", "a0", "f0", "du_prev")
+POINT_INPUTS = ("theta_p", "gamma_p")
+CASE_INPUTS = ("load", "dt", "dt_old", "has_prev", "active")
+
+
+@dataclass
+class Newmark:
+    """Generalized-alpha parameters from ``rho_inf`` in [0, 1]."""
+
+    alpha_m: float
+    alpha_f: float
+    beta: float
+    gamma: float
+
+    @classmethod
+    def from_rho_inf(cls, rho_inf):
+        am = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0)
+        af = rho_inf / (rho_inf + 1.0)
+        return cls(alpha_m=am, alpha_f=af, beta=0.25 * (1.0 - am + af) ** 2,
+                   gamma=0.5 - am + af)
+
+
+class StepFailure(Exception):
+    """A Newton iteration that did not converge (internal: triggers a cut-back)."""
+
+
+def take(w, dofs, elements, cases):
+    """The start-of-step data ``w`` of a subset of the stack's cases."""
+    out = {name: w[name][dofs] for name in DOF_INPUTS if name in w}
+    out.update({name: w[name][elements] for name in POINT_INPUTS})
+    out.update({name: w[name][cases] for name in CASE_INPUTS})
+    return out
+
+
+def newton(stack, w, params, dynamic, tol, first_iteration=1):
+    """Generalized-alpha Newton iteration of every case of ``stack`` with ``w["active"]``.
+
+    ``w`` holds the start-of-step state in stack layout (``u0, v0, a0, f0, du_prev`` per dof,
+    ``theta_p, gamma_p`` per point, ``load, dt, dt_old, has_prev, active`` per case; ``u`` the
+    current iterate when continuing at ``first_iteration > 1``). Converged: ``max |r_free| <=
+    tol * scale`` from the second iteration on. Returns ``(u, a, f, response, iterations,
+    reasons)``; ``reasons[c]`` is None for a converged case, else why it failed. Inactive cases
+    come back as converged (their values are not to be used).
+    """
+    k = stack.n_cases
+    u = predict(stack, w, dynamic) if first_iteration == 1 else w["u"]
+    done = ~w["active"]
+    reasons = np.full(k, None, dtype=object)
+    iterations = np.zeros(k, dtype=int)
+    buffers = None
+    for iteration in range(first_iteration, MAX_ITERATIONS + 1):
+        buffers = stack.assemble(u, w["theta_p"], w["gamma_p"], done, buffers)
+        f, band, resp, folded, force_scale = buffers
+        _fail(reasons, done, folded, "non-positive stretch")
+        a, r_free, jac, scale = equations(stack, w, params, dynamic, u, f, band, force_scale)
+        _fail(reasons, done, ~stack.per_case_all(np.isfinite(r_free)), "non-finite residual")
+        with np.errstate(invalid="ignore"):
+            converged = stack.per_case_max(np.abs(r_free)) <= tol * scale
+        if iteration > 1:
+            newly = converged & ~done
+            iterations[newly] = iteration - 1
+            done |= newly
+        if done.all():
+            return u, a, f, resp, iterations, reasons
+        remaining = np.flatnonzero(~done)
+        if k >= MIN_SHRINK and remaining.size <= SHRINK_FRACTION * k:
+            return _continue_on_subset(stack, w, params, dynamic, tol, iteration, remaining,
+                                       u, a, f, resp, iterations, reasons)
+        failed = np.array([r is not None for r in reasons])
+        du, singular = stack.solve(jac, r_free, failed | done)
+        _fail(reasons, done, singular, "singular tangent")
+        _fail(reasons, done, ~stack.per_case_all(np.isfinite(du)), "non-finite increment")
+        u = np.where(stack.free & (~done)[stack.dof_case], u - du, u)
+    for c in np.flatnonzero(~done):
+        reasons[c] = f"Newton did not converge in {MAX_ITERATIONS} iterations"
+    return u, a, f, resp, iterations, reasons
+
+
+def predict(stack, w, dynamic):
+    """First Newton iterate of every active case: the last step's increment scaled to this
+    step's ``dt``, or (first step) ``u0 + dt v0`` dynamic and ``u0`` quasi-static; the wall at
+    its prescribed displacement under displacement control."""
+    dof_case = stack.dof_case
+    u0 = w["u0"]
+    u = u0.copy()
+    if not stack.pressure_control:
+        u[stack.wall] = w["load"]
+    guess = u0 + w["dt"][dof_case] * w["v0"] if dynamic else u0
+    ratio = (w["dt"] / w["dt_old"])[dof_case]
+    predicted = np.where(w["has_prev"][dof_case], u0 + ratio * w["du_prev"], guess)
+    return np.where(stack.free & w["active"][dof_case], predicted, u)
+
+
+def equations(stack, w, params, dynamic, u, f, band, force_scale):
+    """``(a, r_free, jac, scale)`` of the step's equations at the iterate ``u`` (stack layout;
+    ``r_free`` is zero at the prescribed dofs; ``scale`` per case: the largest of the point
+    force yardstick, the reactions and the wall load)."""
+    p = params
+    if dynamic:
+        dt_d = w["dt"][stack.dof_case]
+        c_m = ((1.0 - p.alpha_m) / (p.beta * w["dt"] * w["dt"]))[stack.dof_case]
+        a = ((u - w["u0"] - dt_d * w["v0"]) / (p.beta * dt_d * dt_d)
+             - (0.5 / p.beta - 1.0) * w["a0"])
+        inertia = stack.mass @ ((1.0 - p.alpha_m) * a + p.alpha_m * w["a0"])
+        residual = inertia + (1.0 - p.alpha_f) * f + p.alpha_f * w["f0"]
+        jac = (1.0 - p.alpha_f) * band + c_m[None, :] * stack.mass_band
+    else:
+        a = np.zeros_like(u)
+        residual = f.copy()
+        jac = band.copy()
+    scale = np.maximum(force_scale, 1e-300)
+    if stack.pressure_control:
+        r_wall = stack.R_dofs[stack.wall] + u[stack.wall]
+        residual[stack.wall] -= w["load"] * 4.0 * np.pi * r_wall ** 2
+        jac[stack.degree, stack.wall] -= w["load"] * 8.0 * np.pi * r_wall
+        scale = np.maximum(scale, np.abs(w["load"]) * 4.0 * np.pi
+                           * stack.R_dofs[stack.wall] ** 2)
+    r_free = np.where(stack.free, residual, 0.0)
+    with np.errstate(invalid="ignore"):
+        if stack.fixed.size:
+            reaction = np.zeros(stack.n_cases)
+            np.maximum.at(reaction, stack.dof_case[stack.fixed], np.abs(residual[stack.fixed]))
+            scale = np.maximum(scale, reaction)
+    return a, r_free, jac, scale
+
+
+def _fail(reasons, done, flags, why):
+    """Mark the not-yet-done cases among ``flags`` failed with ``why``."""
+    if not flags.any():
+        return
+    new = flags & ~done
+    for c in np.flatnonzero(new):
+        reasons[c] = why
+    done |= new
+
+
+def _continue_on_subset(stack, w, params, dynamic, tol, iteration, cases, u, a, f, resp,
+                        iterations, reasons):
+    """Continue the Newton iteration of ``cases`` on a smaller stack, from ``iteration``."""
+    sub, dofs, elements = stack.subset(cases)
+    sw = take(w, dofs, elements, cases)
+    sw["active"] = np.ones(cases.size, dtype=bool)
+    sw["u"] = u[dofs]
+    su, sa, sf, sresp, sit, sreasons = newton(sub, sw, params, dynamic, tol, iteration)
+    u, a, f = u.copy(), a.copy(), f.copy()
+    u[dofs], a[dofs], f[dofs] = su, sa, sf
+    resp = copy_response(resp)
+    replace_points(resp, elements, sresp)
+    iterations[cases] = sit
+    reasons[cases] = sreasons
+    return u, a, f, resp, iterations, reasons
+
+
+def copy_response(resp):
+    return SimpleNamespace(**{name: value.copy() for name, value in vars(resp).items()})
+
+
+def replace_points(response, where, other):
+    """Overwrite the point arrays of ``response`` at ``where`` (elements) by ``other``'s."""
+    for name, value in vars(response).items():
+        value[where] = getattr(other, name)
+
+
+# ------------------------------------------------------------------------- the line search
+def _dot(x, y):
+    """``x . y`` correctly rounded (``math.fsum``): the same bits whatever the array layout."""
+    return math.fsum(x * y)
+
+
+def line_search_newton(evaluate, solve, x, tol, max_iterations):
+    """Newton iteration with an energy line search; the last resort of a failing step.
+
+    ``evaluate(x)`` returns a tuple starting with the free-dof residual ``r`` and the force
+    yardstick ``scale`` at the free-dof iterate ``x`` (it raises :class:`StepFailure` where the
+    equations cannot be evaluated); ``solve(out, r)`` returns the Newton increment ``J^-1 r``
+    for the tangent of ``out``. Converged: ``max |r| <= tol * scale`` from the second
+    iteration on, as :func:`newton`. Returns ``(x, out, iterations)``.
+
+    The full step ``d = -J^-1 r`` is taken unless it increases ``max |r|``; then ``s`` in
+    ``(0, 1)`` is sought with ``G(s) = d . r(x + s d) = 0`` (the energy along the step is
+    stationary; ``G(0) = -r^T J^-1 r < 0``), by regula falsi with the Illinois modification
+    on the bracket ``[0, 1]`` when ``G(1) > 0``, until ``|G(s)| <= 0.5 |G(0)|``. This reaches
+    the narrow set of states in which a point lies on the Mohr-Coulomb face next to the apex
+    of the cone, which plain Newton steps over in both directions (a two-cycle between an
+    elastic and an apex state; docs/fem.md) and which halving the step on the residual norm
+    does not find.
+    """
+    out = evaluate(x)
+    for iteration in range(1, max_iterations + 1):
+        r, scale = out[0], out[1]
+        norm = np.max(np.abs(r))
+        if iteration > 1 and norm <= tol * scale:
+            return x, out, iteration - 1
+        d = -solve(out, r)
+        if not np.all(np.isfinite(d)):
+            raise StepFailure("non-finite increment")
+        trial = evaluate(x + d)
+        s = 1.0
+        if np.max(np.abs(trial[0])) > norm:
+            s, trial = _illinois(evaluate, x, d, _dot(d, r), _dot(d, trial[0]), trial)
+        x = x + s * d
+        out = trial
+    raise StepFailure(f"Newton with line search did not converge in {max_iterations} "
+                      "iterations")
+
+
+def _illinois(evaluate, x, d, g0, g1, out1):
+    """``(s, evaluate(x + s d))`` with ``|G(s)| <= 0.5 |G(0)|`` (see :func:`line_search_newton`);
+    the full step when ``[0, 1]`` does not bracket a root of ``G``."""
+    if not g0 < 0.0 < g1:
+        return 1.0, out1
+    lo, g_lo, hi, g_hi = 0.0, g0, 1.0, g1
+    side = 0
+    s, out = 1.0, out1
+    for _ in range(LINE_SEARCH_EVALUATIONS):
+        s = hi - g_hi * (hi - lo) / (g_hi - g_lo)
+        out = evaluate(x + s * d)
+        g = _dot(d, out[0])
+        if abs(g) <= LINE_SEARCH_TOLERANCE * abs(g0):
+            break
+        if g > 0.0:
+            hi, g_hi = s, g
+            if side > 0:
+                g_lo *= 0.5
+            side = 1
+        else:
+            lo, g_lo = s, g
+            if side < 0:
+                g_hi *= 0.5
+            side = -1
+    return s, out
+
+
+def newton_line_search(stack, w, params, dynamic, tol):
+    """The Newton iteration of the one case of ``stack`` with the line search of
+    :func:`line_search_newton`. Returns ``(u, a, f, response, iterations, reason)`` (reason
+    None when converged)."""
+    start = predict(stack, w, dynamic)
+    free = stack.free
+
+    def evaluate(x):
+        u = start.copy()
+        u[free] = x
+        f, band, resp, folded, force_scale = stack.assemble(u, w["theta_p"], w["gamma_p"])
+        if folded[0]:
+            raise StepFailure("non-positive stretch")
+        a, r_free, jac, scale = equations(stack, w, params, dynamic, u, f, band, force_scale)
+        r = r_free[free]
+        if not np.all(np.isfinite(r)):
+            raise StepFailure("non-finite residual")
+        return r, scale[0], jac, u, a, f, resp
+
+    def solve(out, r):
+        rhs = np.zeros(stack.ndof)
+        rhs[free] = r
+        du, singular = stack.solve(out[2], rhs, np.zeros(1, dtype=bool))
+        if singular[0]:
+            raise StepFailure("singular tangent")
+        return du[free]
+
+    try:
+        _, out, iterations = line_search_newton(evaluate, solve, start[free], tol,
+                                                MAX_ITERATIONS)
+    except StepFailure as exc:
+        return start, np.zeros_like(start), np.zeros_like(start), None, 0, str(exc)
+    _, _, _, u, a, f, resp = out
+    return u, a, f, resp, iterations, None

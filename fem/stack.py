@@ -1,0 +1,203 @@
+r"""Several radial models concatenated into one model of disconnected copies (a *stack*).
+
+Every computation of :mod:`cavex.fem` runs on a stack; a single problem is a stack of one. The
+cases are concatenated element by element and dof by dof; the compiled kernel
+(:func:`cavex.fem.element.assemble_cases`) then runs once per Newton iteration over all
+(case, element, point) triples. The global tangent is block diagonal with the bandwidth of one
+case, so the whole stack is one ``scipy.linalg.solve_banded`` call; the prescribed dofs become
+identity rows and columns. Partial pivoting never leaves a block (the entries coupling two
+blocks are exact zeros), so every block is factorised with the same operations as alone: a case
+gives the same bits alone and inside any stack.
+"""
+
+from types import SimpleNamespace
+
+import numpy as np
+from scipy.linalg import LinAlgError, solve_banded
+from scipy.sparse import csr_matrix
+
+from cavex.fem.constitutive import PointMaterial
+from cavex.fem.element import assemble_cases
+
+WALL_CONTROLS = ("displacement", "pressure")
+
+
+def ranges(starts, counts):
+    """Concatenated ``arange(s, s + c)`` for every pair (vectorised)."""
+    counts = np.asarray(counts)
+    total = int(counts.sum())
+    if total == 0:
+        return np.zeros(0, dtype=int)
+    first = np.repeat(np.asarray(starts) - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
+    return first + np.arange(total)
+
+
+def starts(counts):
+    """Offsets of consecutive blocks of the given sizes."""
+    return np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(int)
+
+
+class Stack:
+    """Discretisations of several cases concatenated into one model of disconnected copies.
+
+    Case ``c`` owns dofs ``dof_start[c] : dof_start[c] + dof_count[c]`` (its radial order) and
+    elements ``el_start[c] : el_start[c] + el_count[c]``.
+
+    Parameters
+    ----------
+    discs : sequence of Discretisation
+        All of one degree.
+    outer_fixed : bool
+        The outermost dof of every case is held at zero displacement (else traction-free).
+    wall_control : {"displacement", "pressure"}
+        The wall dof is prescribed (displacement) or free and loaded by a follower pressure.
+    """
+
+    def __init__(self, discs, outer_fixed=True, wall_control="displacement"):
+        d0 = discs[0]
+        self.discs = list(discs)
+        self.degree = p = d0.degree
+        self.N = d0.N
+        self.n_cases = k = len(discs)
+        self.dof_count = np.array([d.ndof for d in discs])
+        self.el_count = np.array([d.n_elements for d in discs])
+        self.dof_start = starts(self.dof_count)
+        self.el_start = starts(self.el_count)
+        self.ndof = n = int(self.dof_count.sum())
+        self.element_dofs = np.concatenate([d.element_dofs + o
+                                            for d, o in zip(discs, self.dof_start, strict=True)])
+        for name in ("dNdR", "R_points", "weights", "force_weights", "R_dofs", "mass_band"):
+            setattr(self, name, np.concatenate([getattr(d, name) for d in discs],
+                                               axis=1 if name == "mass_band" else 0))
+        self.material = PointMaterial(**{name: np.concatenate([getattr(d.material, name)
+                                                               for d in discs])
+                                         for name in vars(d0.material)})
+        self.element_case = np.repeat(np.arange(k), self.el_count)
+        self.dof_case = np.repeat(np.arange(k), self.dof_count)
+        nnz = np.array([d.mass.nnz for d in discs])
+        indptr = np.concatenate([d.mass.indptr[:-1] + o for d, o in zip(discs, starts(nnz),
+                                                                         strict=True)]
+                                + [[nnz.sum()]])
+        self.mass = csr_matrix((np.concatenate([d.mass.data for d in discs]),
+                                np.concatenate([d.mass.indices + o for d, o in
+                                                zip(discs, self.dof_start, strict=True)]),
+                                indptr), shape=(n, n))
+        self.outer_fixed = outer_fixed
+        self.wall_control = wall_control
+        self.pressure_control = wall_control == "pressure"
+        self.wall = self.dof_start
+        self.outer = self.dof_start + self.dof_count - 1
+        fixed = [] if self.pressure_control else [self.wall]
+        fixed = np.concatenate(fixed + ([self.outer] if outer_fixed else []) + [[]]).astype(int)
+        self.fixed = fixed
+        self.free = np.ones(n, dtype=bool)
+        self.free[fixed] = False
+        # band entries of the fixed dofs' rows and columns (cleared, then a unit diagonal)
+        rows = np.arange(2 * p + 1)
+        col_entries = (rows[:, None] * n + fixed[None, :]).ravel()
+        j = fixed[None, :] + np.arange(-p, p + 1)[:, None]
+        row_entries = ((p + fixed[None, :] - j) * n + j)[(j >= 0) & (j < n)]
+        self.fixed_entries = np.concatenate([col_entries, row_entries])
+        self.fixed_diagonal = p * n + fixed
+
+    def subset(self, cases):
+        """``(stack, dof_map, element_map)`` of the cases ``cases`` (indices into this stack)."""
+        cases = np.asarray(cases)
+        sub = Stack([self.discs[c] for c in cases], self.outer_fixed, self.wall_control)
+        return (sub, ranges(self.dof_start[cases], self.dof_count[cases]),
+                ranges(self.el_start[cases], self.el_count[cases]))
+
+    def dofs(self, c):
+        """Slice of case ``c``'s dofs."""
+        return slice(self.dof_start[c], self.dof_start[c] + self.dof_count[c])
+
+    def elements(self, c):
+        """Slice of case ``c``'s elements."""
+        return slice(self.el_start[c], self.el_start[c] + self.el_count[c])
+
+    def displacement_gradients(self, u):
+        """``(du/dR, u/R)`` at the points, shape (elements, points)."""
+        ue = u[self.element_dofs]
+        return (ue[:, :, None] * self.dNdR).sum(1), (ue @ self.N) / self.R_points
+
+    def new_buffers(self):
+        """Output arrays of :meth:`assemble`: ``(f, band, response, folded, force_scale)``."""
+        shape = self.R_points.shape
+        response = SimpleNamespace(tau_r=np.zeros(shape), tau_t=np.zeros(shape),
+                                   theta_p=np.zeros(shape), gamma_p=np.zeros(shape),
+                                   plastic=np.zeros(shape, dtype=bool),
+                                   yield_ratio=np.zeros(shape))
+        return (np.zeros(self.ndof), np.zeros((2 * self.degree + 1, self.ndof)), response,
+                np.zeros(self.n_cases, dtype=bool), np.zeros(self.n_cases))
+
+    def assemble(self, u, theta_p, gamma_p, skip=None, out=None):
+        """``(f, band, response, folded, force_scale)`` at ``u`` for the start-of-step plastic
+        strains; cases with ``skip`` set keep the values they have in ``out`` (the previous
+        call's result, reused in place; new arrays when None)."""
+        if out is None:
+            out = self.new_buffers()
+        if skip is None:
+            skip = np.zeros(self.n_cases, dtype=bool)
+        f, band, resp, folded, scale = out
+        if skip.any():
+            keep = ~skip[self.dof_case]
+            f[keep] = 0.0
+            band[:, keep] = 0.0
+        else:
+            f[:] = 0.0
+            band[:] = 0.0
+        m = self.material
+        g_r, g_t = self.displacement_gradients(u)
+        assemble_cases(g_r, g_t, self.element_dofs, self.dNdR, self.N, self.R_points,
+                       self.weights, self.force_weights, m.K, m.G, m.lam, m.tau, m.lam_psi,
+                       m.tension, theta_p, gamma_p, self.el_start, self.el_count, skip,
+                       self.degree, f, band, resp.tau_r, resp.tau_t, resp.theta_p,
+                       resp.gamma_p, resp.plastic, resp.yield_ratio, folded, scale)
+        return out
+
+    def per_case_max(self, dof_values):
+        return np.maximum.reduceat(dof_values, self.dof_start)
+
+    def per_case_all(self, dof_flags):
+        return np.logical_and.reduceat(dof_flags, self.dof_start)
+
+    def per_case_sum(self, point_values):
+        """Sum over every case's points of a (element, point) array."""
+        return np.add.reduceat(point_values.sum(axis=1), self.el_start)
+
+    def solve(self, band, rhs, skip):
+        """Solve the block-diagonal banded system for the cases without ``skip`` (bool per
+        case; their increment is zero); fixed dofs get identity rows. Returns the increment and
+        the cases whose block is singular. ``band`` is overwritten (pass a scratch copy).
+
+        Only the blocks solved are passed to LAPACK (gathered when some are skipped): partial
+        pivoting never leaves a block, so each is factorised exactly as it would be alone.
+        """
+        p = self.degree
+        flat = band.reshape(-1)
+        flat[self.fixed_entries] = 0.0
+        flat[self.fixed_diagonal] = 1.0
+        rhs = np.where(self.free, rhs, 0.0)
+        du = np.zeros_like(rhs)
+        singular = np.zeros(self.n_cases, dtype=bool)
+        solve = np.flatnonzero(~skip)
+        if solve.size == 0:
+            return du, singular
+        if solve.size < self.n_cases:
+            cols = ranges(self.dof_start[solve], self.dof_count[solve])
+            band, rhs = band[:, cols], rhs[cols]
+        else:
+            cols = slice(None)
+        try:
+            du[cols] = solve_banded((p, p), band, rhs, check_finite=False)
+        except (LinAlgError, ValueError):
+            offsets = starts(self.dof_count[solve])
+            for c, start in zip(solve, offsets, strict=True):
+                s = slice(start, start + self.dof_count[c])
+                try:
+                    part = solve_banded((p, p), band[:, s], rhs[s], check_finite=False)
+                except (LinAlgError, ValueError):
+                    singular[c] = True
+                    continue
+                du[self.dofs(c)] = part
+        return du, singular

@@ -1,0 +1,88 @@
+"""The compiled point and element kernels against independent numpy/scikit-fem oracles.
+
+Tolerances (measured on 800 000 random points, the sample of these tests):
+stresses and plastic strains agree to the last bit on a CPU without AVX-512 (numpy's ``exp``
+is then libm's); with AVX-512 numpy's SIMD ``exp`` differs from libm's by 1 ulp on a few
+percent of inputs, which moves ``J`` and the stresses by <= 1e-15 of their scale: bound 1e-13.
+The consistent tangent differs by up to 1.6e-12 of ``K + G`` (the corner's 2x2 product is
+associated differently): bound 1e-11. Element force and tangent against the scikit-fem forms:
+measured <= 1.1e-15 of the largest entry (P1 and P2): bound 1e-12.
+"""
+
+import numpy as np
+import pytest
+from oracles import assemble_forms, hencky_mohr_coulomb
+
+from cavex import load_config
+from cavex.fem.constitutive import PointMaterial, return_map
+from cavex.fem.expansion import build_model
+from cavex.fem.settings import Numerics
+from cavex.fem.solver import RadialSolver
+
+LAYERS = load_config()[0].layers
+
+
+def random_points(rng, n, material):
+    """Strains from tiny (elastic) to large (plastic, tension) around each layer's yield."""
+    yield_strain = material.tau / material.K
+    spread = [0.1, 1.0, 10.0, 100.0, 1e4]
+    eps_r, eps_t = (np.clip(rng.normal(0, 1, n) * yield_strain * rng.choice(spread, n),
+                            -0.5, 0.5) for _ in range(2))
+    theta_p, gamma_p = (rng.normal(0, 1, n) * yield_strain * rng.choice([0.0, 1.0, 10.0], n)
+                        for _ in range(2))
+    return eps_r, eps_t, theta_p, gamma_p
+
+
+@pytest.mark.parametrize(("dilatancy", "cutoff"), [(0.0, None), (20.0, None), (0.0, 2e6),
+                                                   (10.0, 1e5)])
+def test_point_kernel_equals_the_numpy_return_map(dilatancy, cutoff):
+    rng = np.random.default_rng(7)
+    n = 200_000
+    material = PointMaterial.from_layers(LAYERS, rng.integers(0, 3, n), dilatancy, cutoff)
+    eps_r, eps_t, theta_p, gamma_p = random_points(rng, n, material)
+    kernel = return_map(eps_r, eps_t, theta_p, gamma_p, material)
+    # each point its own group: the oracle chooses the multi-surface return per point, as the
+    # kernel does
+    oracle = hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, material, groups=np.arange(n))
+    assert np.array_equal(kernel["plastic"], oracle.plastic)
+    stress = np.abs(oracle.tau_r) + np.abs(oracle.tau_t) + material.tau
+    strain = np.abs(eps_r) + np.abs(eps_t) + material.tau / material.K
+    for name, scale in (("tau_r", stress), ("tau_t", stress)):
+        assert np.max(np.abs(kernel[name] - getattr(oracle, name)) / scale) <= 1e-13
+    for name in ("theta_p", "gamma_p"):
+        scale = strain + np.abs(getattr(oracle, name))
+        assert np.max(np.abs(kernel[name] - getattr(oracle, name)) / scale) <= 1e-13
+    assert np.max(np.abs(kernel["yield_ratio"] - oracle.yield_ratio)) <= 1e-13
+    for i, name in enumerate(("C_rr", "C_rt", "C_tr", "C_tt")):
+        diff = np.abs(kernel[name] - oracle.tangent[i // 2, i % 2]) / (material.K + material.G)
+        assert np.max(diff) <= 1e-11
+    # the sample covers the elastic, Mohr-Coulomb (both signs of the deviator) and, with a
+    # cut-off, the tension and corner returns
+    plastic = oracle.plastic
+    assert 0.2 < plastic.mean() < 0.8
+    deviator = oracle.tau_t - oracle.tau_r
+    assert np.sum(plastic & (deviator > 0)) > 1000 and np.sum(plastic & (deviator < 0)) > 1000
+    if dilatancy == 0.0:  # volume changes plastically only through the tension cut-off
+        assert np.sum(oracle.theta_p != theta_p) > 1000
+
+
+def test_element_kernel_equals_the_scikit_fem_forms():
+    numerics = Numerics(elements_per_decade=15.0)
+    for degree in (1, 2):
+        disc, _ = build_model(tuple(LAYERS), (0.03, 0.06), 0.0125,
+                              Numerics(degree=degree, elements_per_decade=15.0))
+        solver = RadialSolver(disc, dynamic=True, rho_inf=numerics.rho_inf, wall_velocity=600.0)
+        seed = disc.R_dofs[0]
+        for k in range(1, 31):  # 30 steps of 3 % growth: plastic zone across an interface
+            solver.advance(seed * (1.03 ** k - 1.0), seed * 0.03 * 1.03 ** (k - 1) / 600.0)
+        one = solver.case()
+        rng = np.random.default_rng(3)
+        u = one.u * (1.0 + 0.01 * rng.normal(size=one.u.size))  # a Newton iterate
+        f, band, resp, folded, _ = solver.stack.assemble(u, one.state["theta_p"],
+                                                         one.state["gamma_p"])
+        f_ref, band_ref, resp_ref = assemble_forms(disc, u, one.state["theta_p"],
+                                                   one.state["gamma_p"])
+        assert not folded[0] and resp_ref.plastic.any() and not resp_ref.plastic.all()
+        assert np.array_equal(resp.plastic, resp_ref.plastic)
+        assert np.max(np.abs(f - f_ref)) <= 1e-12 * np.max(np.abs(f_ref))
+        assert np.max(np.abs(band - band_ref)) <= 1e-12 * np.max(np.abs(band_ref))

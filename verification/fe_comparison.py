@@ -1,0 +1,102 @@
+"""FE and closed-form cavity-wall stress side by side for a target's spherical problem at depth L.
+
+The FE side runs on the one solver of :mod:`cavex.fem` (all problems of a call in stacks), with
+the default error target: a problem whose estimated discretisation error exceeds
+:data:`cavex.fem.estimate.DEFAULT_ERROR_TARGET` is refined (up to twice) until it does not.
+"""
+
+from dataclasses import replace
+
+from cavex.analytic.cavity import cavity_solution
+from cavex.analytic.geometry import spherical_problem
+from cavex.fem.estimate import DEFAULT_ERROR_TARGET, MAX_REFINEMENTS
+from cavex.fem.expansion import expand_cavities
+
+BOUNDARIES = ("dynamic", "quasi-static")
+
+
+def fe_problem(target, projectile, depth, velocity, nu=None):
+    """``(layers, interfaces, velocity, radius)`` of the FE problem at nose-tip depth ``depth``
+    (:func:`cavex.analytic.geometry.spherical_problem`; cavity radius = shank radius), with
+    Poisson's ratio ``nu`` for every layer when given."""
+    layers, interfaces = spherical_problem(target, projectile, depth)
+    if nu is not None:
+        layers = [replace(m, nu=nu) for m in layers]
+    return list(layers), list(interfaces), float(velocity), float(projectile.r)
+
+
+def compare_many(requests, error_target=DEFAULT_ERROR_TARGET, max_refinements=MAX_REFINEMENTS,
+                 **numerics):
+    """FE against closed form for many ``(target, projectile, depth, velocity, nu)`` requests,
+    with shared numerics; a list of dicts (see :func:`compare_at_depth`), or of the
+    :class:`~cavex.errors.CavexNumericalError` of a failed FE run."""
+    problems = [fe_problem(*request) for request in requests]
+    results = expand_cavities(problems, error_target=error_target,
+                              max_refinements=max_refinements, **numerics)
+    return [comparison(request[2], problem, result) if result.ok else result.error
+            for request, problem, result in zip(requests, problems, results, strict=True)]
+
+
+def comparison(depth, problem, result):
+    """The JSON-able comparison of one FE result with both closed-form conventions."""
+    layers, interfaces, velocity, radius = problem
+    analytic = {b: cavity_solution(layers, interfaces, velocity, radius, boundary=b)
+                for b in BOUNDARIES}
+    fe = result.cavity_stress
+    return {
+        "depth": float(depth), "velocity": float(velocity), "radius": float(radius),
+        "layers": [m.name or f"layer {i}" for i, m in enumerate(layers)],
+        "interfaces": [float(h) for h in interfaces],
+        "interfaces_final": [float(h) for h in result.interfaces_final],
+        "fe_sigma_r": float(fe),
+        "S": float(fe / layers[0].tau),
+        "analytic_sigma_r": {b: float(s.stress) for b, s in analytic.items()},
+        "relative_difference": {b: float(fe / s.stress - 1.0) for b, s in analytic.items()},
+        "error_estimate": None if result.error_estimate is None else float(result.error_estimate),
+        "refinements": int(result.stats["refinements"]),
+        "fe_plastic_radius": float(result.plastic_radius),
+        "analytic_plastic_radius": {b: float(s.plastic_radius) for b, s in analytic.items()},
+        "settings": result.numerics,
+        "seconds": float(result.stats["seconds"]),
+    }
+
+
+def compare_at_depth(target, projectile, depth, velocity, nu=None,
+                     error_target=DEFAULT_ERROR_TARGET, **numerics):
+    """FE ``sigma_r`` at the cavity wall next to both analytic conventions, as a plain dict.
+
+    Parameters
+    ----------
+    target : Target
+    projectile : Projectile
+    depth : float
+        Nose-tip depth ``L`` (m).
+    velocity : float
+        Cavity expansion velocity ``V`` (m/s).
+    nu : float, optional
+        Poisson's ratio given to every layer (default: each layer's own ``nu``).
+    error_target : float or None
+        Refine the FE run while its estimated error exceeds this (None: never).
+    **numerics
+        Settings of :class:`cavex.fem.Numerics`.
+
+    Returns
+    -------
+    dict
+        ``fe_sigma_r``; ``analytic_sigma_r`` and ``relative_difference`` (``fe/analytic - 1``),
+        each a dict keyed ``"dynamic"`` and ``"quasi-static"``; ``error_estimate``,
+        ``refinements``; ``fe_plastic_radius`` and ``analytic_plastic_radius`` (dict); ``S``
+        (FE wall stress over the wall layer's tau); the problem (``depth``, ``velocity``,
+        ``radius``, ``layers``, ``interfaces``, ``interfaces_final``) and ``settings`` (the
+        numerics of the run reported).
+
+    Raises
+    ------
+    CavexNumericalError
+        The FE run failed.
+    """
+    result, = compare_many([(target, projectile, depth, velocity, nu)], error_target,
+                           **numerics)
+    if isinstance(result, Exception):
+        raise result
+    return result
