@@ -39,16 +39,17 @@ from cavex.fem.constitutive import return_point
 
 
 @njit(cache=True, error_model="numpy")
-def assemble_cases(Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_weights, K, G, lam,
-                   tau, lam_psi, tension, theta_p, gamma_p, el_start, el_count, skip, p, f, band,
-                   tau_r, tau_t, th_p_new, ga_p_new, plastic, yield_ratio, folded, force_scale):
-    """Response, internal force and banded tangent of every case ``c`` with ``not skip[c]``.
+def assemble_cases(u, Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_weights, K, G,
+                   lam, tau, lam_psi, tension, theta_p, gamma_p, el_start, el_count, skip, p, f,
+                   band, tau_r, tau_t, th_p_new, ga_p_new, plastic, yield_ratio, folded,
+                   force_scale):
+    """Response, internal force and banded tangent at the radial dofs ``u`` of every case ``c``
+    with ``not skip[c]``.
 
-    ``Gr``, ``Gt`` (element, point) are the displacement gradients ``du/dR``, ``u/R``; those of
-    a folded case are overwritten by zero. ``f`` and ``band`` must be zero on the cases
-    evaluated; the per-point outputs (``tau_r`` ... ``yield_ratio``) and per-case ``folded``
-    and ``force_scale`` (the largest nodal force one point contributes: Newton's yardstick)
-    are written in place.
+    ``Gr``, ``Gt`` (element, point) receive the displacement gradients ``du/dR``, ``u/R`` (zero
+    in a folded case). ``f`` and ``band`` must be zero on the cases evaluated; the per-point
+    outputs (``tau_r`` ... ``yield_ratio``) and per-case ``folded`` and ``force_scale`` (the
+    largest nodal force one point contributes: Newton's yardstick) are written in place.
     """
     nb = element_dofs.shape[1]
     nq = R_points.shape[1]
@@ -56,6 +57,8 @@ def assemble_cases(Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_weigh
     C = np.empty((4, nq))
     Br = np.empty((nb, nq))
     Bt = np.empty((nb, nq))
+    X = np.empty((nb, nq))
+    Y = np.empty((nb, nq))
     for c in range(el_start.size):
         if skip[c]:
             continue
@@ -63,6 +66,13 @@ def assemble_cases(Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_weigh
         bad = False
         for e in range(e0, e1):
             for q in range(nq):
+                g_r = 0.0
+                g_t = 0.0
+                for b in range(nb):
+                    g_r += u[element_dofs[e, b]] * dNdR[e, b, q]
+                    g_t += u[element_dofs[e, b]] * N[b, q]
+                Gr[e, q] = g_r
+                Gt[e, q] = g_t / R_points[e, q]
                 if not (Gr[e, q] > -1.0 and Gt[e, q] > -1.0):
                     bad = True
         folded[c] = bad
@@ -87,19 +97,26 @@ def assemble_cases(Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_weigh
                 if s > scale or s != s:
                     scale = s
             _element(e, Gr, Gt, C, tau_r, tau_t, element_dofs, dNdR, N, R_points, weights, p,
-                     Br, Bt, f, band)
+                     Br, Bt, X, Y, f, band)
         force_scale[c] = scale
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _element(e, Gr, Gt, C, tau_r, tau_t, element_dofs, dNdR, N, R_points, weights, p, Br, Bt,
-             f, band):
+             X, Y, f, band):
     """Add element ``e``'s internal force and tangent (module docstring) to ``f``, ``band``."""
     nb, nq = Br.shape
-    for b in range(nb):
-        for q in range(nq):
-            Br[b, q] = dNdR[e, b, q] / (1.0 + Gr[e, q])                 # d eps_r / d u_b
-            Bt[b, q] = N[b, q] / (R_points[e, q] * (1.0 + Gt[e, q]))    # d eps_t / d u_b
+    for q in range(nq):
+        W = weights[e, q]
+        inv_r = 1.0 / (1.0 + Gr[e, q])
+        inv_t = 1.0 / (R_points[e, q] * (1.0 + Gt[e, q]))
+        for b in range(nb):
+            br = dNdR[e, b, q] * inv_r                     # d eps_r / d u_b
+            bt = N[b, q] * inv_t                           # d eps_t / d u_b
+            Br[b, q] = br
+            Bt[b, q] = bt
+            X[b, q] = W * ((C[0, q] - tau_r[e, q]) * br + C[1, q] * bt)
+            Y[b, q] = 2.0 * W * (C[2, q] * br + (C[3, q] - tau_t[e, q]) * bt)
     for a in range(nb):
         row = element_dofs[e, a]
         fe = 0.0
@@ -107,10 +124,7 @@ def _element(e, Gr, Gt, C, tau_r, tau_t, element_dofs, dNdR, N, R_points, weight
             fe += weights[e, q] * (tau_r[e, q] * Br[a, q] + 2.0 * tau_t[e, q] * Bt[a, q])
         f[row] += fe
         for b in range(nb):
-            col = element_dofs[e, b]
             k = 0.0
             for q in range(nq):
-                X = (C[0, q] - tau_r[e, q]) * Br[b, q] + C[1, q] * Bt[b, q]
-                Y = C[2, q] * Br[b, q] + (C[3, q] - tau_t[e, q]) * Bt[b, q]
-                k += weights[e, q] * (Br[a, q] * X + 2.0 * Bt[a, q] * Y)
-            band[p + row - col, col] += k
+                k += Br[a, q] * X[b, q] + Bt[a, q] * Y[b, q]
+            band[p + row - element_dofs[e, b], element_dofs[e, b]] += k

@@ -147,8 +147,9 @@ class Stack:
             f[:] = 0.0
             band[:] = 0.0
         m = self.material
-        g_r, g_t = self.displacement_gradients(u)
-        assemble_cases(g_r, g_t, self.element_dofs, self.dNdR, self.N, self.R_points,
+        if not hasattr(self, "_gradients"):
+            self._gradients = (np.zeros(self.R_points.shape), np.zeros(self.R_points.shape))
+        assemble_cases(u, *self._gradients, self.element_dofs, self.dNdR, self.N, self.R_points,
                        self.weights, self.force_weights, m.K, m.G, m.lam, m.tau, m.lam_psi,
                        m.tension, theta_p, gamma_p, self.el_start, self.el_count, skip,
                        self.degree, f, band, resp.tau_r, resp.tau_t, resp.theta_p,
