@@ -52,8 +52,7 @@ def run_cases(function, cases, *, store=None, scheduler=None, workers=None, prog
     progress : bool, optional
         Progress bar with ETA on stderr; None shows it when stderr is a terminal.
     chunk_size : int, optional
-        Cases per work unit; default: about two work units per worker (at most
-        :data:`MAX_CHUNK` cases each), consecutive cases together.
+        Consecutive cases per work unit; default: see :func:`chunks`.
 
     Returns
     -------
@@ -252,13 +251,15 @@ def _check_workers(workers):
 # --- execution ----------------------------------------------------------------------------------
 
 def chunks(todo, parallelism, chunk_size=None):
-    """Consecutive chunks of ``todo``: ``chunk_size`` cases, or about two per worker (at most
-    :data:`MAX_CHUNK`)."""
-    if chunk_size is None:
-        chunk_size = min(MAX_CHUNK, max(1, math.ceil(len(todo) / (2 * parallelism))))
-    require(isinstance(chunk_size, int) and not isinstance(chunk_size, bool) and chunk_size >= 1,
-            "chunk_size", "an integer >= 1", chunk_size)
-    return [todo[i:i + chunk_size] for i in range(0, len(todo), chunk_size)]
+    """``todo`` split into work units: ``chunk_size`` consecutive cases, or (default) one
+    chunk per worker, at most :data:`MAX_CHUNK` cases each, the cases dealt out in turn so that
+    every chunk gets its share of cheap and expensive ones (a grid is ordered by velocity)."""
+    if chunk_size is not None:
+        require(isinstance(chunk_size, int) and not isinstance(chunk_size, bool)
+                and chunk_size >= 1, "chunk_size", "an integer >= 1", chunk_size)
+        return [todo[i:i + chunk_size] for i in range(0, len(todo), chunk_size)]
+    n = min(len(todo), max(parallelism, math.ceil(len(todo) / MAX_CHUNK)))
+    return [todo[i::n] for i in range(n)]
 
 
 def _execute(function, todo, scheduler, workers, finished, chunk_size):
