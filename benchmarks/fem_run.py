@@ -31,7 +31,6 @@ def main(repeats=11):
     expand_cavity([CONCRETE], [], 500.0, 0.0125)  # warm-up (imports, caches)
     with_estimate, result = timed(repeats)
     main_only, plain = timed(repeats, error_estimate=False)
-    forms, forms_result = timed(max(1, repeats // 4), error_estimate=False, assembly="forms")
     tracemalloc.start()
     expand_cavity([CONCRETE], [], 500.0, 0.0125)
     _, traced_peak = tracemalloc.get_traced_memory()
@@ -46,8 +45,6 @@ def main(repeats=11):
     print(f"default run        : {with_estimate:.3f} s median of {repeats} (incl. error estimate)")
     print(f"main run only      : {main_only:.3f} s median of {repeats}")
     print(f"per element-step   : {1e6 * main_only / element_steps:.2f} us")
-    print(f"forms path         : {forms:.3f} s; |fast/forms - 1| = "
-          f"{abs(plain.cavity_stress / forms_result.cavity_stress - 1):.2e}")
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"peak traced memory : {traced_peak / 2**20:.1f} MB (allocations of one run)")
     print(f"peak RSS           : {rss:.1f} MB (whole process, interpreter and libraries)")

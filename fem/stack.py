@@ -4,18 +4,17 @@ Every computation of :mod:`cavex.fem` runs on a stack; a single problem is a sta
 cases are concatenated element by element and dof by dof; the compiled kernel
 (:func:`cavex.fem.element.assemble_cases`) then runs once per Newton iteration over all
 (case, element, point) triples. The global tangent is block diagonal with the bandwidth of one
-case, so the whole stack is one ``scipy.linalg.solve_banded`` call; the prescribed dofs become
-identity rows and columns. Partial pivoting never leaves a block (the entries coupling two
-blocks are exact zeros), so every block is factorised with the same operations as alone: a case
-gives the same bits alone and inside any stack.
+case, solved block by block by the compiled LU of :mod:`cavex.fem.banded`; the prescribed dofs
+become identity rows and columns. Every block is factorised with the same operations as alone:
+a case gives the same bits alone and inside any stack.
 """
 
 from types import SimpleNamespace
 
 import numpy as np
-from scipy.linalg import LinAlgError, solve_banded
 from scipy.sparse import csr_matrix
 
+from cavex.fem.banded import solve_blocks
 from cavex.fem.constitutive import PointMaterial
 from cavex.fem.element import assemble_cases
 
@@ -171,34 +170,15 @@ class Stack:
         case; their increment is zero); fixed dofs get identity rows. Returns the increment and
         the cases whose block is singular. ``band`` is overwritten (pass a scratch copy).
 
-        Only the blocks solved are passed to LAPACK (gathered when some are skipped): partial
-        pivoting never leaves a block, so each is factorised exactly as it would be alone.
+        Each block is factorised alone (:func:`cavex.fem.banded.solve_blocks`), so a case gets
+        the same bits in any stack.
         """
-        p = self.degree
         flat = band.reshape(-1)
         flat[self.fixed_entries] = 0.0
         flat[self.fixed_diagonal] = 1.0
         rhs = np.where(self.free, rhs, 0.0)
         du = np.zeros_like(rhs)
         singular = np.zeros(self.n_cases, dtype=bool)
-        solve = np.flatnonzero(~skip)
-        if solve.size == 0:
-            return du, singular
-        if solve.size < self.n_cases:
-            cols = ranges(self.dof_start[solve], self.dof_count[solve])
-            band, rhs = band[:, cols], rhs[cols]
-        else:
-            cols = slice(None)
-        try:
-            du[cols] = solve_banded((p, p), band, rhs, check_finite=False)
-        except (LinAlgError, ValueError):
-            offsets = starts(self.dof_count[solve])
-            for c, start in zip(solve, offsets, strict=True):
-                s = slice(start, start + self.dof_count[c])
-                try:
-                    part = solve_banded((p, p), band[:, s], rhs[s], check_finite=False)
-                except (LinAlgError, ValueError):
-                    singular[c] = True
-                    continue
-                du[self.dofs(c)] = part
+        solve_blocks(band, rhs, self.degree, self.dof_start, self.dof_count, ~skip, du,
+                     singular)
         return du, singular
