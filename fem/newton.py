@@ -30,6 +30,7 @@ from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
+from numba import njit
 
 MAX_ITERATIONS = 30     # Newton iterations per attempt
 SHRINK_FRACTION = 0.25  # continue on a smaller stack when at most this fraction still iterates
@@ -86,15 +87,15 @@ def newton(stack, w, params, dynamic, tol, first_iteration=1):
     done = ~w["active"]
     reasons = np.full(k, None, dtype=object)
     iterations = np.zeros(k, dtype=int)
-    buffers = None
+    buffers = system = None
     for iteration in range(first_iteration, MAX_ITERATIONS + 1):
         buffers = stack.assemble(u, w["theta_p"], w["gamma_p"], done, buffers)
         f, band, resp, folded, force_scale = buffers
         _fail(reasons, done, folded, "non-positive stretch")
-        a, r_free, jac, scale = equations(stack, w, params, dynamic, u, f, band, force_scale)
-        _fail(reasons, done, ~stack.per_case_all(np.isfinite(r_free)), "non-finite residual")
-        with np.errstate(invalid="ignore"):
-            converged = stack.per_case_max(np.abs(r_free)) <= tol * scale
+        system = equations(stack, w, params, dynamic, u, f, band, force_scale, done, system)
+        a, r_free, jac, scale, r_max = system
+        _fail(reasons, done, np.isnan(r_max), "non-finite residual")
+        converged = r_max <= tol * scale
         if iteration > 1:
             newly = converged & ~done
             iterations[newly] = iteration - 1
@@ -130,37 +131,77 @@ def predict(stack, w, dynamic):
     return np.where(stack.free & w["active"][dof_case], predicted, u)
 
 
-def equations(stack, w, params, dynamic, u, f, band, force_scale):
-    """``(a, r_free, jac, scale)`` of the step's equations at the iterate ``u`` (stack layout;
-    ``r_free`` is zero at the prescribed dofs; ``scale`` per case: the largest of the point
-    force yardstick, the reactions and the wall load)."""
+def equations(stack, w, params, dynamic, u, f, band, force_scale, skip=None, out=None):
+    """``(a, r_free, jac, scale, r_max)`` of the step's equations at the iterate ``u`` (stack
+    layout; ``r_free`` is zero at the prescribed dofs; per case ``scale``, the largest of the
+    point force yardstick, the reactions and the wall load, and ``r_max = max |r_free|``, NaN
+    where the residual is not finite). ``jac`` is a buffer that :meth:`Stack.solve` may
+    overwrite. Cases with ``skip`` keep their values in ``out`` (the
+    previous call's result, reused in place)."""
+    k = stack.n_cases
+    if out is None:
+        out = (np.zeros(stack.ndof), np.zeros(stack.ndof), np.zeros_like(band), np.zeros(k),
+               np.zeros(k))
+    if skip is None:
+        skip = np.zeros(k, dtype=bool)
+    a, r_free, jac, scale, r_max = out
     p = params
-    if dynamic:
-        dt_d = w["dt"][stack.dof_case]
-        c_m = ((1.0 - p.alpha_m) / (p.beta * w["dt"] * w["dt"]))[stack.dof_case]
-        a = ((u - w["u0"] - dt_d * w["v0"]) / (p.beta * dt_d * dt_d)
-             - (0.5 / p.beta - 1.0) * w["a0"])
-        inertia = stack.mass @ ((1.0 - p.alpha_m) * a + p.alpha_m * w["a0"])
-        residual = inertia + (1.0 - p.alpha_f) * f + p.alpha_f * w["f0"]
-        jac = (1.0 - p.alpha_f) * band + c_m[None, :] * stack.mass_band
-    else:
-        a = np.zeros_like(u)
-        residual = f.copy()
-        jac = band.copy()
-    scale = np.maximum(force_scale, 1e-300)
-    if stack.pressure_control:
-        r_wall = stack.R_dofs[stack.wall] + u[stack.wall]
-        residual[stack.wall] -= w["load"] * 4.0 * np.pi * r_wall ** 2
-        jac[stack.degree, stack.wall] -= w["load"] * 8.0 * np.pi * r_wall
-        scale = np.maximum(scale, np.abs(w["load"]) * 4.0 * np.pi
-                           * stack.R_dofs[stack.wall] ** 2)
-    r_free = np.where(stack.free, residual, 0.0)
-    with np.errstate(invalid="ignore"):
-        if stack.fixed.size:
-            reaction = np.zeros(stack.n_cases)
-            np.maximum.at(reaction, stack.dof_case[stack.fixed], np.abs(residual[stack.fixed]))
-            scale = np.maximum(scale, reaction)
-    return a, r_free, jac, scale
+    step_equations(u, w["u0"], w["v0"], w["a0"], w["f0"], f, band, stack.mass_band, w["dt"],
+                   w["load"], stack.dof_start, stack.dof_count, stack.free, skip, stack.degree,
+                   p.alpha_m, p.alpha_f, p.beta, dynamic, stack.pressure_control,
+                   stack.outer_fixed, stack.R_dofs, force_scale, a, r_free, jac, scale, r_max)
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def step_equations(u, u0, v0, a0, f0, f, band, mass_band, dt, load, dof_start, dof_count, free,
+                   skip, p, alpha_m, alpha_f, beta, dynamic, pressure, outer_fixed, R_dofs,
+                   force_scale, a, r_free, jac, scale, r_max):
+    """Compiled body of :func:`equations` (module docstring: the generalized-alpha residual
+    and Newton matrix; the inertia from the banded mass matrix)."""
+    for c in range(dof_start.size):
+        if skip[c]:
+            continue
+        s0, m = dof_start[c], dof_count[c]
+        h = dt[c]
+        c_m = (1.0 - alpha_m) / (beta * h * h)
+        for i in range(s0, s0 + m):
+            if dynamic:
+                a[i] = (u[i] - u0[i] - h * v0[i]) / (beta * h * h) - (0.5 / beta - 1.0) * a0[i]
+            else:
+                a[i] = 0.0
+        biggest = 0.0
+        finite = True
+        reaction = 0.0
+        for i in range(s0, s0 + m):
+            if dynamic:
+                inertia = 0.0
+                for j in range(max(s0, i - p), min(s0 + m, i + p + 1)):
+                    inertia += mass_band[p + i - j, j] * ((1.0 - alpha_m) * a[j]
+                                                          + alpha_m * a0[j])
+                residual = inertia + (1.0 - alpha_f) * f[i] + alpha_f * f0[i]
+                for r in range(2 * p + 1):
+                    jac[r, i] = (1.0 - alpha_f) * band[r, i] + c_m * mass_band[r, i]
+            else:
+                residual = f[i]
+                for r in range(2 * p + 1):
+                    jac[r, i] = band[r, i]
+            if pressure and i == s0:
+                r_wall = R_dofs[i] + u[i]
+                residual -= load[c] * 4.0 * np.pi * r_wall * r_wall
+                jac[p, i] -= load[c] * 8.0 * np.pi * r_wall
+            if free[i]:
+                r_free[i] = residual
+                finite = finite and np.isfinite(residual)
+                biggest = max(biggest, abs(residual))
+            else:
+                r_free[i] = 0.0
+                reaction = max(reaction, abs(residual))
+        r_max[c] = biggest if finite else np.nan
+        sc = max(force_scale[c], 1e-300, reaction)
+        if pressure:
+            sc = max(sc, abs(load[c]) * 4.0 * np.pi * R_dofs[s0] * R_dofs[s0])
+        scale[c] = sc
 
 
 def _fail(reasons, done, flags, why):
@@ -283,16 +324,16 @@ def newton_line_search(stack, w, params, dynamic, tol):
         f, band, resp, folded, force_scale = stack.assemble(u, w["theta_p"], w["gamma_p"])
         if folded[0]:
             raise StepFailure("non-positive stretch")
-        a, r_free, jac, scale = equations(stack, w, params, dynamic, u, f, band, force_scale)
-        r = r_free[free]
-        if not np.all(np.isfinite(r)):
+        a, r_free, jac, scale, r_max = equations(stack, w, params, dynamic, u, f, band,
+                                                 force_scale)
+        if np.isnan(r_max[0]):
             raise StepFailure("non-finite residual")
-        return r, scale[0], jac, u, a, f, resp
+        return r_free[free], scale[0], jac, u, a, f, resp
 
     def solve(out, r):
         rhs = np.zeros(stack.ndof)
         rhs[free] = r
-        du, singular = stack.solve(out[2], rhs, np.zeros(1, dtype=bool))
+        du, singular = stack.solve(out[2].copy(), rhs, np.zeros(1, dtype=bool))
         if singular[0]:
             raise StepFailure("singular tangent")
         return du[free]

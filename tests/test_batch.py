@@ -155,10 +155,9 @@ def test_sweep_killed_and_resumed_computes_only_the_missing_cases(tmp_path):
     out = tmp_path / "out"
     script = textwrap.dedent(f"""
         from cavex.verification.batch import run_sweep
-        run_sweep({str(sweep)!r}, {str(out)!r}, workers=1)
+        run_sweep({str(sweep)!r}, {str(out)!r}, workers=1, chunk_size=2)
     """)
-    # -P: import the installed package, not the checkout's cavex/ folder
-    process = subprocess.Popen([sys.executable, "-P", "-c", script])
+    process = subprocess.Popen([sys.executable, "-c", script])
     try:
         _wait_for_cases(out / "cases", 4, process)
     finally:

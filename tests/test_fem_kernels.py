@@ -104,7 +104,7 @@ def test_block_banded_solver_equals_lapack():
         band = rng.normal(size=(2 * p + 1, n))
         band[p, : counts[:3].sum()] *= 5.0      # dominant diagonals in the small blocks
         band[p, starts[3]:starts[3] + 40] *= 1e-3  # pivoting needed in block 3
-        for c, (s, m) in enumerate(zip(starts, counts, strict=True)):  # no coupling entries
+        for s, m in zip(starts, counts, strict=True):  # no coupling entries
             for k in range(1, p + 1):
                 band[p - k, s:s + min(k, m)] = 0.0
                 band[p + k, s + m - min(k, m):s + m] = 0.0

@@ -107,10 +107,9 @@ def test_store_resume_computes_only_missing_cases(tmp_path):
         from cavex.verification.cases import probe_cases
         from cavex.verification.runner import run_cases
         run_cases(probe_cases, json.loads({json.dumps(json.dumps(cases))}),
-                  store={str(store)!r}, workers=1)
+                  store={str(store)!r}, workers=1, chunk_size=1)
     """)
-    # -P: import the installed package, not the checkout's cavex/ folder
-    process = subprocess.Popen([sys.executable, "-P", "-c", script])
+    process = subprocess.Popen([sys.executable, "-c", script])
     try:
         _wait_for_files(store, 5, process)
     finally:

@@ -347,7 +347,8 @@ def _id_text(value):
 
 # --- running and loading ------------------------------------------------------------------------
 
-def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None):
+def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None,
+              chunk_size=None):
     """Validate, run (resuming from ``out_dir``) and return the sweep as one Dataset.
 
     Parameters
@@ -362,6 +363,10 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
         Overrides ``sweep.workers`` (local processes).
     progress : bool, optional
         Progress bar on stderr (None: when stderr is a terminal).
+    chunk_size : int, optional
+        Cases per work unit (default: one chunk per worker, at most
+        :data:`cavex.verification.runner.MAX_CHUNK`); a run killed and resumed recomputes the
+        cases of the chunks that had not finished.
 
     Returns
     -------
@@ -377,9 +382,11 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
     results = run_cases(fe_cases, cases, store=os.path.join(out_dir, STORE_DIR),
                         scheduler=scheduler if scheduler is not None else sweep.scheduler,
                         workers=workers if workers is not None else sweep.workers,
-                        progress=progress)
+                        progress=progress, chunk_size=chunk_size)
     dataset = _dataset(description, {r["id"]: r for r in results})
-    write_table(dataset, os.path.join(out_dir, RESULTS_FILE))
+    # exactly as computed: the file mirrors the case store (it loads back identical to
+    # load_sweep) and holds the wall times, so it is not a reproducible result file anyway
+    write_table(dataset, os.path.join(out_dir, RESULTS_FILE), reproducible=False)
     return dataset
 
 

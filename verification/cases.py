@@ -23,6 +23,7 @@ import time
 import uuid
 from dataclasses import fields
 
+from cavex.analytic.cavity import check_problem
 from cavex.config import load_config, parse_projectile, parse_target
 from cavex.errors import CavexInputError, CavexNumericalError, require
 from cavex.errors import is_finite_number as _finite
@@ -73,6 +74,8 @@ def fe_cases(chunk):
 
 def _fe_request(case):
     """``((target, projectile, depth, velocity, nu), numerics, error_target)`` of a case."""
+    from cavex.verification.fe_comparison import fe_problem
+
     unknown = sorted(set(case) - CASE_KEYS)
     if unknown:
         raise CavexInputError(f"unknown key '{unknown[0]}' in case "
@@ -83,8 +86,9 @@ def _fe_request(case):
     error_target = case.get("error_target", DEFAULT_ERROR_TARGET)
     require(error_target is None or (_finite(error_target) and 0 < error_target < 1),
             "error_target", "null or a number in (0, 1)", error_target)
-    return ((target, projectile, case["depth"], case["velocity"], case.get("nu")), numerics,
-            None if error_target is None else float(error_target))
+    request = (target, projectile, case["depth"], case["velocity"], case.get("nu"))
+    check_problem(*fe_problem(*request), "dynamic")  # a bad case fails alone, not its chunk
+    return request, numerics, None if error_target is None else float(error_target)
 
 
 def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, numerics=None,

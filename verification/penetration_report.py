@@ -1,4 +1,9 @@
-"""The ``cavex penetrate`` job: trajectories, the Table 2 comparison, CSV and PNG outputs."""
+"""The ``cavex penetrate`` job: trajectories, the Table 2 comparison, CSV and PNG outputs.
+
+The CSV files carry :data:`~cavex.verification.number_format.TRAJECTORY_DIGITS` significant
+digits (the integrator's tolerance; see :mod:`cavex.verification.number_format`), so that they
+are the same when regenerated on another CPU.
+"""
 
 import csv
 import io
@@ -7,6 +12,7 @@ from pathlib import Path
 
 from cavex.analytic.penetration import penetrate
 from cavex.analytic.resistance import ClosedFormResistance
+from cavex.verification.number_format import format_number
 from cavex.verification.runner import write_text_atomic
 from cavex.verification.table2 import table2_comparison
 
@@ -63,10 +69,12 @@ def _columns(rows):
 
 
 def _write_csv(path, columns):
+    """``columns`` as CSV, every number through :func:`format_number`."""
     text = io.StringIO(newline="")
     writer = csv.writer(text)
     writer.writerow(columns)
-    writer.writerows(zip(*columns.values(), strict=True))
+    writer.writerows([format_number(x) for x in row]
+                     for row in zip(*columns.values(), strict=True))
     write_text_atomic(path, text.getvalue())
     return path
 

@@ -5,6 +5,11 @@ shared case runner), adds the closed forms (derived dynamic, derived quasi-stati
 printed model), and writes ``report.md``, ``report.html``, PNG figures, a pyvista picture of the
 cut-open layered sphere and ``grid.nc`` (every number the report prints) into ``out_dir``.
 :func:`verify_main` is the ``cavex verify`` job.
+
+The written files are reproducible: the FE table is rounded to the digits the numerics support
+(:mod:`cavex.verification.number_format`) before anything is computed from it, the trajectory
+numbers in ``grid.nc`` carry the integrator's digits, and wall times and the table's creation
+time are only in the returned summary (printed by ``cavex verify``), not in the files.
 """
 
 import json
@@ -17,6 +22,7 @@ from cavex.errors import CavexInputError
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
 from cavex.verification import report_plots as plots
 from cavex.verification import report_text as text
+from cavex.verification.number_format import TRAJECTORY_DIGITS, round_dataset, round_nested
 from cavex.verification.report_analysis import all_stats, analyse, layer_names
 from cavex.verification.report_html import markdown_to_html
 from cavex.verification.table import build_table, write_table
@@ -90,7 +96,10 @@ def figures(grid, target, out):
 
 
 def write_grid(grid, path, extra):
-    """``grid.nc`` (netCDF3, scipy engine) with the report's extra attributes as JSON."""
+    """``grid.nc`` (netCDF3, scipy engine) with the report's extra attributes as JSON.
+
+    Through :func:`~cavex.verification.table.write_table`: rounded, without the creation time.
+    """
     ds = grid.copy()
     for key, value in extra.items():
         ds.attrs[key] = value if isinstance(value, str) else json.dumps(value)
@@ -133,7 +142,9 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     -------
     dict
         ``out_dir``, ``files``, ``cells``, ``failed``, ``seconds`` (wall time), ``table_seconds``,
-        ``conclusions`` (list of str), ``picture`` (message), ``stats``.
+        ``created`` (the FE table's creation time), ``conclusions`` (list of str), ``picture``
+        (message), ``stats``. The wall times and the creation time are not written into any
+        file (they would differ on every run).
     """
     started = time.perf_counter()
     out = Path(out_dir)
@@ -144,6 +155,8 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     fe = build_table(target, projectile, v, d, nu=nu, numerics=numerics,
                      error_target=error_target, scheduler=scheduler, workers=workers,
                      store=store, progress=progress)
+    created = fe.attrs.get("created")
+    fe = round_dataset(fe)  # the numbers grid.nc stores: everything below derives from them
     table_seconds = time.perf_counter() - started
     grid = analyse(fe, target, projectile)
     trajectory = trajectories(target, projectile, fe)
@@ -151,12 +164,12 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     paths = figures(grid, target, out)
     stats = all_stats(grid, target)
     lines = text.conclusions(grid, target, stats)
-    seconds = time.perf_counter() - started
     info = {"quick": quick, "cells": int(grid["failed"].size), "failed": int(grid["failed"].sum()),
-            "table_seconds": table_seconds, "seconds": seconds, "picture": pic["message"]}
+            "picture": pic["message"]}
     files = {**{k: str(p) for k, p in paths.items()},
              "grid": str(write_grid(grid, out / "grid.nc",
-                                    {"report": info, "trajectories": trajectory,
+                                    {"report": info,
+                                     "trajectories": round_nested(trajectory, TRAJECTORY_DIGITS),
                                      "conclusions": lines}))}
     if pic["path"] is not None:
         files["sphere"] = str(pic["path"])
@@ -168,7 +181,9 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     (out / "report.html").write_text(markdown_to_html(markdown, "cavex verification report"),
                                      encoding="utf-8")
     files.update(report=str(out / "report.md"), html=str(out / "report.html"))
-    return {"out_dir": str(out), "files": files, "conclusions": lines, "stats": stats, **info}
+    return {"out_dir": str(out), "files": files, "conclusions": lines, "stats": stats, **info,
+            "seconds": time.perf_counter() - started, "table_seconds": table_seconds,
+            "created": created}
 
 
 def _settings_lines(grid, info):
@@ -182,9 +197,7 @@ def _settings_lines(grid, info):
         f"- FE: Poisson's ratio {settings.get('nu') or 'of each layer'}, numerics "
         f"`{json.dumps(settings.get('numerics', {}), sort_keys=True)}`",
         f"- target fingerprint `{grid.attrs.get('fingerprint', '?')}`; versions "
-        f"`{grid.attrs.get('versions', '?')}`; table created {grid.attrs.get('created', '?')}",
-        f"- wall time {info['seconds']:.1f} s (FE table {info['table_seconds']:.1f} s); every "
-        "number below is in `grid.nc`",
+        f"`{grid.attrs.get('versions', '?')}`; every number below is in `grid.nc`",
         "- relative error = (analytic - FE) / FE; S = sigma_r / tau of the layer at the cavity "
         "wall (the derived model's cavity switch) for every model",
     ]
@@ -232,7 +245,8 @@ def summary_text(summary):
     """Printable summary of :func:`verify`'s result."""
     return "\n".join([
         f"cells   {summary['cells']} ({summary['failed']} failed)",
-        f"time    {summary['seconds']:.1f} s (FE table {summary['table_seconds']:.1f} s)",
+        f"time    {summary['seconds']:.1f} s (FE table {summary['table_seconds']:.1f} s, "
+        f"created {summary.get('created') or '?'})",
         f"picture {summary['picture']}",
         *(f"- {line}" for line in summary["conclusions"]),
         f"wrote   {summary['files']['report']} (+ html, PNGs, grid.nc) in {summary['out_dir']}",

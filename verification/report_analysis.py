@@ -7,6 +7,11 @@ holds every number the report prints.
 Conventions: the relative error of a closed form is ``(analytic - FE) / FE``; ``S`` is
 ``sigma_r`` over ``tau`` of the layer at the cavity wall (the FE table's ``wall_layer``, the
 derived model's ``"cavity"`` switch) for every model, so that the curves are comparable.
+
+The FE and closed-form values are rounded to the digits the numerics support
+(:func:`cavex.verification.number_format.round_dataset`) before the errors are computed, so
+that every derived number is a function of the numbers ``grid.nc`` stores and comes out the
+same on every CPU.
 """
 
 import math
@@ -18,6 +23,7 @@ from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.paper_model import paper_stress
 from cavex.errors import CavexInputError
+from cavex.verification.number_format import round_dataset
 
 # (key, label, sigma_r variable) of each closed form, in report order.
 MODELS = (("dynamic", "derived dynamic", "sigma_r_dynamic"),
@@ -81,7 +87,7 @@ def add_errors(grid):
     fe = out["sigma_r"].where(~failed)
     for key, label, var in MODELS:
         rel = (out[var] - fe) / fe
-        out[f"rel_err_{key}"] = rel.assign_attrs(long_name=f"({label} - FE) / FE")
+        out[f"rel_err_{key}"] = rel.assign_attrs(units="1", long_name=f"({label} - FE) / FE")
         out[f"validity_{key}"] = validity_codes(rel, failed)
         resolved = out["error_estimate"] < RESOLVED_FRACTION * abs(rel)
         out[f"resolved_{key}"] = xr.where(failed, -1, resolved.astype(np.int8)).astype(
@@ -105,7 +111,8 @@ def add_S(grid, target):
     taus = np.array([m.tau for m in target.layers])
     tau = xr.DataArray(taus[out["wall_layer"].values.astype(int)], dims=out["wall_layer"].dims)
     for key, _, var in MODELS:
-        out[f"S_{key}"] = (out[var] / tau).assign_attrs(long_name=f"{var} / tau of wall layer")
+        out[f"S_{key}"] = (out[var] / tau).assign_attrs(units="1",
+                                                         long_name=f"{var} / tau of wall layer")
     return out
 
 
@@ -117,14 +124,17 @@ def add_error_parts(grid):
              "convention": out["sigma_r_quasi_static"] - out["sigma_r_dynamic"],
              "idealisation": out["sigma_r_dynamic"] - fe}
     for name, text in ERROR_PARTS:
-        out[f"part_{name}"] = (parts[name] / fe).assign_attrs(long_name=text + " (over FE)")
+        out[f"part_{name}"] = (parts[name] / fe).assign_attrs(units="1",
+                                                              long_name=text + " (over FE)")
     return out
 
 
 def analyse(grid, target, projectile):
-    """The FE grid with every analytic and derived report quantity added."""
-    grid = grid.transpose("velocity", "depth", ...)
-    return add_error_parts(add_S(add_errors(add_analytic(grid, target, projectile)), target))
+    """The FE grid with every analytic and derived report quantity added (the FE and
+    closed-form values rounded first, see the module docstring)."""
+    grid = round_dataset(add_analytic(grid.transpose("velocity", "depth", ...), target,
+                                      projectile))
+    return add_error_parts(add_S(add_errors(grid), target))
 
 
 def layer_mask(grid, index):

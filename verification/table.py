@@ -38,6 +38,7 @@ from cavex.fem.estimate import DEFAULT_ERROR_TARGET
 from cavex.verification.cases import fe_cases, make_fe_cases
 from cavex.verification.cases import projectile_table as projectile_to_table
 from cavex.verification.cases import target_table as target_to_table
+from cavex.verification.number_format import round_dataset
 from cavex.verification.runner import run_cases
 
 DEFAULT_VELOCITIES = tuple(np.linspace(0.0, 1200.0, 13))
@@ -316,11 +317,25 @@ def _version(name):
 
 # --- files ------------------------------------------------------------------------------------
 
-def write_table(ds, path):
-    """Write ``ds`` as netCDF3 (scipy engine) atomically: a temporary file, then ``os.replace``."""
+# attributes that would make the same table a different file: when it was made, where it was read
+UNREPRODUCIBLE_ATTRS = ("created", "source")
+
+
+def write_table(ds, path, *, reproducible=True):
+    """Write ``ds`` as netCDF3 (scipy engine) atomically: a temporary file, then ``os.replace``.
+
+    ``reproducible`` (default): the same table computed on another CPU gives the same file;
+    float data variables are rounded to the significant digits the numerics support
+    (:func:`cavex.verification.number_format.round_dataset`) and the attributes in
+    :data:`UNREPRODUCIBLE_ATTRS` are left out. ``ds`` itself is not changed. False: ``ds`` is
+    written exactly as it is.
+    """
     path = Path(path)
     if path.parent != Path(""):
         path.parent.mkdir(parents=True, exist_ok=True)
+    if reproducible:
+        ds = round_dataset(ds)
+        ds.attrs = {k: v for k, v in ds.attrs.items() if k not in UNREPRODUCIBLE_ATTRS}
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
         ds.to_netcdf(tmp, engine="scipy")
