@@ -1,11 +1,12 @@
 """Throughput of ``cavex table`` end to end, measured through the command a user runs.
 
-Runs ``cavex table`` as a subprocess on two grids of the default target (Table 1, each layer's
+Runs ``cavex table`` as a subprocess on three grids of the default target (Table 1, each layer's
 own nu, default FE settings: error estimate on, every cell refined while its estimate exceeds
 0.5 %, at most twice):
 
 - ``issue``: 7 velocities 0..1200 m/s x the 8 depths 0.15..0.9 m of issue 8 (the table adds
   the wall-layer switch depths and their refinement depths);
+- ``default``: ``cavex table`` without a grid (13 velocities x 31 depths, + switch depths);
 - ``1200``: 30 velocities 0..1200 m/s x 40 depths 0.12..1.30 m (1200 requested cells, more
   with the switch depths).
 
@@ -31,6 +32,7 @@ import psutil
 import xarray as xr
 
 GRIDS = {
+    "default": (None, None),
     "issue": ([0, 200, 400, 600, 800, 1000, 1200],
               [0.15, 0.25, 0.35, 0.45, 0.55, 0.7, 0.8, 0.9]),
     "1200": (np.round(np.linspace(0.0, 1200.0, 30), 6).tolist(),
@@ -51,8 +53,9 @@ def tree_rss(process):
 
 
 def run_once(velocities, depths, workers, out):
-    command = [sys.executable, "-m", "cavex.cli", "table", "--velocities",
-               *map(str, velocities), "--depths", *map(str, depths), "-o", out]
+    command = [sys.executable, "-m", "cavex.cli", "table", "-o", out]
+    if velocities is not None:
+        command += ["--velocities", *map(str, velocities), "--depths", *map(str, depths)]
     if workers:
         command += ["--workers", str(workers)]
     started = time.perf_counter()

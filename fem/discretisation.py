@@ -91,12 +91,6 @@ class Discretisation:
         M = asm(forms.mass, self.mass_basis, rho=self._rho_mass)
         return M[np.argsort(self.radial)][:, np.argsort(self.radial)].tocsr()
 
-    def new_state(self):
-        """Zero plastic strains at every quadrature point."""
-        shape = self.R_points.shape
-        return {"theta_p": np.zeros(shape), "gamma_p": np.zeros(shape),
-                "eq_p": np.zeros(shape)}
-
     def displacement_gradients(self, u):
         """``(lambda_r - 1, lambda_t - 1) = (du/dR, u/R)`` at the reduced quadrature points."""
         ue = u[self.element_dofs]  # (nel, nb)

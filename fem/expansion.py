@@ -22,7 +22,7 @@ from cavex.analytic.cavity import check_problem
 from cavex.errors import CavexInputError, require
 from cavex.fem.discretisation import Discretisation
 from cavex.fem.estimate import estimate_errors, refine_above
-from cavex.fem.fields import cauchy_stresses, current_point_radii, plastic_radius
+from cavex.fem.fields import cauchy_stresses, current_point_radii, plastic_radius, wall_stress
 from cavex.fem.mesh import element_layers, reference_mesh
 from cavex.fem.result import ExpansionResult
 from cavex.fem.settings import make_numerics
@@ -114,10 +114,9 @@ class Recorder:
             return
         one = solver.case(case)
         disc = one.disc
-        a = float(disc.R_dofs[0] + one.u[0])
         self.history["time"].append(one.t if self.dynamic else 0.0)
-        self.history["radius"].append(a)
-        self.history["wall_stress"].append(one.wall_force / (4.0 * np.pi * a * a))
+        self.history["radius"].append(float(disc.R_dofs[0] + one.u[0]))
+        self.history["wall_stress"].append(wall_stress(disc, one.u, one.wall_force))
         self.history["plastic_radius"].append(plastic_radius(disc, one.u, one.response,
                                                              one.state))
         if step in self.keep:
@@ -186,7 +185,6 @@ def _result(solver, c, problem, vertices, numerics, error, seconds, recorder):
              "seconds": seconds, "refinements": 0}
     if error is not None:
         return ExpansionResult(math.nan, None, math.nan, (), settings, stats=stats, error=error)
-    a = float(disc.R_dofs[0] + one.u[0])
     r_nodes = disc.R_dofs + one.u
     fields = {"u": one.u.copy(), "r_nodes": r_nodes, "R_nodes": disc.R_dofs.copy()}
     energy = {"work": one.work, "kinetic": solver.kinetic_energy(c),
@@ -199,7 +197,7 @@ def _result(solver, c, problem, vertices, numerics, error, seconds, recorder):
                       layer=disc.point_layer.ravel(), snapshots=recorder.snapshots)
         history = {k: np.asarray(v) for k, v in recorder.history.items()}
     return ExpansionResult(
-        cavity_stress=float(one.wall_force / (4.0 * np.pi * a * a)), error_estimate=None,
+        cavity_stress=float(wall_stress(disc, one.u, one.wall_force)), error_estimate=None,
         plastic_radius=plastic_radius(disc, one.u, one.response, one.state),
         interfaces_final=tuple(float(r_nodes[disc.degree * v]) for v in vertices),
         settings=settings, fields=fields, history=history, energy=energy, stats=stats)

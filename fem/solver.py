@@ -28,7 +28,14 @@ import numpy as np
 from scipy.linalg import solve_banded
 
 from cavex.errors import CavexNumericalError
-from cavex.fem.newton import Newmark, newton, newton_line_search, take
+from cavex.fem.newton import (
+    Newmark,
+    copy_response,
+    newton,
+    newton_line_search,
+    replace_points,
+    take,
+)
 from cavex.fem.stack import Stack
 
 DOF_STATE = ("u", "v", "a", "f", "du_prev")
@@ -193,7 +200,7 @@ class RadialSolver:
                                                     self.newton_tol)
         if search.any():
             u, a, f = u.copy(), a.copy(), f.copy()
-            resp = SimpleNamespace(**{n: v.copy() for n, v in vars(resp).items()})
+            resp = copy_response(resp)
             for i in np.flatnonzero(search):
                 sub, sdofs, selements = stack.subset([i])
                 sw = take(w, sdofs, selements, [i])
@@ -202,8 +209,7 @@ class RadialSolver:
                     sub, sw, self.params, self.dynamic, self.newton_tol)
                 if reasons[i] is None:
                     u[sdofs], a[sdofs], f[sdofs] = su, sa, sf
-                    for name, value in vars(resp).items():
-                        value[selements] = getattr(sresp, name)
+                    replace_points(resp, selements, sresp)
         ok = active & np.array([r is None for r in reasons])
         return (u, a, f, resp), ok, iterations, reasons
 

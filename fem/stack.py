@@ -155,9 +155,6 @@ class Stack:
                        resp.gamma_p, resp.plastic, resp.yield_ratio, folded, scale)
         return out
 
-    def per_case_max(self, dof_values):
-        return np.maximum.reduceat(dof_values, self.dof_start)
-
     def per_case_all(self, dof_flags):
         return np.logical_and.reduceat(dof_flags, self.dof_start)
 
