@@ -7,8 +7,10 @@ docs/fem.md):
 
 .. math:: e(S_h) = \frac{|S_h - S_{2h}|}{2^2 - 1}\,/\,|S_h| .
 
-Where that coarser run fails numerically (a Newton failure that survives the cut-backs and the
-line search), a 2x finer companion is used instead, ``S_h - S_{h/2} = C h^p (1 - 2^{-p})``, so
+Where that coarser run would leave the accepted numerics (:meth:`cavex.fem.settings.Numerics.
+can_coarsen`: it would not be a meaningful discretisation, so it cannot certify anything) or
+fails numerically (a Newton failure that survives the cut-backs and the line search), a 2x finer
+companion is used instead, ``S_h - S_{h/2} = C h^p (1 - 2^{-p})``, so
 
 .. math:: e(S_h) = |S_h - S_{h/2}|\,\frac{2^p}{2^p - 1}\,/\,|S_h| ,
 
@@ -42,15 +44,24 @@ def estimate_errors(problems, results, numerics, run):
     """Set ``error_estimate`` and the companion's ``stats`` on every successful result.
 
     ``run(problems, numerics)`` runs problems without estimates (a list of results). A case
-    whose companions both fail gets the companion's error.
+    whose companions both fail gets the companion's error; where neither companion is in the
+    accepted numerics (a run at the finest settings accepted), the estimate stays None.
     """
     todo = [i for i, r in enumerate(results) if r.ok]
-    coarse = run([problems[i] for i in todo], numerics.coarsened())
-    retry = [i for i, c in zip(todo, coarse, strict=True) if not c.ok]
+    if numerics.can_coarsen():
+        coarse = run([problems[i] for i in todo], numerics.coarsened())
+    else:
+        coarse = [None] * len(todo)
+    retry = [i for i, c in zip(todo, coarse, strict=True) if c is None or not c.ok]
+    if not numerics.can_coarsen(0.5):
+        retry = []
     finer = dict(zip(retry, run([problems[i] for i in retry], numerics.coarsened(0.5)),
                      strict=True))
     for i, c in zip(todo, coarse, strict=True):
-        kind, companion = ("coarse", c) if c.ok else ("finer", finer[i])
+        if i not in finer and (c is None or not c.ok):
+            results[i].stats["error_companion"] = None
+            continue
+        kind, companion = ("coarse", c) if c is not None and c.ok else ("finer", finer[i])
         result = results[i]
         result.stats[f"{kind}_cavity_stress"] = companion.cavity_stress
         result.stats["error_companion"] = kind
@@ -75,8 +86,9 @@ def refine_above(problems, results, numerics, target, max_refinements, run_estim
     """Re-run (in place in ``results``) the cases estimated above ``target`` at twice the
     resolution, up to ``max_refinements`` times; ``stats["refinements"]`` counts them."""
     for refinement in range(1, max_refinements + 1):
-        redo = [i for i, r in enumerate(results) if r.ok and r.error_estimate > target]
-        if not redo:
+        redo = [i for i, r in enumerate(results) if r.ok and r.error_estimate is not None
+                and r.error_estimate > target]
+        if not redo or not numerics.can_coarsen(1.0 / REFINEMENT):
             return
         numerics = refined(numerics)
         for i, r in zip(redo, run_estimated([problems[i] for i in redo], numerics),

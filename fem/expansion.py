@@ -275,8 +275,8 @@ def expand_cavities(problems, *, batch_size=DEFAULT_BATCH, on_error="return", er
     settings = make_numerics(**numerics)
     problems = [_problem(i, p) for i, p in enumerate(problems)]
     for i, (_, _, _, radius) in enumerate(problems):
-        require(settings.seed_radius is None or settings.seed_radius < radius,
-                f"problems[{i}]: seed_radius", f"in (0, radius = {radius})",
+        require(settings.seed_radius is None or settings.seed_radius <= radius / 5.0,
+                f"problems[{i}]: seed_radius", f"in (0, radius/5 = {radius / 5.0:g}]",
                 settings.seed_radius)
     require(error_target is None or (isinstance(error_target, float) and 0 < error_target < 1),
             "error_target", "None or a float in (0, 1)", error_target)
@@ -333,8 +333,8 @@ def expand_cavity(layers, interfaces, velocity, radius, **numerics):
     check_problem(layers, interfaces, float(velocity), float(radius), "dynamic")
     settings = make_numerics(**{k: v for k, v in numerics.items()
                                 if k not in ("error_target", "max_refinements")})
-    require(settings.seed_radius is None or settings.seed_radius < radius, "seed_radius",
-            f"in (0, radius = {radius})", settings.seed_radius)
+    require(settings.seed_radius is None or settings.seed_radius <= radius / 5.0,
+            "seed_radius", f"in (0, radius/5 = {radius / 5.0:g}]", settings.seed_radius)
     try:
         result, = expand_cavities([(layers, interfaces, float(velocity), float(radius))],
                                   on_error="raise", record=True, **numerics)
