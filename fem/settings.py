@@ -2,8 +2,8 @@
 
 from dataclasses import asdict, dataclass, fields, replace
 
-from cavex.errors import is_finite_number as _finite
 from cavex.errors import CavexInputError, require, require_choice
+from cavex.errors import is_finite_number as _finite
 
 OUTER_BOUNDARIES = ("fixed", "free")
 
