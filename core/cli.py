@@ -7,6 +7,7 @@ import sys
 from cavex.analytic.paper_model import EPSILON_READINGS
 from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
+from cavex.paths import check_output_dir
 
 DEFAULT_PENETRATION_DIR = "results/penetration"
 
@@ -40,6 +41,8 @@ def build_parser():
     fem.add_argument("--depth", type=float, required=True, help="nose-tip depth L (m)")
     fem.add_argument("--nu", type=float, help="Poisson's ratio for every layer (default: file's)")
     fem.add_argument("--json", action="store_true", help="print JSON")
+    fem.add_argument("--fields", help="folder for the FE fields (XDMF time series for ParaView "
+                     "and meshio, history CSV)")
     table = commands.add_parser("table", help="FE-tabulated sigma_r(V, L) for the target")
     table.add_argument("--config", help="target TOML file (default: the paper's Table 1)")
     table.add_argument("--velocities", nargs="+", type=float, help="m/s (default 0..1200)")
@@ -56,6 +59,27 @@ def build_parser():
     batch.add_argument("sweep", help="sweep TOML file; its [target] section names the target")
     batch.add_argument("--out", help="output folder (default results/batch/<sweep name>)")
     _parallel(batch)
+    batch.add_argument("--allow-large", action="store_true",
+                       help="run a sweep of more than 20000 FE cases")
+    calibrate = commands.add_parser("calibrate", help="fit material parameters to measured "
+                                    "penetration depths (docs/validation.md)")
+    calibrate.add_argument("--shots", required=True, help="shot file (CSV)")
+    calibrate.add_argument("--out", required=True, help="calibration TOML file to write")
+    calibrate.add_argument("--params", nargs="+", help="free parameters: lam, strength_factor, "
+                           "modulus_factor (default: lam strength_factor)")
+    calibrate.add_argument("--model", default="derived-quasi-static",
+                           help="derived-quasi-static (default), derived-dynamic, paper or "
+                                "fe-table")
+    calibrate.add_argument("--ids", nargs="+", help="fit only these shots (default: all)")
+    _parallel(calibrate)
+    validate = commands.add_parser("validate", help="predicted against measured penetration "
+                                   "depths (docs/validation.md)")
+    validate.add_argument("--shots", required=True, help="shot file (CSV)")
+    validate.add_argument("--calibration", nargs="+", action="extend",
+                          help="calibration TOML file(s) from `cavex calibrate`")
+    validate.add_argument("--json", action="store_true", help="print JSON")
+    validate.add_argument("--out", help="output folder (default results/validation)")
+    _parallel(validate)
     return parser
 
 
@@ -86,6 +110,11 @@ def main(argv=None):
     except CavexNumericalError as exc:
         print(f"cavex: numerical failure: {exc}", file=sys.stderr)
         return 1
+    except OSError as exc:  # the file system refused (disk full, a file changed under us)
+        where = f"'{exc.filename}': " if exc.filename else ""
+        print(f"cavex: error: cannot read or write {where}{exc.strerror or exc}",
+              file=sys.stderr)
+        return 2
     print(text)
     return 0
 
@@ -100,6 +129,7 @@ def _penetrate(args, target, projectile):
     if (args.resistance == "table") != (args.table is not None):
         raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
                               "neither)")
+    check_output_dir(args.out, "out")
     job = penetration_job(target, projectile, model=args.model, boundary=args.boundary,
                           epsilon=args.epsilon, crater=args.crater, table_path=args.table)
     written = write_outputs(job, args.out)
@@ -144,7 +174,8 @@ def _stress(args, target, projectile):
 def _fem(args, target, projectile):
     from cavex.verification.fe_comparison import compare_at_depth
 
-    result = compare_at_depth(target, projectile, args.depth, args.velocity, nu=args.nu)
+    result = compare_at_depth(target, projectile, args.depth, args.velocity, nu=args.nu,
+                              fields=args.fields)
     if args.json:
         return json.dumps(result, indent=2)
     fe, analytic = result["fe_sigma_r"], result["analytic_sigma_r"]
@@ -162,6 +193,8 @@ def _fem(args, target, projectile):
     lines.append("FE estimated discretisation error: "
                  + ("not estimated" if estimate is None else f"{estimate:.3%}")
                  + f" ({result['refinements']} refinement(s) of the default resolution)")
+    if "fields" in result:
+        lines.append(f"wrote   {result['fields']} (+ history CSV)")
     return "\n".join(lines)
 
 
@@ -181,11 +214,27 @@ def _verify(args, target, projectile):
 def _batch(args, target, projectile):
     from cavex.verification.batch import batch_main
 
-    return batch_main(args.sweep, args.out, args.scheduler, args.workers)
+    return batch_main(args.sweep, args.out, args.scheduler, args.workers,
+                      allow_large=args.allow_large)
+
+
+def _calibrate(args, target, projectile):
+    from cavex.verification.calibration import calibrate_main
+
+    return calibrate_main(args.shots, args.out, args.params, args.model, args.ids,
+                          args.workers, args.scheduler)
+
+
+def _validate(args, target, projectile):
+    from cavex.verification.validation_output import validate_main
+
+    return validate_main(args.shots, args.calibration, args.out, args.json, args.workers,
+                         args.scheduler)
 
 
 COMMANDS = {"penetrate": _penetrate, "stress": _stress, "fem": _fem, "table": _table,
-            "verify": _verify, "batch": _batch}
+            "verify": _verify, "batch": _batch, "calibrate": _calibrate,
+            "validate": _validate}
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -9,6 +9,9 @@ from cavex.materials import Material, Projectile, Target
 LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c"}
 PROJECTILE_KEYS = {"r", "l", "R", "crh", "m", "V0"}
 TOP_KEYS = {"projectile", "layers"}
+# written by `cavex calibrate` beside the calibrated target; read by `cavex validate`
+# (cavex.verification.calibration), ignored by the commands that only need the target
+OPTIONAL_TOP_KEYS = {"calibration"}
 
 
 def default_config_text():
@@ -38,11 +41,17 @@ def _read(path):
             return handle.read()
     except OSError as exc:
         raise CavexInputError(f"config '{path}' cannot be read: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise CavexInputError(f"config '{path}' is not UTF-8 text (byte {exc.start}: "
+                              f"{exc.reason})") from None
 
 
 def parse_config(data):
     """Build ``(target, projectile)`` from an already parsed TOML mapping."""
-    check_keys(data, TOP_KEYS, "", required=TOP_KEYS)
+    check_keys(data, TOP_KEYS | OPTIONAL_TOP_KEYS, "", required=TOP_KEYS)
+    if "calibration" in data:
+        require(isinstance(data["calibration"], dict), "calibration", "a table",
+                data["calibration"])
     return parse_target(data["layers"]), parse_projectile(data["projectile"])
 
 
@@ -61,7 +70,7 @@ def parse_target(layers):
                                   "the last layer is semi-infinite")
         numbers = {k: _number(table[k], where + k) for k in table if k != "name"}
         thickness = numbers.pop("thickness", None)
-        materials.append(prefixed(Material, where, name=str(table.get("name", "")), **numbers))
+        materials.append(prefixed(Material, where, name=table.get("name", ""), **numbers))
         if thickness is not None:
             thicknesses.append(thickness)
     return prefixed(Target, "", materials, thicknesses)

@@ -54,6 +54,7 @@ class Material:
     sigma_c: float | None = field(default=None, compare=False)
 
     def __post_init__(self):
+        require(isinstance(self.name, str), "name", "a string", self.name)
         _positive("E", self.E)
         _positive("rho", self.rho)
         require(is_finite_number(self.nu) and -1.0 < self.nu < 0.5, "nu", "in (-1, 0.5)", self.nu)

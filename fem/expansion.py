@@ -124,7 +124,8 @@ class Recorder:
             self.snapshots.append({"time": one.t, "u": one.u[::disc.degree].copy(),
                                    "sigma_r": sigma_r.mean(axis=1),
                                    "sigma_theta": sigma_t.mean(axis=1),
-                                   "plastic_strain": one.state["eq_p"].mean(axis=1)})
+                                   "plastic_strain": one.state["eq_p"].mean(axis=1),
+                                   "layer": disc.element_layer.copy()})
 
 
 # ---------------------------------------------------------------------------------- runs

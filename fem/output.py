@@ -1,10 +1,13 @@
-"""Writing a result for ParaView with meshio: a VTU per snapshot and a PVD time-series index.
+"""Writing a result for ParaView and meshio: an XDMF time series of the radial fields.
 
-Each VTU holds the 1-D radial mesh in its *current* configuration at the snapshot time (points
-on the x axis), the nodal displacement ``u`` and the element-averaged ``sigma_r``,
-``sigma_theta`` (Pa, compression positive) and ``plastic_strain``. The step history (``time``,
-``radius``, ``wall_stress``, ``plastic_radius``) goes to ``<path>_history.csv``. Open the
-``.pvd`` file in ParaView to step through time.
+``<path>.xdmf`` (XML data, no HDF5 library needed) holds the 1-D radial mesh in the *reference*
+configuration (points on the x axis, radius ``R``, m) and, at every snapshot time, the nodal
+displacement ``u`` as a vector ``(u, 0, 0)`` (ParaView's "Warp By Vector" shows the current
+configuration) and, per element, the averages of ``sigma_r``, ``sigma_theta`` (Cauchy, Pa,
+compression positive), the accumulated equivalent plastic log strain and the layer index. Units
+are part of the field names (``"sigma_r [Pa]"``). meshio reads the series back
+(``meshio.xdmf.TimeSeriesReader``). The step history (``time``, ``radius``, ``wall_stress``,
+``plastic_radius``) goes to ``<path>_history.csv`` with units in its header.
 """
 
 from pathlib import Path
@@ -12,39 +15,45 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-HISTORY = ("time", "radius", "wall_stress", "plastic_radius")
+HISTORY = (("time", "s"), ("radius", "m"), ("wall_stress", "Pa"), ("plastic_radius", "m"))
+CELL_FIELDS = (("sigma_r", "sigma_r [Pa]"), ("sigma_theta", "sigma_theta [Pa]"),
+               ("plastic_strain", "plastic_strain [1]"), ("layer", "layer [index]"))
 
 
 def write_result(result, path):
-    """Write ``result`` as ``<path>.pvd`` plus ``<path>_NNNN.vtu`` snapshots; return the PVD path.
+    """Write a recorded ``result`` (from :func:`cavex.fem.expand_cavity`) as ``<path>.xdmf`` and
+    ``<path>_history.csv``; return the XDMF path.
 
     Parameters
     ----------
     result : ExpansionResult
+        With its history and snapshots (``record=True``, as :func:`expand_cavity` runs).
     path : str or Path
-        Output path; a ``.pvd`` suffix is added (or replaces another suffix).
+        Output path; an ``.xdmf`` suffix is added (or replaces another suffix).
     """
-    path = Path(path).with_suffix(".pvd")
+    if result.history is None or "snapshots" not in result.fields:
+        raise ValueError("write_result needs a recorded result (expand_cavity, or "
+                         "expand_cavities(..., record=True))")
+    path = Path(path).with_suffix(".xdmf")
     path.parent.mkdir(parents=True, exist_ok=True)
-    R = result.fields["R_nodes"]
-    step = (len(R) - 1) // (len(result.fields["snapshots"][0]["sigma_r"]))
-    R_vertices = R[::step]
-    cells = [("line", np.column_stack([np.arange(len(R_vertices) - 1),
-                                       np.arange(1, len(R_vertices))]))]
-    history = result.history
-    entries = []
-    for k, snap in enumerate(result.fields["snapshots"]):
-        x = R_vertices + snap["u"]
-        points = np.column_stack([x, np.zeros_like(x), np.zeros_like(x)])
-        mesh = meshio.Mesh(points, cells, point_data={"u": snap["u"]},
-                           cell_data={name: [snap[name]] for name in
-                                      ("sigma_r", "sigma_theta", "plastic_strain")})
-        name = f"{path.stem}_{k:04d}.vtu"
-        meshio.write(path.parent / name, mesh)
-        entries.append(f'    <DataSet timestep="{snap["time"]:.9e}" file="{name}"/>')
-    table = np.column_stack([np.asarray(history[k]) for k in HISTORY])
+    snapshots = result.fields["snapshots"]
+    R_vertices = result.fields["R_nodes"][::_degree(result, snapshots)]
+    points = np.column_stack([R_vertices, np.zeros_like(R_vertices), np.zeros_like(R_vertices)])
+    n = len(R_vertices)
+    cells = [("line", np.column_stack([np.arange(n - 1), np.arange(1, n)]))]
+    with meshio.xdmf.TimeSeriesWriter(path, data_format="XML") as writer:
+        writer.write_points_cells(points, cells)
+        for snap in snapshots:
+            u = np.column_stack([snap["u"], np.zeros(n), np.zeros(n)])
+            writer.write_data(snap["time"], point_data={"u [m]": u},
+                              cell_data={label: [np.asarray(snap[name])]
+                                         for name, label in CELL_FIELDS})
+    table = np.column_stack([np.asarray(result.history[name]) for name, _ in HISTORY])
     np.savetxt(path.with_name(path.stem + "_history.csv"), table, delimiter=",",
-               header=",".join(HISTORY), comments="")
-    path.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n'
-                    "  <Collection>\n" + "\n".join(entries) + "\n  </Collection>\n</VTKFile>\n")
+               header=",".join(f"{name} [{unit}]" for name, unit in HISTORY), comments="")
     return path
+
+
+def _degree(result, snapshots):
+    """Nodes per element edge: the snapshots hold vertex values only."""
+    return (len(result.fields["R_nodes"]) - 1) // len(snapshots[0]["sigma_r"])

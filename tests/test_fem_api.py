@@ -104,16 +104,27 @@ def test_newton_failure_names_velocity_step_and_radius():
                       error_estimate=False)
 
 
-def test_write_result_is_a_paraview_time_series(default_run, tmp_path):
-    pvd = write_result(default_run, tmp_path / "run")
-    assert pvd.suffix == ".pvd" and "<DataSet" in pvd.read_text()
-    vtus = sorted(tmp_path.glob("run_*.vtu"))
-    assert len(vtus) == len(default_run.fields["snapshots"]) == 20
-    last = meshio.read(vtus[-1])
-    assert last.points[0, 0] == pytest.approx(0.0125, rel=1e-9)
-    assert np.all(last.cell_data["sigma_r"][0][:5] > 0)
+def test_write_result_is_an_xdmf_time_series_meshio_reads_back(tmp_path):
+    layered = expand_cavity([CONCRETE, SOIL], [0.05], 500.0, 0.0125, error_estimate=False)
+    path = write_result(layered, tmp_path / "run")
+    assert path.suffix == ".xdmf"
+    snapshots = layered.fields["snapshots"]
+    with meshio.xdmf.TimeSeriesReader(path) as reader:
+        points, cells = reader.read_points_cells()
+        assert reader.num_steps == len(snapshots) == 20
+        steps = [reader.read_data(k) for k in range(reader.num_steps)]
+    assert points[0, 0] == pytest.approx(layered.fields["R_nodes"][0], rel=1e-15)
+    t, point_data, cell_data = steps[-1]
+    assert t == pytest.approx(layered.history["time"][-1], rel=1e-12)
+    # the reference points plus u are the current configuration: the wall at the final radius
+    assert points[0, 0] + point_data["u [m]"][0, 0] == pytest.approx(0.0125, rel=1e-9)
+    assert set(cell_data) == {"sigma_r [Pa]", "sigma_theta [Pa]", "plastic_strain [1]",
+                              "layer [index]"}
+    assert np.all(cell_data["sigma_r [Pa]"][0][:5] > 0)
+    assert set(np.unique(cell_data["layer [index]"][0])) == {0, 1}
     history = np.loadtxt(tmp_path / "run_history.csv", delimiter=",", skiprows=1)
-    assert history[-1, 2] == pytest.approx(default_run.cavity_stress)
+    assert (tmp_path / "run_history.csv").read_text().startswith("time [s],radius [m]")
+    assert history[-1, 2] == pytest.approx(layered.cavity_stress)
 
 
 def test_compare_at_depth_is_json_and_side_by_side():

@@ -13,6 +13,7 @@ import itertools
 import json
 import os
 import re
+import sys
 import time
 import tomllib
 from dataclasses import dataclass, field
@@ -22,8 +23,21 @@ import numpy as np
 from cavex.config import parse_projectile, parse_target
 from cavex.errors import CavexInputError, check_keys, is_finite_number, prefixed, require
 from cavex.fem.settings import make_numerics
-from cavex.verification.cases import config_tables, fe_case_id, fe_cases, numerics_names
-from cavex.verification.runner import read_store, run_cases, write_text_atomic
+from cavex.paths import check_output_dir
+from cavex.verification.cases import (
+    check_run_size,
+    config_tables,
+    fe_case_id,
+    fe_cases,
+    numerics_names,
+)
+from cavex.verification.runner import (
+    check_execution,
+    check_store,
+    read_store,
+    run_cases,
+    write_text_atomic,
+)
 from cavex.verification.table import write_table
 
 SECTIONS = ("sweep", "target", "grid", "numerics", "materials")
@@ -120,10 +134,11 @@ def _read_sweep(path_or_dict):
             data = tomllib.load(handle)
     except OSError as exc:
         raise CavexInputError(f"sweep '{path}' cannot be read: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CavexInputError(f"sweep '{path}' is not valid TOML: {exc}") from None
-    stem = os.path.splitext(os.path.basename(path))[0]
-    return data, os.path.dirname(os.path.abspath(path)), stem
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise CavexInputError(f"sweep '{path}' is not valid UTF-8 TOML: {reason}") from None
+    stem = re.sub(r"[^A-Za-z0-9._-]", "_", os.path.splitext(os.path.basename(path))[0])
+    return data, os.path.dirname(os.path.abspath(path)), stem.lstrip("._-") or "sweep"
 
 
 def _check_table(table, where, allowed, required=()):
@@ -134,7 +149,9 @@ def _check_table(table, where, allowed, required=()):
 def _sweep_section(table, default_name):
     _check_table(table, "sweep.", SWEEP_KEYS)
     name = table.get("name", default_name)
-    require(isinstance(name, str) and name, "sweep.name", "a non-empty string", name)
+    require(isinstance(name, str) and re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}", name)
+            is not None, "sweep.name", "a plain folder name (letters, digits, '.', '_', '-'; "
+            "no path)", name)
     scheduler = table.get("scheduler")
     require(scheduler is None or (isinstance(scheduler, str) and scheduler), "sweep.scheduler",
             "an address string such as 'tcp://127.0.0.1:8786'", scheduler)
@@ -375,14 +392,16 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
     """
     sweep = parse_sweep(path_or_dict)
     cases = sweep_cases(sweep)
-    out_dir = os.fspath(out_dir)
+    out_dir = os.fspath(check_output_dir(out_dir, "out"))
+    scheduler = scheduler if scheduler is not None else sweep.scheduler
+    workers = check_execution(workers if workers is not None else sweep.workers, scheduler)
+    check_store(os.path.join(out_dir, STORE_DIR), cases)  # before sweep.json is rewritten
     os.makedirs(out_dir, exist_ok=True)
     description = _description(sweep, cases)
     write_text_atomic(os.path.join(out_dir, SWEEP_FILE), json.dumps(description, indent=1))
     results = run_cases(fe_cases, cases, store=os.path.join(out_dir, STORE_DIR),
-                        scheduler=scheduler if scheduler is not None else sweep.scheduler,
-                        workers=workers if workers is not None else sweep.workers,
-                        progress=progress, chunk_size=chunk_size)
+                        scheduler=scheduler, workers=workers, progress=progress,
+                        chunk_size=chunk_size)
     dataset = _dataset(description, {r["id"]: r for r in results})
     # exactly as computed: the file mirrors the case store (it loads back identical to
     # load_sweep) and holds the wall times, so it is not a reproducible result file anyway
@@ -469,15 +488,25 @@ def _values(results, path):
 
 # --- the command --------------------------------------------------------------------------------
 
-def batch_main(path, out_dir=None, scheduler=None, workers=None, progress=None):
+def batch_main(path, out_dir=None, scheduler=None, workers=None, progress=None,
+               allow_large=False):
     """Run a sweep for ``cavex batch`` and return the printable summary.
 
-    ``out_dir`` defaults to ``results/batch/<sweep name>``.
+    ``out_dir`` defaults to ``results/batch/<sweep name>``. The size and an estimate of the
+    run time go to stderr first; more than :data:`cavex.verification.cases.LARGE_RUN` cases
+    need ``allow_large``.
     """
     sweep = parse_sweep(path)
     out_dir = os.fspath(out_dir) if out_dir is not None else os.path.join("results", "batch",
                                                                           sweep.name)
-    ids = {case["id"] for case in sweep_cases(sweep)}
+    cases = sweep_cases(sweep)
+    check_output_dir(out_dir, "out")
+    scheduler = scheduler if scheduler is not None else sweep.scheduler
+    workers = check_execution(workers if workers is not None else sweep.workers, scheduler)
+    estimate = check_run_size(len(cases), workers, allow_large)
+    check_store(os.path.join(out_dir, STORE_DIR), cases)
+    print(f"sweep '{sweep.name}': {estimate}", file=sys.stderr)
+    ids = {case["id"] for case in cases}
     before = len(ids & set(read_store(os.path.join(out_dir, STORE_DIR))))
     start = time.perf_counter()
     dataset = run_sweep(path, out_dir, scheduler=scheduler, workers=workers, progress=progress)

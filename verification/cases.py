@@ -32,6 +32,25 @@ from cavex.fem.settings import Numerics, make_numerics
 
 CASE_KEYS = {"id", "velocity", "depth", "nu", "numerics", "error_target", "target",
              "projectile"}
+#: FE cases per second per worker, measured on table grids at the default settings with
+#: error estimates (docs/fem.md "Throughput": 12-20 per process); used for estimates only.
+CASES_PER_SECOND_PER_WORKER = 15.0
+LARGE_RUN = 20_000  # FE cases above which a run needs an explicit request
+
+
+def check_run_size(n_cases, workers, allow_large, option="allow-large"):
+    """The one-line estimate of an FE run of ``n_cases`` cases on ``workers`` workers; refuses
+    (naming ``option``) more than :data:`LARGE_RUN` cases unless ``allow_large``."""
+    hours = n_cases / (CASES_PER_SECOND_PER_WORKER * max(1, workers)) / 3600.0
+    minutes = hours * 60.0
+    estimate = (f"{n_cases} FE cases, under a minute" if minutes < 1.0
+                else f"{n_cases} FE cases, about {minutes:.0f} min" if hours < 1.0
+                else f"{n_cases} FE cases, about {hours:.1f} h")
+    if n_cases > LARGE_RUN and not allow_large:
+        raise CavexInputError(f"{estimate} on {workers} worker(s): more than {LARGE_RUN} cases "
+                              f"need the option '--{option}'")
+    return f"{estimate} on {workers} worker(s) (at ~{CASES_PER_SECOND_PER_WORKER:g} cases/s " \
+           "per worker)"
 
 
 def fe_cases(chunk):

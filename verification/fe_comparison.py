@@ -11,6 +11,8 @@ from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET, MAX_REFINEMENTS
 from cavex.fem.expansion import expand_cavities
+from cavex.fem.output import write_result
+from cavex.paths import check_output_dir
 
 BOUNDARIES = ("dynamic", "quasi-static")
 
@@ -30,11 +32,16 @@ def compare_many(requests, error_target=DEFAULT_ERROR_TARGET, max_refinements=MA
     """FE against closed form for many ``(target, projectile, depth, velocity, nu)`` requests,
     with shared numerics; a list of dicts (see :func:`compare_at_depth`), or of the
     :class:`~cavex.errors.CavexNumericalError` of a failed FE run."""
-    problems = [fe_problem(*request) for request in requests]
-    results = expand_cavities(problems, error_target=error_target,
-                              max_refinements=max_refinements, **numerics)
     return [comparison(request[2], problem, result) if result.ok else result.error
-            for request, problem, result in zip(requests, problems, results, strict=True)]
+            for request, problem, result in zip(requests, *_run(requests, error_target,
+                                                                max_refinements, False,
+                                                                **numerics), strict=True)]
+
+
+def _run(requests, error_target, max_refinements, record, **numerics):
+    problems = [fe_problem(*request) for request in requests]
+    return problems, expand_cavities(problems, error_target=error_target,
+                                     max_refinements=max_refinements, record=record, **numerics)
 
 
 def comparison(depth, problem, result):
@@ -62,7 +69,7 @@ def comparison(depth, problem, result):
 
 
 def compare_at_depth(target, projectile, depth, velocity, nu=None,
-                     error_target=DEFAULT_ERROR_TARGET, **numerics):
+                     error_target=DEFAULT_ERROR_TARGET, fields=None, **numerics):
     """FE ``sigma_r`` at the cavity wall next to both analytic conventions, as a plain dict.
 
     Parameters
@@ -77,6 +84,9 @@ def compare_at_depth(target, projectile, depth, velocity, nu=None,
         Poisson's ratio given to every layer (default: each layer's own ``nu``).
     error_target : float or None
         Refine the FE run while its estimated error exceeds this (None: never).
+    fields : str or path, optional
+        Folder for the FE fields of the run reported: ``fem.xdmf`` (time series) and
+        ``fem_history.csv`` (:func:`cavex.fem.write_result`); checked before the run.
     **numerics
         Settings of :class:`cavex.fem.Numerics`.
 
@@ -95,8 +105,14 @@ def compare_at_depth(target, projectile, depth, velocity, nu=None,
     CavexNumericalError
         The FE run failed.
     """
-    result, = compare_many([(target, projectile, depth, velocity, nu)], error_target,
-                           **numerics)
-    if isinstance(result, Exception):
-        raise result
-    return result
+    if fields is not None:
+        fields = check_output_dir(fields, "fields")
+    request = (target, projectile, depth, velocity, nu)
+    (problem,), (result,) = _run([request], error_target, MAX_REFINEMENTS, fields is not None,
+                                 **numerics)
+    if not result.ok:
+        raise result.error
+    out = comparison(depth, problem, result)
+    if fields is not None:
+        out["fields"] = str(write_result(result, fields / "fem"))
+    return out

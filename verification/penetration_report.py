@@ -7,13 +7,12 @@ are the same when regenerated on another CPU.
 
 import csv
 import io
-import os
 from pathlib import Path
 
 from cavex.analytic.penetration import penetrate
 from cavex.analytic.resistance import ClosedFormResistance
 from cavex.verification.number_format import format_number
-from cavex.verification.runner import write_text_atomic
+from cavex.verification.runner import save_figure, write_text_atomic
 from cavex.verification.table2 import table2_comparison
 
 
@@ -105,9 +104,5 @@ def _write_figures(job, out):
 
 
 def _save(fig, path, plt):
-    tmp = path.with_name(path.stem + ".tmp.png")
     fig.tight_layout()
-    fig.savefig(tmp, dpi=120)
-    plt.close(fig)
-    os.replace(tmp, path)
-    return path
+    return save_figure(fig, path, dpi=120)

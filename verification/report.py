@@ -20,11 +20,13 @@ import numpy as np
 
 from cavex.errors import CavexInputError
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
+from cavex.paths import check_output_dir
 from cavex.verification import report_plots as plots
 from cavex.verification import report_text as text
 from cavex.verification.number_format import TRAJECTORY_DIGITS, round_dataset, round_nested
 from cavex.verification.report_analysis import all_stats, analyse, layer_names
 from cavex.verification.report_html import markdown_to_html
+from cavex.verification.runner import check_execution
 from cavex.verification.table import build_table, write_table
 
 DEFAULT_VELOCITIES = (0.0, 50.0, 100.0, 200.0, 300.0, 400.0, 500.0, 600.0, 800.0, 1000.0,
@@ -95,6 +97,17 @@ def figures(grid, target, out):
     return paths
 
 
+REPORT_FILES = ("report.md", "report.html", "grid.nc", "target.toml", "sphere.png",
+                "error_dynamic.png", "error_quasi_static.png", "error_paper.png", "validity.png",
+                "S_depth.png", "states.png", "plastic_radius.png", "error_estimate.png")
+
+
+def remove_report_files(out):
+    """Delete the files a report writes (and nothing else) from ``out``."""
+    for name in REPORT_FILES:
+        (Path(out) / name).unlink(missing_ok=True)
+
+
 def write_grid(grid, path, extra):
     """``grid.nc`` (netCDF3, scipy engine) with the report's extra attributes as JSON.
 
@@ -149,6 +162,7 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     started = time.perf_counter()
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    remove_report_files(out)  # an old report never mixes with this one
     v, d = grid_axes(quick, velocities, depths)
     if numerics is None and quick:
         numerics, error_target = dict(QUICK_NUMERICS), None
@@ -260,8 +274,10 @@ def verify_main(config_path=None, quick=False, out_dir=None, scheduler=None, wor
     target, projectile = load_config(config_path)
     config = default_config_text() if config_path is None else Path(config_path).read_text(
         encoding="utf-8")
-    summary = verify(target, projectile, quick=quick, out_dir=out_dir or DEFAULT_OUT,
-                     scheduler=scheduler, workers=workers, config_text=config)
+    out_dir = check_output_dir(DEFAULT_OUT if out_dir is None else out_dir, "out")
+    workers = check_execution(workers, scheduler)
+    summary = verify(target, projectile, quick=quick, out_dir=out_dir, scheduler=scheduler,
+                     workers=workers, config_text=config)
     return summary_text(summary)
 
 

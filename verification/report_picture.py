@@ -6,6 +6,9 @@ the layer interfaces (black circles) and the FE elastic-plastic boundary (red ci
 it; the plastic zone is also shown as a translucent red shell.
 """
 
+import os
+from pathlib import Path
+
 import numpy as np
 
 from cavex.analytic.cavity import cavity_solution
@@ -107,7 +110,12 @@ def render_sphere(fields, path, title):
     plotter.camera_position = [(1.6 * outer, -3.0 * outer, 1.4 * outer), (0, 0, 0), (0, 0, 1)]
     plotter.reset_camera()
     plotter.camera.zoom(1.1)
-    plotter.screenshot(str(path))
+    tmp = Path(path).with_name(f".{Path(path).name}.{os.getpid()}.tmp.png")
+    try:  # a killed run never leaves a partial picture
+        plotter.screenshot(str(tmp))
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
     plotter.close()
     return path
 

@@ -8,6 +8,7 @@ import numpy as np  # noqa: E402
 from matplotlib.colors import BoundaryNorm, ListedColormap, TwoSlopeNorm  # noqa: E402
 
 from cavex.verification.report_analysis import MODELS, TOLERANCES, layer_names  # noqa: E402
+from cavex.verification.runner import save_figure  # noqa: E402
 
 VALIDITY_COLOURS = ("#1a9850", "#fee08b", "#d73027", "#7f7f7f")  # 1 %, 5 %, beyond, failed
 
@@ -19,9 +20,7 @@ def _depth_limit(ax, grid, target):
 
 
 def _save(fig, path):
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=110, bbox_inches="tight")
 
 
 def _cell_xy(grid):

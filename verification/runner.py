@@ -10,10 +10,16 @@ the store is bit-for-bit the one computed (floats are written with ``repr``, whi
 exactly).
 """
 
+import contextlib
+import ctypes
+import fcntl
 import json
 import math
 import multiprocessing
 import os
+import re
+import signal
+import socket
 import sys
 import threading
 import time
@@ -27,6 +33,11 @@ _BAD_ID_CHARS = set('/\\\0:*?"<>|')
 
 
 MAX_CHUNK = 200  # cases per work unit (the FE solver's stack size)
+MAX_WORKERS_PER_CPU = 4  # local processes beyond this only compete for the cores
+SCHEDULER_TIMEOUT = 10.0  # s: how long an unreachable Dask scheduler is waited for
+LOCK_NAME = ".lock"
+_ADDRESS = re.compile(r"^(?:(?P<protocol>tcp|tls|ws|wss|ucx)://)?"
+                      r"(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9][A-Za-z0-9.\-]*):(?P<port>\d{1,5})$")
 
 
 def run_cases(function, cases, *, store=None, scheduler=None, workers=None, progress=None,
@@ -69,24 +80,62 @@ def run_cases(function, cases, *, store=None, scheduler=None, workers=None, prog
     """
     cases = list(cases)
     _check_cases(cases)
-    workers = _check_workers(workers)
-    results = _load_store(store, cases) if store is not None else {}
-    todo = [case for case in cases if case["id"] not in results]
-    bar = _Progress(len(cases), len(results), _show_progress(progress))
+    workers = check_execution(workers, scheduler)
+    with _locked(store):
+        results = _load_store(store, cases) if store is not None else {}
+        todo = [case for case in cases if case["id"] not in results]
+        bar = _Progress(len(cases), len(results), _show_progress(progress))
 
-    def finished(chunk, chunk_results):
-        for case, result in zip(chunk, chunk_results, strict=True):
-            if store is not None:
-                write_case(store, case, result)
-            results[case["id"]] = result
-            bar.update()
+        def finished(chunk, chunk_results):
+            for case, result in zip(chunk, chunk_results, strict=True):
+                if store is not None:
+                    write_case(store, case, result)
+                results[case["id"]] = result
+                bar.update()
 
-    try:
-        if todo:
-            _execute(function, todo, scheduler, workers, finished, chunk_size)
-    finally:
-        bar.close()
+        try:
+            if todo:
+                _execute(function, todo, scheduler, workers, finished, chunk_size)
+        finally:
+            bar.close()
     return [results[case["id"]] for case in cases]
+
+
+def check_execution(workers, scheduler):
+    """Check ``workers`` and ``scheduler`` before anything is created; returns the number of
+    local workers. A malformed scheduler address is refused at once, an unreachable one after
+    :data:`SCHEDULER_TIMEOUT` seconds (the message says so)."""
+    workers = _check_workers(workers)
+    if isinstance(scheduler, str):
+        _check_address(scheduler)
+    return workers
+
+
+def check_store(store, cases):
+    """Raise :class:`CavexInputError` if ``store`` holds a different case under one of the
+    ids of ``cases`` (nothing is created or changed)."""
+    if store is None or not os.path.isdir(store):
+        return
+    _compare_with_store(store, cases)
+
+
+@contextlib.contextmanager
+def _locked(store):
+    """Hold an exclusive lock on ``store`` (a second run into the same store is refused)."""
+    if store is None:
+        yield
+        return
+    os.makedirs(store, exist_ok=True)
+    handle = open(os.path.join(store, LOCK_NAME), "a+")  # noqa: SIM115 - held until the end
+    try:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise CavexInputError(f"store '{os.fspath(store)}' is in use by another cavex run; "
+                                  "wait for it or use another output folder") from None
+        yield
+    finally:
+        handle.close()
 
 
 def run_chunk(function, chunk):
@@ -150,6 +199,22 @@ def write_text_atomic(path, text):
     os.replace(tmp, path)
 
 
+def save_figure(fig, path, **savefig):
+    """Save a matplotlib figure atomically (a temporary file, then ``os.replace``: a killed run
+    never leaves a partial PNG) and close it; returns ``path``."""
+    import matplotlib.pyplot as plt
+
+    tmp = os.fspath(path) + f".{os.getpid()}.tmp.png"
+    try:
+        fig.savefig(tmp, **savefig)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        plt.close(fig)
+    return path
+
+
 def read_store(store):
     """All complete stored cases of ``store`` as ``{id: {"case": ..., "result": ...}}``."""
     entries = {}
@@ -164,19 +229,33 @@ def read_store(store):
 
 
 def _read_entry(path):
+    """A stored case, or None when it is unreadable, not JSON of the stored shape or holds a
+    non-finite number (treated as not computed: recomputed and rewritten)."""
     try:
         with open(path, encoding="utf-8") as handle:
-            entry = json.load(handle)
+            entry = json.load(handle, parse_constant=_reject_constant)
     except (OSError, ValueError):
-        return None  # unreadable: treated as not computed (it is rewritten when recomputed)
-    if not (isinstance(entry, dict) and {"case", "result"} <= entry.keys()):
+        return None
+    if not (isinstance(entry, dict) and {"case", "result"} <= entry.keys()
+            and isinstance(entry["case"], dict) and isinstance(entry["result"], dict)
+            and isinstance(entry["case"].get("id"), str)
+            and entry["result"].get("id") == entry["case"]["id"]
+            and entry["result"].get("status") in ("ok", "failed")):
         return None
     return entry
+
+
+def _reject_constant(name):
+    raise ValueError(f"non-finite number {name}")
 
 
 def _load_store(store, cases):
     os.makedirs(store, exist_ok=True)
     _remove_stale_tmp(store)
+    return _compare_with_store(store, cases)
+
+
+def _compare_with_store(store, cases):
     stored = read_store(store)
     results = {}
     for case in cases:
@@ -191,8 +270,9 @@ def _load_store(store, cases):
 
 
 def _remove_stale_tmp(store):
+    """Temporary files left by a killed run (the store is locked: none is in flight)."""
     for name in os.listdir(store):
-        if name.endswith(TMP_SUFFIX):
+        if name.endswith(TMP_SUFFIX) or (name.startswith(".") and name.endswith(".tmp")):
             try:
                 os.remove(os.path.join(store, name))
             except FileNotFoundError:
@@ -241,11 +321,26 @@ def _usable_id(case_id):
 
 
 def _check_workers(workers):
+    cpus = os.cpu_count() or 1
     if workers is None:
-        return os.cpu_count() or 1
-    require(isinstance(workers, int) and not isinstance(workers, bool) and workers >= 1,
-            "workers", "an integer >= 1", workers)
+        return cpus
+    most = MAX_WORKERS_PER_CPU * cpus
+    require(isinstance(workers, int) and not isinstance(workers, bool) and 1 <= workers <= most,
+            "workers", f"an integer in [1, {most}] ({MAX_WORKERS_PER_CPU} per CPU)", workers)
     return workers
+
+
+def _check_address(address):
+    match = _ADDRESS.match(address)
+    require(match is not None and 0 < int(match["port"]) < 65536, "scheduler",
+            "a Dask scheduler address such as 'tcp://127.0.0.1:8786'", address)
+    host = match["host"].strip("[]")
+    try:
+        socket.create_connection((host, int(match["port"])), timeout=SCHEDULER_TIMEOUT).close()
+    except OSError as exc:
+        raise CavexInputError(f"parameter 'scheduler' must be a reachable Dask scheduler (no "
+                              f"connection to {address!r} within {SCHEDULER_TIMEOUT:g} s: "
+                              f"{exc.strerror or exc})") from None
 
 
 # --- execution ----------------------------------------------------------------------------------
@@ -269,7 +364,8 @@ def _execute(function, todo, scheduler, workers, finished, chunk_size):
         for chunk in chunks(todo, 1, chunk_size):
             finished(chunk, run_chunk(function, chunk))
     else:
-        _run_pool(function, chunks(todo, workers, chunk_size), workers, finished)
+        units = chunks(todo, workers, chunk_size)
+        _run_pool(function, units, min(workers, len(units)), finished)
 
 
 def _pool_context():
@@ -284,7 +380,8 @@ def _pool_context():
 def _run_pool(function, todo, workers, finished):
     """Local processes; at most ``2 * workers`` chunks in flight."""
     pending = iter(todo)
-    with ProcessPoolExecutor(max_workers=workers, mp_context=_pool_context()) as pool:
+    with ProcessPoolExecutor(max_workers=workers, mp_context=_pool_context(),
+                             initializer=_die_with_parent, initargs=(os.getpid(),)) as pool:
         try:
             running = {}
             _top_up(running, pending, 2 * workers,
@@ -298,6 +395,25 @@ def _run_pool(function, todo, workers, finished):
         except BaseException:
             pool.shutdown(wait=False, cancel_futures=True)
             raise
+
+
+def _die_with_parent(parent):
+    """Worker initialiser: end this process when the parent ends, even by ``kill -9`` (Linux's
+    parent-death signal where available, else a watchdog thread)."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+    if os.getppid() != parent:  # the parent ended before the signal was armed
+        os._exit(1)
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
 
 
 def _top_up(running, pending, limit, submit):
@@ -350,7 +466,7 @@ def _stream_dask(client, as_completed, function, todo, finished):
 def _connect(client_class, address):
     """A client for ``address``; an unreachable or malformed address is an input error."""
     try:  # not the default client: a failed connection must not leave dask (and xarray) using it
-        return client_class(address, set_as_default=False)
+        return client_class(address, set_as_default=False, timeout=SCHEDULER_TIMEOUT)
     except (OSError, ValueError, TypeError) as exc:
         raise CavexInputError(f"parameter 'scheduler' must be a reachable Dask scheduler "
                               f"address (got {address!r}: {one_line_reason(exc)})") from None

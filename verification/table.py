@@ -23,6 +23,7 @@ import hashlib
 import json
 import math
 import os
+import shutil
 import time
 from datetime import UTC, datetime
 from importlib import metadata
@@ -35,11 +36,12 @@ from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.errors import CavexInputError, require
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
+from cavex.paths import check_output_file
 from cavex.verification.cases import fe_cases, make_fe_cases
 from cavex.verification.cases import projectile_table as projectile_to_table
 from cavex.verification.cases import target_table as target_to_table
 from cavex.verification.number_format import round_dataset
-from cavex.verification.runner import run_cases
+from cavex.verification.runner import check_execution, run_cases
 
 DEFAULT_VELOCITIES = tuple(np.linspace(0.0, 1200.0, 13))
 DEFAULT_DEPTHS = tuple(np.round(np.linspace(0.10, 1.30, 31), 6))
@@ -118,13 +120,15 @@ def check_grid(velocities, depths):
     """Raise :class:`CavexInputError` unless the grid can be tabulated and interpolated."""
     v = np.asarray(velocities, dtype=float)
     d = np.asarray(depths, dtype=float)
-    require(v.ndim == 1 and v.size >= 2 and np.all(np.isfinite(v)), "velocities",
-            "at least two finite values", list(v))
+    shown_v, shown_d = [float(x) for x in v.ravel()], [float(x) for x in d.ravel()]
+    require(v.ndim == 1 and np.all(np.isfinite(v)) and np.all(v >= 0.0), "velocities",
+            "finite values >= 0 (m/s)", shown_v)
+    require(np.unique(v).size >= 2, "velocities", "at least two different values", shown_v)
     require(v.min() == 0.0, "velocities",
-            "a grid that includes V = 0 (the nose tip sees V cos(phi) -> 0)", list(v))
-    require(np.all(v >= 0.0), "velocities", ">= 0", list(v))
-    require(d.ndim == 1 and d.size >= 2 and np.all(np.isfinite(d)) and np.all(d >= 0.0),
-            "depths", "at least two finite values >= 0", list(d))
+            "a grid that includes V = 0 (the nose tip sees V cos(phi) -> 0)", shown_v)
+    require(d.ndim == 1 and np.all(np.isfinite(d)) and np.all(d >= 0.0), "depths",
+            "finite values >= 0 (m)", shown_d)
+    require(np.unique(d).size >= 2, "depths", "at least two different values", shown_d)
 
 
 # --- building ---------------------------------------------------------------------------------
@@ -350,9 +354,12 @@ def load_table(path):
     """Read a table written by :func:`write_table` (fully into memory; the file is closed)."""
     try:
         ds = xr.load_dataset(path, engine="scipy")
-    except (OSError, ValueError, TypeError) as exc:
-        raise CavexInputError(f"table '{path}' cannot be read as a netCDF3 table: {exc}") from None
-    missing = [k for k in ("sigma_r", "sigma_r_first_layer", "wall_layer") if k not in ds]
+    except Exception as exc:  # a truncated or foreign file fails in many ways inside the reader
+        reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise CavexInputError(f"table '{path}' cannot be read as a netCDF3 table: "
+                              f"{reason}") from None
+    missing = [k for k in ("sigma_r", "sigma_r_first_layer", "wall_layer", "failed",
+                           "failed_first_layer") if k not in ds]
     if missing or "fingerprint" not in ds.attrs:
         raise CavexInputError(f"'{path}' is not a cavex table (missing "
                               f"{', '.join(missing) or 'fingerprint attribute'})")
@@ -362,9 +369,16 @@ def load_table(path):
 
 # --- command-line job -------------------------------------------------------------------------
 
+STORE_SUFFIX = ".cases"  # cavex table's resumable case store: <out>.cases/ until it is written
+
+
 def table_main(config_path=None, velocities=None, depths=None, out_path="results/table.nc",
                nu=None, workers=None, scheduler=None, numerics=None, progress=None):
     """The ``cavex table`` job: build, write and summarise a table; returns the summary text.
+
+    The output location, the grid, ``workers`` and ``scheduler`` are checked before any FE
+    work; finished cells are kept in ``<out>.cases/`` while the table is built, so that a killed
+    run resumes where it stopped (the folder is removed once the table is written).
 
     Defaults: velocities 0, 100, ..., 1200 m/s (13), depths 0.10 ... 1.30 m every 0.04 m (31,
     plus the two wall-layer switch depths): concrete, macadam and into the soil.
@@ -372,13 +386,18 @@ def table_main(config_path=None, velocities=None, depths=None, out_path="results
     from cavex.config import load_config
 
     target, projectile = load_config(config_path)
+    velocities = DEFAULT_VELOCITIES if velocities is None else velocities
+    depths = DEFAULT_DEPTHS if depths is None else depths
+    check_grid(velocities, depths)
+    out_path = check_output_file(out_path, "out")
+    workers = check_execution(workers, scheduler)
+    store = out_path.with_name(out_path.name + STORE_SUFFIX)
     start = time.perf_counter()
-    ds = build_table(target, projectile,
-                     DEFAULT_VELOCITIES if velocities is None else velocities,
-                     DEFAULT_DEPTHS if depths is None else depths, nu=nu, numerics=numerics,
-                     scheduler=scheduler, workers=workers, progress=progress)
+    ds = build_table(target, projectile, velocities, depths, nu=nu, numerics=numerics,
+                     scheduler=scheduler, workers=workers, progress=progress, store=store)
     seconds = time.perf_counter() - start
     written = write_table(ds, out_path)
+    shutil.rmtree(store, ignore_errors=True)  # the table holds every cell now
     return summary_text(ds, seconds, written)
 
 

@@ -198,6 +198,8 @@ def _linear(x, y):
 def _check_table(table, name, switches):
     """Refuse tables that cannot be interpolated honestly."""
     v, d = table["velocity"].values, table["depth"].values
+    if not (np.all(np.isfinite(v)) and np.all(np.isfinite(d))):
+        raise CavexInputError(f"table '{name}' has non-finite velocity or depth coordinates")
     if v.size < 2 or v[0] != 0.0 or np.any(np.diff(v) <= 0):
         raise CavexInputError(f"table '{name}' velocities must increase from V = 0 (the nose "
                               f"tip sees V cos(phi) -> 0); it has {v[0]:g}..{v[-1]:g} m/s")
@@ -210,9 +212,16 @@ def _check_table(table, name, switches):
                               f"{', '.join(f'{s:g}' for s in missing)} m; rebuild it with "
                               "build_table, which inserts them")
     failed = int(table["failed"].sum()) + int(table["failed_first_layer"].sum())
-    if failed or np.any(~np.isfinite(table["sigma_r"].values)):
-        raise CavexInputError(f"table '{name}' has {failed} failed FE cell(s) (NaN); see its "
-                              "'failures' attribute and rebuild those cells")
+    values = np.concatenate([np.ravel(table["sigma_r"].values),
+                             np.ravel(table["sigma_r_first_layer"].values)])
+    missing = int(np.sum(~np.isfinite(values)))
+    if failed or missing:
+        raise CavexInputError(f"table '{name}' has {failed} failed FE cell(s) and {missing} "
+                              "non-finite wall stress(es); see its 'failures' attribute and "
+                              "rebuild those cells")
+    if np.any(values <= 0.0):
+        raise CavexInputError(f"table '{name}' has {int(np.sum(values <= 0.0))} wall "
+                              "stress(es) <= 0 (cavex tables hold compressive sigma_r > 0, Pa)")
 
 
 def check_fingerprint(table, target, projectile, name="in-memory table"):

@@ -1,0 +1,59 @@
+"""Output locations, checked before any work is done.
+
+A command that writes refuses at once, with one line naming its option and the reason, when it
+could not write where it is asked to (a parent that is a file, a read-only or immutable folder,
+a pseudo file system such as ``/proc``, an empty path), instead of failing after the
+computation and losing it. Nothing is created by the check: the folder is made when the command
+writes.
+"""
+
+import os
+import tempfile
+from pathlib import Path
+
+from cavex.errors import CavexInputError, require
+
+
+def check_output_dir(path, option, shown=None):
+    """The folder ``path`` as a :class:`~pathlib.Path` if it exists as a writable folder or can
+    be created as one; else :class:`CavexInputError` naming ``option`` (and ``shown``, the path
+    the user gave, when it differs)."""
+    text = os.fspath(path)
+    require(text.strip() != "", option, "a non-empty path", text)
+    folder = Path(text)
+    existing = folder
+    while not existing.exists():
+        if existing.parent == existing:
+            break
+        existing = existing.parent
+    shown = text if shown is None else shown
+    if existing != folder:
+        require(existing.is_dir(), option, f"a path whose existing part '{existing}' is a folder",
+                shown)
+    else:
+        require(folder.is_dir(), option, f"a path in a folder ('{folder}' is a file)", shown)
+    _check_writable(existing, option, shown)
+    return folder
+
+
+def check_output_file(path, option):
+    """The file ``path`` as a :class:`~pathlib.Path` if its folder is writable (or can be
+    created) and it is not a folder; else :class:`CavexInputError` naming ``option``."""
+    text = os.fspath(path)
+    require(text.strip() != "", option, "a non-empty path", text)
+    file = Path(text)
+    require(not file.is_dir(), option, "a file path (it is a folder)", text)
+    check_output_dir(file.parent if str(file.parent) else Path("."), option, shown=text)
+    return file
+
+
+def _check_writable(folder, option, text):
+    """Create and remove a temporary file in ``folder`` (the only test that also catches
+    immutable folders, pseudo file systems and root's read-only mounts)."""
+    try:
+        handle, name = tempfile.mkstemp(dir=folder, prefix=".cavex-check-")
+        os.close(handle)
+        os.remove(name)
+    except OSError as exc:
+        raise CavexInputError(f"parameter '{option}' must be a writable location (got "
+                              f"{text!r}: {exc.strerror or exc})") from None
