@@ -113,7 +113,7 @@ RANGES = {  # closed intervals of the numeric settings (growth_per_step excludes
 def _in(name, value, open_low=False):
     low, high = RANGES[name]
     ok = _finite(value) and (low < value if open_low else low <= value) and value <= high
-    require(ok, name, f"{'(' if open_low else '['}{low:g}, {high:g}]", value)
+    require(ok, name, f"in {'(' if open_low else '['}{low:g}, {high:g}]", value)
 
 
 def _integer(name, value):

@@ -95,7 +95,7 @@ BAD_SWEEPS = [
      r"parameter 'grid.velocities\[0\]' must be a finite number > 0 \(got -1\)"),
     ("[grid]\nvelocities = 300.0\ndepths = [0.3]\n", "parameter 'grid.velocities' must be"),
     ("[grid]\nvelocities = [300.0]\ndepths = [0.3]\n[numerics]\ngrowth_per_step = [0.1, 2.0]\n",
-     r"parameter 'numerics.growth_per_step' must be in \(0, 1\] \(got 2.0\)"),
+     r"parameter 'numerics.growth_per_step' must be in \(0, 0.5\] \(got 2.0\)"),
     ("[grid]\nvelocities = [300.0]\ndepths = [0.3]\n[numerics]\nelements_per_decad = 3\n",
      "unknown key 'numerics.elements_per_decad'"),
     ("[grid]\nvelocities = [300.0]\ndepths = [0.3]\n[[materials]]\nlayer = 'concrete'\n"

@@ -5,6 +5,7 @@ recomputed, never used."""
 import fcntl
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,7 @@ from cavex.cli import main
 from cavex.config import default_config_text, load_config
 from cavex.errors import CavexInputError
 from cavex.verification.cases import config_tables, make_fe_cases, probe_cases
-from cavex.verification.runner import LOCK_NAME, read_store, run_cases, write_case
+from cavex.verification.runner import read_store, run_cases, write_case
 from cavex.verification.table import analytic_table, load_table, write_table
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sweep.toml"
@@ -84,7 +85,8 @@ def test_unwritable_output_is_refused_before_any_work(capsys, tmp_path, files, c
 @pytest.mark.parametrize(("option", "value", "name"), [
     ("--workers", "0", "'workers'"), ("--workers", "-1", "'workers'"),
     ("--workers", "100000", "'workers'"), ("--scheduler", "bogus", "'scheduler'"),
-    ("--scheduler", "tcp://127.0.0.1:1", "reachable"), ("--scheduler", "tcp://:99999", "'scheduler'"),
+    ("--scheduler", "tcp://127.0.0.1:1", "reachable"),
+    ("--scheduler", "tcp://:99999", "'scheduler'"),
 ])
 @pytest.mark.parametrize("command", [
     ["batch", "{sweep}", "--out", "{tmp}/b"],
@@ -139,7 +141,7 @@ def test_config_not_utf8_or_with_a_numeric_name(capsys, tmp_path):
 def test_sweep_not_utf8_or_named_outside_its_folder(capsys, tmp_path):
     noise = tmp_path / "noise.toml"
     noise.write_bytes(b"[grid]\nvelocities = [\xff\xfe]\n")
-    refused(capsys, tmp_path, ["batch", noise, "--out", tmp_path / "b"], "not valid UTF-8")
+    refused(capsys, tmp_path, ["batch", noise, "--out", tmp_path / "b"], "not UTF-8")
     escape = tmp_path / "escape.toml"
     escape.write_text(SMALL_SWEEP.replace('name = "small"', 'name = "/tmp/elsewhere"'))
     refused(capsys, tmp_path, ["batch", escape], "'sweep.name'")
@@ -218,10 +220,13 @@ def test_damaged_store_entries_are_recomputed_not_used(tmp_path):
 def test_a_store_in_use_is_refused(tmp_path):
     store = tmp_path / "store"
     store.mkdir()
-    with open(store / LOCK_NAME, "a+") as handle:
+    handle = os.open(store, os.O_RDONLY)
+    try:  # another run holds the store
         fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         with pytest.raises(CavexInputError, match="in use by another cavex run"):
             run_cases(probe_cases, probes(2), store=store, workers=1)
+    finally:
+        os.close(handle)
     assert len(run_cases(probe_cases, probes(2), store=store, workers=1)) == 2
 
 
@@ -242,7 +247,6 @@ def test_refused_rerun_keeps_the_sweep_description(capsys, tmp_path):
 
 
 def test_pool_workers_end_with_their_parent():
-    import os
     import signal
     import subprocess
     import sys

@@ -173,13 +173,13 @@ def test_bad_cases_are_input_errors(cases, message):
 
 
 def test_bad_workers_is_an_input_error():
-    with pytest.raises(CavexInputError, match="parameter 'workers' must be an integer >= 1"):
+    with pytest.raises(CavexInputError, match=r"parameter 'workers' must be an integer in \[1, "):
         run_cases(probe_cases, probes(1), workers=0)
 
 
 def test_progress_bar_on_request_only(capsys):
     run_cases(probe_cases, probes(3), workers=1, progress=True)
-    assert "3/3 100%" in capsys.readouterr().err
+    assert "100%" in (err := capsys.readouterr().err) and "3/3" in err  # tqdm
     run_cases(probe_cases, probes(3), workers=1)
     assert capsys.readouterr().err == ""  # stderr is not a terminal under pytest
 
@@ -200,5 +200,5 @@ def test_fe_case_ids_are_stable_and_unique():
 
 
 def test_bad_scheduler_address_is_an_input_error():
-    with pytest.raises(CavexInputError, match="parameter 'scheduler' must be a reachable Dask"):
+    with pytest.raises(CavexInputError, match="'scheduler' must be a Dask scheduler address"):
         run_cases(probe_cases, probes(1), scheduler="nonsense://nowhere")

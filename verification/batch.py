@@ -134,9 +134,11 @@ def _read_sweep(path_or_dict):
             data = tomllib.load(handle)
     except OSError as exc:
         raise CavexInputError(f"sweep '{path}' cannot be read: {exc.strerror}") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise CavexInputError(f"sweep '{path}' is not valid UTF-8 TOML: {reason}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise CavexInputError(f"sweep '{path}' is not valid TOML: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise CavexInputError(f"sweep '{path}' is not UTF-8 text (byte {exc.start}: "
+                              f"{exc.reason})") from None
     stem = re.sub(r"[^A-Za-z0-9._-]", "_", os.path.splitext(os.path.basename(path))[0])
     return data, os.path.dirname(os.path.abspath(path)), stem.lstrip("._-") or "sweep"
 
@@ -394,7 +396,8 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
     cases = sweep_cases(sweep)
     out_dir = os.fspath(check_output_dir(out_dir, "out"))
     scheduler = scheduler if scheduler is not None else sweep.scheduler
-    workers = check_execution(workers if workers is not None else sweep.workers, scheduler)
+    workers = workers if workers is not None else sweep.workers
+    check_execution(workers, scheduler)
     check_store(os.path.join(out_dir, STORE_DIR), cases)  # before sweep.json is rewritten
     os.makedirs(out_dir, exist_ok=True)
     description = _description(sweep, cases)
@@ -502,8 +505,9 @@ def batch_main(path, out_dir=None, scheduler=None, workers=None, progress=None,
     cases = sweep_cases(sweep)
     check_output_dir(out_dir, "out")
     scheduler = scheduler if scheduler is not None else sweep.scheduler
-    workers = check_execution(workers if workers is not None else sweep.workers, scheduler)
-    estimate = check_run_size(len(cases), workers, allow_large)
+    workers = workers if workers is not None else sweep.workers
+    check_execution(workers, scheduler)
+    estimate = check_run_size(len(cases), workers or os.cpu_count() or 1, allow_large)
     check_store(os.path.join(out_dir, STORE_DIR), cases)
     print(f"sweep '{sweep.name}': {estimate}", file=sys.stderr)
     ids = {case["id"] for case in cases}

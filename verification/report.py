@@ -275,7 +275,7 @@ def verify_main(config_path=None, quick=False, out_dir=None, scheduler=None, wor
     config = default_config_text() if config_path is None else Path(config_path).read_text(
         encoding="utf-8")
     out_dir = check_output_dir(DEFAULT_OUT if out_dir is None else out_dir, "out")
-    workers = check_execution(workers, scheduler)
+    check_execution(workers, scheduler)
     summary = verify(target, projectile, quick=quick, out_dir=out_dir, scheduler=scheduler,
                      workers=workers, config_text=config)
     return summary_text(summary)

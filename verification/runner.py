@@ -23,6 +23,7 @@ import socket
 import sys
 import threading
 import time
+import uuid
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
 from cavex.errors import CavexInputError, require
@@ -35,7 +36,6 @@ _BAD_ID_CHARS = set('/\\\0:*?"<>|')
 MAX_CHUNK = 200  # cases per work unit (the FE solver's stack size)
 MAX_WORKERS_PER_CPU = 4  # local processes beyond this only compete for the cores
 SCHEDULER_TIMEOUT = 10.0  # s: how long an unreachable Dask scheduler is waited for
-LOCK_NAME = ".lock"
 _ADDRESS = re.compile(r"^(?:(?P<protocol>tcp|tls|ws|wss|ucx)://)?"
                       r"(?P<host>\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9][A-Za-z0-9.\-]*):(?P<port>\d{1,5})$")
 
@@ -80,7 +80,11 @@ def run_cases(function, cases, *, store=None, scheduler=None, workers=None, prog
     """
     cases = list(cases)
     _check_cases(cases)
-    workers = check_execution(workers, scheduler)
+    check_execution(workers, scheduler)
+    if scheduler is not None and workers is not None:
+        print(f"cavex: note: workers = {workers} is ignored: the Dask scheduler's workers run "
+              "the cases", file=sys.stderr)
+    workers = (os.cpu_count() or 1) if workers is None else workers
     with _locked(store):
         results = _load_store(store, cases) if store is not None else {}
         todo = [case for case in cases if case["id"] not in results]
@@ -102,13 +106,12 @@ def run_cases(function, cases, *, store=None, scheduler=None, workers=None, prog
 
 
 def check_execution(workers, scheduler):
-    """Check ``workers`` and ``scheduler`` before anything is created; returns the number of
-    local workers. A malformed scheduler address is refused at once, an unreachable one after
+    """Check ``workers`` (None: one per CPU) and ``scheduler`` before anything is created; a
+    malformed scheduler address is refused at once, an unreachable one after
     :data:`SCHEDULER_TIMEOUT` seconds (the message says so)."""
-    workers = _check_workers(workers)
+    _check_workers(workers)
     if isinstance(scheduler, str):
         _check_address(scheduler)
-    return workers
 
 
 def check_store(store, cases):
@@ -126,7 +129,7 @@ def _locked(store):
         yield
         return
     os.makedirs(store, exist_ok=True)
-    handle = open(os.path.join(store, LOCK_NAME), "a+")  # noqa: SIM115 - held until the end
+    handle = os.open(store, os.O_RDONLY)  # the folder itself is locked: no lock file
     try:
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -135,7 +138,7 @@ def _locked(store):
                                   "wait for it or use another output folder") from None
         yield
     finally:
-        handle.close()
+        os.close(handle)
 
 
 def run_chunk(function, chunk):
@@ -381,7 +384,7 @@ def _run_pool(function, todo, workers, finished):
     """Local processes; at most ``2 * workers`` chunks in flight."""
     pending = iter(todo)
     with ProcessPoolExecutor(max_workers=workers, mp_context=_pool_context(),
-                             initializer=_die_with_parent, initargs=(os.getpid(),)) as pool:
+                             initializer=_die_with_parent) as pool:
         try:
             running = {}
             _top_up(running, pending, 2 * workers,
@@ -397,16 +400,15 @@ def _run_pool(function, todo, workers, finished):
             raise
 
 
-def _die_with_parent(parent):
-    """Worker initialiser: end this process when the parent ends, even by ``kill -9`` (Linux's
-    parent-death signal where available, else a watchdog thread)."""
+def _die_with_parent():
+    """Worker initialiser: end this process when its parent ends, even by ``kill -9`` (Linux's
+    parent-death signal where available, and a watchdog thread)."""
+    parent = os.getppid()
     try:
         libc = ctypes.CDLL(None, use_errno=True)
         libc.prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
     except (OSError, AttributeError):
         pass
-    if os.getppid() != parent:  # the parent ended before the signal was armed
-        os._exit(1)
 
     def watch():
         while os.getppid() == parent:
@@ -447,8 +449,10 @@ def _stream_dask(client, as_completed, function, todo, finished):
     pending = iter(todo)
     running = {}
 
-    def submit(case):
-        return client.submit(run_chunk, function, case, pure=False)
+    def submit(chunk):  # tasks named by what they compute, e.g. "fe_cases-v0500.000_L0.30000+41"
+        name = getattr(function, "__name__", "cases")
+        return client.submit(run_chunk, function, chunk, pure=False,
+                             key=f"{name}-{chunk[0]['id']}+{len(chunk) - 1}-{uuid.uuid4().hex[:8]}")
 
     _top_up(running, pending, limit, submit)
     stream = as_completed(list(running))
@@ -481,41 +485,18 @@ def _show_progress(progress):
 
 
 class _Progress:
-    """A one-line progress bar with ETA on stderr (nothing when disabled)."""
+    """Progress bar with ETA on stderr through tqdm (works in terminals, notebooks and logs);
+    nothing when disabled."""
 
-    def __init__(self, total, done, enabled, width=30):
-        self.total, self.done, self.enabled, self.width = total, done, enabled, width
-        self.stored = done
-        self.start = time.monotonic()
-        self._draw()
+    def __init__(self, total, done, enabled, unit="case"):
+        from tqdm.auto import tqdm
 
-    def update(self):
-        self.done += 1
-        self._draw()
+        tqdm.monitor_interval = 0  # no monitor thread: a pool forked later stays a plain fork
+        self.bar = tqdm(total=total, initial=done, disable=not enabled, file=sys.stderr,
+                        unit=unit, dynamic_ncols=True, leave=True)
+
+    def update(self, n=1):
+        self.bar.update(n)
 
     def close(self):
-        if self.enabled:
-            sys.stderr.write("\n")
-            sys.stderr.flush()
-
-    def _draw(self):
-        if not self.enabled:
-            return
-        fraction = self.done / self.total if self.total else 1.0
-        filled = int(round(self.width * fraction))
-        elapsed = time.monotonic() - self.start
-        computed = self.done - self.stored
-        remaining = self.total - self.done
-        eta = elapsed / computed * remaining if computed else math.nan
-        sys.stderr.write(f"\r[{'#' * filled}{'.' * (self.width - filled)}] "
-                         f"{self.done}/{self.total} {fraction:4.0%} "
-                         f"elapsed {_clock(elapsed)} ETA {_clock(eta)}")
-        sys.stderr.flush()
-
-
-def _clock(seconds):
-    if not math.isfinite(seconds):
-        return "--:--"
-    minutes, secs = divmod(int(round(seconds)), 60)
-    hours, minutes = divmod(minutes, 60)
-    return f"{hours}:{minutes:02d}:{secs:02d}" if hours else f"{minutes:02d}:{secs:02d}"
+        self.bar.close()

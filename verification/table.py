@@ -390,7 +390,7 @@ def table_main(config_path=None, velocities=None, depths=None, out_path="results
     depths = DEFAULT_DEPTHS if depths is None else depths
     check_grid(velocities, depths)
     out_path = check_output_file(out_path, "out")
-    workers = check_execution(workers, scheduler)
+    check_execution(workers, scheduler)
     store = out_path.with_name(out_path.name + STORE_SUFFIX)
     start = time.perf_counter()
     ds = build_table(target, projectile, velocities, depths, nu=nu, numerics=numerics,
