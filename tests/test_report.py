@@ -6,6 +6,7 @@ import re
 import numpy as np
 import pytest
 import xarray as xr
+from cf_check import check_cf, check_quantify
 
 from cavex.config import default_config_text, load_config
 from cavex.verification import report, report_picture
@@ -34,16 +35,18 @@ def appendix_rows(markdown):
     return header, [[c.strip() for c in x.strip("|").split("|")] for x in lines[2:]]
 
 
+PNGS = ["error_maps", "validity", "S_depth", "states", "plastic_radius", "error_estimate",
+        "stresses", "trajectories"]
+
+
 def test_quick_report_writes_every_file(quick_report):
     out, summary, grid = quick_report
     for name in ("report.md", "report.html", "grid.nc", "target.toml"):
         assert (out / name).stat().st_size > 0
-    pngs = ["error_dynamic", "error_quasi_static", "error_paper", "validity", "S_depth",
-            "states", "plastic_radius", "error_estimate", "sphere"]
-    for name in pngs:
+    for name in PNGS:
         assert (out / f"{name}.png").read_bytes()[:8] == PNG, name
     html = (out / "report.html").read_text()
-    assert html.count("<img ") == len(pngs) and "<table>" in html
+    assert html.count("<img ") == len(PNGS) and "<table>" in html
     assert summary["cells"] == grid.sizes["velocity"] * grid.sizes["depth"] >= 3 * 3
     assert grid.sizes["velocity"] == 3 and set(np.unique(grid["wall_layer"])) == {0, 1, 2}
     # nothing that differs from run to run: wall times and the creation time only in the summary
@@ -75,8 +78,88 @@ def test_report_numbers_equal_grid(quick_report):
             printed = float(PERCENT.match(row[col[name]]).group(1))
             assert printed == pytest.approx(100 * float(cell[f"rel_err_{key}"]), abs=5e-4)
             checked += 1
-        assert row[col["state (dynamic)"]] == str(cell["state_dynamic"].values)
+        meanings = dict(zip(cell["state_dynamic"].attrs["flag_values"].tolist(),
+                            cell["state_dynamic"].attrs["flag_meanings"].split(), strict=True))
+        assert row[col["state (dynamic)"]] == meanings[int(cell["state_dynamic"])]
     assert checked >= 3 * 20
+
+
+def test_quick_report_is_complete(quick_report):
+    """The quick grid reaches the crater's end and V0: the trajectory comparison is there."""
+    out, summary, grid = quick_report
+    md = (out / "report.md").read_text()
+    section = md.split("## Trajectories: closed forms against the FE table", 1)[1]
+    assert "not possible" not in md and "![trajectories](trajectories.png)" in section
+    rows = [x for x in section.split("\n## ", 1)[0].splitlines() if x.startswith("| ")]
+    names = [r.strip("|").split("|")[0].strip() for r in rows[1:5]]
+    assert names == ["derived quasi-static", "derived dynamic", "paper", "FE table"]
+    trajectories = json.loads(grid.attrs["trajectories"])
+    assert trajectories["FE table"]["final_depth_m"] > 1.3  # through all three layers
+    target, projectile = load_config()
+    assert grid.depth.values[0] <= 0.06 + 4.5 * projectile.r  # the crater's end (nose base)
+    assert grid.velocity.values[-1] >= projectile.V0
+    assert "stress figure not drawn" not in md and "![stresses](stresses.png)" in md
+
+
+def test_report_html_is_self_contained_and_leads_with_a_figure(quick_report):
+    out, _, _ = quick_report
+    import xml.etree.ElementTree as ET
+    from html.parser import HTMLParser
+
+    html = (out / "report.html").read_text()
+    root = ET.fromstring(html.split("\n", 1)[1])  # well-formed (after the DOCTYPE line)
+    sources, hrefs = [], []
+
+    class Collect(HTMLParser):
+        def handle_starttag(self, tag, attrs):
+            attrs = dict(attrs)
+            if "src" in attrs:
+                sources.append(attrs["src"])
+            if tag == "a":
+                hrefs.append(attrs["href"])
+
+    Collect().feed(html)
+    assert len(sources) == len(PNGS)
+    assert all(s.startswith("data:image/png;base64,") for s in sources)
+    assert 'src="' not in html.replace('src="data:', "")  # nothing loaded from a file
+    # a table of contents whose every link reaches a heading
+    ids = {e.get("id") for e in root.iter() if e.get("id")}
+    assert len(hrefs) >= 10 and all(h[1:] in ids for h in hrefs if h.startswith("#"))
+    # one figure and one table first, the prose after
+    body = root.find("body")
+    kinds = [e.tag for e in body if e.tag in ("figure", "div", "ul")]
+    assert kinds[:3] == ["figure", "div", "ul"]
+    assert body.find("div").find("table") is not None
+    # numbers do not wrap inside table cells
+    assert "td.num{text-align:right;white-space:nowrap}" in html
+    assert '<td class="num">+' in html and '<td>derived dynamic</td>' in html
+
+
+def test_grid_nc_is_cf(quick_report):
+    """grid.nc: CF-1.10, units and long_name everywhere, coded variables with flags."""
+    _, _, grid = quick_report
+    coded = ["failed", "failed_first_layer", "wall_layer",
+             *(f"{kind}_{key}" for kind in ("validity", "resolved")
+               for key in ("dynamic", "quasi_static", "paper")),
+             "state_dynamic", "state_quasi_static"]
+    check_cf(grid, coded)
+    assert grid["velocity"].attrs["units"] == "m s-1"
+    assert grid["validity_paper"].attrs["flag_meanings"] == (
+        "FE_failed within_1_percent within_5_percent beyond_5_percent")
+    assert grid["wall_layer"].attrs["flag_meanings"] == "concrete macadam soil"
+    check_quantify(grid)
+
+
+def test_response_states_are_explained(quick_report):
+    out, _, grid = quick_report
+    md = (out / "report.md").read_text()
+    labels = grid["state_dynamic"].attrs["flag_meanings"].split()
+    assert "a" in labels and "f" in labels
+    for label in labels:
+        assert f"- `{label}`: " in md
+    assert "- `a`: concrete + macadam + soil around the cavity; the plastic zone (radius b) " \
+           "ends inside concrete" in md
+    assert "- `f`: macadam + soil around the cavity" in md
 
 
 def test_accuracy_table_and_conclusion_from_grid(quick_report):
@@ -236,21 +319,22 @@ def test_failed_cell_and_renderer_failure(tmp_path, monkeypatch, capsys):
                 if case["velocity"] == 1000.0 and case["depth"] == 0.5 else result
                 for case, result in zip(chunk, out, strict=True)]
 
-    def no_opengl(*args, **kwargs):
-        raise RuntimeError("no OpenGL context\nsecond line")
+    def cannot_draw(*args, **kwargs):
+        raise RuntimeError("cannot draw\nsecond line")
 
     monkeypatch.setattr(table_module, "fe_cases", failing)  # workers=1: runs in this process
-    monkeypatch.setattr(report_picture, "render_sphere", no_opengl)
+    monkeypatch.setattr(report_picture, "plot_stresses", cannot_draw)
     target, projectile = load_config()
     summary = report.verify(target, projectile, out_dir=tmp_path, workers=1,
                             velocities=(0.0, 1000.0), depths=(0.3, 0.5),
                             numerics=dict(report.QUICK_NUMERICS))
     print(report.summary_text(summary))
     md = (tmp_path / "report.md").read_text()
-    message = "3-D picture not rendered (RuntimeError: no OpenGL context)"
+    message = "stress figure not drawn (RuntimeError: cannot draw)"
     assert summary["picture"] == message and message in md
     assert message in capsys.readouterr().out
-    assert not (tmp_path / "sphere.png").exists()
+    assert not (tmp_path / "stresses.png").exists()
+    assert not (tmp_path / "trajectories.png").exists()  # no trajectories: no figure
     assert (tmp_path / "validity.png").read_bytes()[:8] == PNG
     grid = xr.load_dataset(tmp_path / "grid.nc", engine="scipy")
     assert int(grid["failed"].sum()) == 1 and bool(grid["failed"].sel(velocity=1000.0, depth=0.5))

@@ -99,7 +99,9 @@ def test_netcdf_round_trip_is_exact_with_attributes(synthetic, runway, tmp_path)
     assert loaded["failed"].dtype == bool and loaded["wall_layer"].dtype == np.int32
     for name in [*loaded.data_vars, *loaded.coords]:
         assert loaded[name].attrs["units"], name
-    assert loaded["velocity"].attrs["units"] == "m/s" and loaded["depth"].attrs["units"] == "m"
+    assert loaded["velocity"].attrs["units"] == "m s-1" and loaded["depth"].attrs["units"] == "m"
+    assert loaded.attrs["Conventions"] == "CF-1.10"
+    assert loaded["failed"].attrs["flag_meanings"] == "ok failed"
     assert loaded["sigma_r"].attrs["units"] == "Pa"
     for key in ("target", "fingerprint", "solver_settings", "versions"):
         assert loaded.attrs[key], key

@@ -31,6 +31,7 @@ from cavex.verification.cases import (
     fe_cases,
     numerics_names,
 )
+from cavex.verification.cf_metadata import CONVENTIONS, boolean_attrs
 from cavex.verification.runner import (
     check_execution,
     check_store,
@@ -461,21 +462,34 @@ def _dataset(description, results):
                         {"units": units, "long_name": long_name})
                  for name, (path, units, long_name) in VARIABLES.items()}
     status = [r["status"] if r else "missing" for r in ordered]
+    # text variables: a long_name, no units (CF: units belong to numbers)
     data_vars["status"] = (dims, np.array(status, dtype=str).reshape(shape),
                            {"long_name": "ok, failed (see failure_reasons) or missing"})
     data_vars["failed"] = (dims, np.array([s != "ok" for s in status]).reshape(shape),
-                           {"long_name": "the case failed or was not run; its values are NaN"})
+                           boolean_attrs("the case failed or was not run; its values are NaN",
+                                         "ok", "failed_or_missing"))
     data_vars["case_id"] = (dims, np.array(ids, dtype=str).reshape(shape),
                             {"long_name": "case id (file cases/<id>.json)"})
-    coords = {axis["name"]: (axis["name"], np.asarray(axis["values"]),
-                             {"units": axis["units"], "long_name": axis["long_name"]})
+    coords = {axis["name"]: (axis["name"], np.asarray(axis["values"]), _axis_attrs(axis))
               for axis in axes}
     reasons = {r["id"]: r["reason"] for r in ordered if r and r["status"] == "failed"}
-    attrs = {"sweep": description["name"], "failure_reasons": json.dumps(reasons),
+    attrs = {"Conventions": CONVENTIONS, "title": f"cavex batch sweep {description['name']}",
+             "sweep": description["name"], "failure_reasons": json.dumps(reasons),
              "cases": len(ids), "failed_cases": len(reasons),
              "missing_cases": status.count("missing"),
              "fixed": json.dumps(description["fixed"])}
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def _axis_attrs(axis):
+    """CF attributes of a swept coordinate: numbers with units, booleans as flags (stored as
+    int8), text with a long_name only."""
+    values = np.asarray(axis["values"])
+    if values.dtype.kind == "b":
+        return boolean_attrs(axis["long_name"], "false", "true")
+    if values.dtype.kind in "US":
+        return {"long_name": axis["long_name"]}
+    return {"units": axis["units"], "long_name": axis["long_name"]}
 
 
 def _values(results, path):

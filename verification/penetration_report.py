@@ -27,11 +27,25 @@ def penetration_job(target, projectile, *, model="derived", boundary="quasi-stat
     runs = {"runway": _runway(target, projectile, model, boundary, epsilon, crater, table_path),
             "first_layer_only": penetrate(single, projectile, ClosedFormResistance(
                 single, projectile, model, boundary, epsilon=epsilon), crater=crater)}
+    title = resistance_title(model, boundary, epsilon, table_path)
     if table_path is not None:
         model = f"FE table {table_path} (first layer alone: {model})"
     return {"model": model, "boundary": boundary, "epsilon": epsilon, "crater": crater,
             "runs": runs, "table2": table2_comparison(runs["runway"]),
-            "interface_depths": target.interface_depths}
+            "interface_depths": target.interface_depths, "title": title,
+            "table": None if table_path is None else str(table_path),
+            "layer_names": [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]}
+
+
+def resistance_title(model, boundary, epsilon, table_path=None):
+    """What the figures say about the resistance: the settings the model uses (the paper's
+    model has its own quasi-static boundary and an epsilon reading; the derived model has a
+    boundary convention), and only the file name of an FE table."""
+    closed = (f"paper model (She 2020), epsilon: {epsilon}" if model == "paper"
+              else f"derived model, {boundary} boundary")
+    if table_path is None:
+        return closed
+    return f"FE table {Path(table_path).name} (first layer alone: {closed})"
 
 
 def _runway(target, projectile, model, boundary, epsilon, crater, table_path):
@@ -79,27 +93,43 @@ def _write_csv(path, columns):
 
 
 def _write_figures(job, out):
+    import textwrap
+
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     runway, single = job["runs"]["runway"], job["runs"]["first_layer_only"]
-    title = f"{job['model']} model, {job['boundary']} boundary"
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(runway.t * 1e3, runway.velocity, label="runway (layered)")
-    ax.plot(single.t * 1e3, single.velocity, "--", label="first layer alone")
-    ax.set(xlabel="time (ms)", ylabel="velocity (m/s)", title=f"Velocity vs time: {title}")
+    subtitle = textwrap.fill(job.get("title", job["model"]), 70)
+    names = job.get("layer_names", [])
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    runway_label = "runway (layered)" if job.get("table") is None else \
+        "runway (layered, FE table)"
+    ax.plot(runway.t * 1e3, runway.velocity, label=runway_label)
+    ax.plot(single.t * 1e3, single.velocity, "--", label=f"{names[0] if names else 'first layer'}"
+            " alone")
+    ax.set(xlabel="time (ms)", ylabel="velocity (m/s)")
+    ax.set_title(f"Velocity against time\n{subtitle}", fontsize=10)
     ax.legend()
     velocity_png = _save(fig, out / "velocity_time.png", plt)
-    fig, ax = plt.subplots(figsize=(6, 4))
-    ax.plot(runway.depth, runway.deceleration / 9.81 / 1e3, label="runway (layered)")
-    ax.plot(single.depth, single.deceleration / 9.81 / 1e3, "--", label="first layer alone")
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    ax.plot(runway.depth, runway.deceleration / 9.81 / 1e3, label=runway_label)
+    ax.plot(single.depth, single.deceleration / 9.81 / 1e3, "--",
+            label=f"{names[0] if names else 'first layer'} alone")
+    left, right = ax.get_xlim()
+    bounds = [left, *job["interface_depths"], right]
     for depth in job["interface_depths"]:
         ax.axvline(depth, color="grey", linewidth=0.8, linestyle=":")
-    ax.set(xlabel="nose depth (m)", ylabel="deceleration (10^3 g)",
-           title=f"Deceleration vs depth: {title}")
-    ax.legend()
+    for k, name in enumerate(names[:len(bounds) - 1]):
+        lo, hi = max(bounds[k], left), min(bounds[k + 1], right)
+        if hi - lo > 0.08 * (right - left):
+            ax.text(0.5 * (lo + hi), 1.0, name, ha="center", va="bottom", fontsize=8,
+                    style="italic", transform=ax.get_xaxis_transform())
+    ax.set_xlim(left, right)
+    ax.set(xlabel="nose-tip depth (m)", ylabel=r"deceleration ($10^3$ g)")
+    ax.set_title(f"Deceleration against depth\n{subtitle}", fontsize=10, pad=14)
+    ax.legend(loc="center right")
     return [velocity_png, _save(fig, out / "deceleration_depth.png", plt)]
 
 

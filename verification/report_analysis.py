@@ -23,6 +23,7 @@ from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.paper_model import paper_stress
 from cavex.errors import CavexInputError
+from cavex.verification.cf_metadata import decode_flags, flag_attrs
 from cavex.verification.number_format import round_dataset
 
 # (key, label, sigma_r variable) of each closed form, in report order.
@@ -49,35 +50,106 @@ def layer_names(target):
     return [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]
 
 
-def analytic_cell(target, projectile, depth, velocity):
-    """Closed-form quantities at one nose depth (m) and velocity (m/s) as a plain dict."""
-    layers, interfaces = spherical_problem(target, projectile, depth)
-    cell = {}
+def analytic_cells(target, projectile, depths, velocities):
+    """Closed-form quantities on the grid, ``cells[i][j]`` a plain dict at ``velocities[i]``
+    (m/s) and ``depths[j]`` (m), computed through the array form: one derived call per group
+    of depths with the same layers around the cavity and per convention (every velocity at
+    once); the paper's coefficients once per depth."""
+    velocities = np.asarray(velocities, dtype=float)
+    cells = [[{} for _ in depths] for _ in velocities]
+    groups = {}  # layers around the cavity -> (depth columns, their interface radii)
+    for j, depth in enumerate(depths):
+        layers, interfaces = spherical_problem(target, projectile, float(depth))
+        columns, radii = groups.setdefault(tuple(layers), ([], []))
+        columns.append(j)
+        radii.append(interfaces)
     for key, boundary in (("dynamic", "dynamic"), ("quasi_static", "quasi-static")):
-        state = cavity_solution(layers, interfaces, velocity, projectile.r, boundary=boundary)
-        cell[f"state_{key}"] = state.state
-        cell[f"b_{key}"] = state.plastic_radius
-    try:
-        cell["sigma_r_paper"] = paper_stress(target, projectile, float(depth), float(velocity))
-    except CavexInputError:
-        cell["sigma_r_paper"] = math.nan
-    return cell
+        for layers, (columns, radii) in groups.items():
+            interfaces = np.array(radii, dtype=float).reshape(len(columns), len(layers) - 1)
+            state = cavity_solution(layers, interfaces,
+                                    velocities[:, None], projectile.r, boundary=boundary)
+            for i in range(len(velocities)):
+                for k, j in enumerate(columns):
+                    cells[i][j][f"state_{key}"] = str(state.state[i, k])
+                    cells[i][j][f"b_{key}"] = float(state.plastic_radius[i, k])
+    for j, depth in enumerate(depths):
+        try:
+            paper = paper_stress(target, projectile, float(depth), velocities)
+        except CavexInputError:
+            paper = np.full(len(velocities), math.nan)
+        for i in range(len(velocities)):
+            cells[i][j]["sigma_r_paper"] = float(paper[i])
+    return cells
 
 
 def add_analytic(grid, target, projectile):
-    """Add ``sigma_r_paper``, ``state_*`` and ``b_*`` (derived dynamic and quasi-static)."""
-    cells = [[analytic_cell(target, projectile, float(L), float(V)) for L in grid.depth.values]
-             for V in grid.velocity.values]
+    """Add ``sigma_r_paper``, ``state_*`` and ``b_*`` (derived dynamic and quasi-static).
+
+    The response states are stored coded (``int8``, one code list for both conventions, in
+    label order) with CF ``flag_values``/``flag_meanings``; :func:`state_labels` decodes them.
+    """
+    cells = analytic_cells(target, projectile, grid.depth.values, grid.velocity.values)
     dims = ("velocity", "depth")
     out = grid.copy()
     for key in cells[0][0]:
-        values = np.array([[c[key] for c in row] for row in cells])
-        out[key] = (dims, values.astype(str) if values.dtype.kind in "US" else values)
+        if not key.startswith("state_"):
+            out[key] = (dims, np.array([[c[key] for c in row] for row in cells], dtype=float))
     out["sigma_r_paper"].attrs.update(units="Pa", long_name="paper's wall stress, Eqs. 19-29")
+    labels = {key: np.array([[c[f"state_{key}"] for c in row] for row in cells], dtype=str)
+              for key in ("dynamic", "quasi_static")}
+    vocabulary = sorted({str(x) for values in labels.values() for x in np.unique(values)},
+                        key=lambda label: (len(label.split("+")[0]) > 1, label))  # letters first
+    index = {label: i for i, label in enumerate(vocabulary)}
     for key in ("dynamic", "quasi_static"):
         out[f"b_{key}"].attrs.update(units="m", long_name=f"derived {key} plastic radius b")
-        out[f"state_{key}"].attrs["long_name"] = f"derived {key} response state (Fig. 2)"
+        codes = np.vectorize(index.__getitem__, otypes=[np.int8])(labels[key])
+        out[f"state_{key}"] = (dims, codes, flag_attrs(
+            range(len(vocabulary)), vocabulary,
+            f"derived {key.replace('_', '-')} response state (paper's Fig. 2, a-h)"))
     return out
+
+
+def state_labels(grid, key):
+    """Response-state labels (``"a"``, ``"c+island"``, ...) of ``state_<key>``, as strings."""
+    return decode_flags(grid[f"state_{key}"])
+
+
+# The paper's Fig. 2 states by the number of layers around the cavity ({0} = the wall layer):
+# where the elastic-plastic boundary b lies (cavex.analytic.cavity.PAPER_STATES).
+STATE_POSITIONS = {
+    3: dict(zip("abcde", ("inside {0}", "at the {0}|{1} interface ({1} elastic)", "inside {1}",
+                          "at the {1}|{2} interface ({2} elastic)", "inside {2}"), strict=True)),
+    2: dict(zip("fgh", ("inside {0}", "at the {0}|{1} interface ({1} elastic)", "inside {1}"),
+                strict=True)),
+}
+STATE_GROUPS = {3: "a-e", 2: "f-h"}
+STATE_SUFFIXES = {"island": "a layer between plastic ones stays elastic",
+                  "free": "the plastic zone reaches the free surface"}
+
+
+def state_meaning(label, names, short=False):
+    """Plain-language meaning of a response-state label for a target with layer ``names``.
+
+    The letters a-e are the states with three layers around the cavity (the last three),
+    f-h with two, ``single`` with one (:data:`STATE_POSITIONS`). ``short``: without the list
+    of the layers around the cavity.
+    """
+    base, *suffixes = str(label).split("+")
+    count = next((n for n, states in STATE_POSITIONS.items() if base in states), None)
+    if count is not None and len(names) >= count:
+        around = list(names[-count:])
+        where = STATE_POSITIONS[count][base].format(*around)
+        text = (f"plastic zone ends {where}" if short else f"{' + '.join(around)} around the "
+                f"cavity; the plastic zone (radius b) ends {where}")
+    elif base == "single":
+        text = f"plastic zone in {names[-1]}" if short else \
+            f"{names[-1]} alone around the cavity; the plastic zone (radius b) lies in it"
+    elif base == "elastic":
+        text = "nothing yields (no plastic zone)"
+    else:
+        text = (f"plastic zone ends at position code {base[1:]} (more layers than the "
+                "paper's figure)")
+    return "; ".join([text] + [STATE_SUFFIXES.get(s, s) for s in suffixes])
 
 
 def add_errors(grid):
@@ -91,8 +163,10 @@ def add_errors(grid):
         out[f"validity_{key}"] = validity_codes(rel, failed)
         resolved = out["error_estimate"] < RESOLVED_FRACTION * abs(rel)
         out[f"resolved_{key}"] = xr.where(failed, -1, resolved.astype(np.int8)).astype(
-            np.int8).assign_attrs(long_name=f"FE error estimate < {RESOLVED_FRACTION:.3g} "
-                                  "|rel_err| (1), not (0), failed (-1)")
+            np.int8).assign_attrs(flag_attrs(
+                [-1, 0, 1], ["FE_failed", "not_resolved", "resolved"],
+                f"FE error estimate < {RESOLVED_FRACTION:.3g} |rel_err_{key}|: resolved (1), "
+                "not (0), FE failed (-1)"))
     return out
 
 
@@ -101,8 +175,11 @@ def validity_codes(rel, failed):
     mag = abs(rel)
     codes = xr.where(mag <= TOLERANCES[0], 0, xr.where(mag <= TOLERANCES[1], 1, 2))
     codes = xr.where(failed | rel.isnull(), -1, codes).astype(np.int8)
-    return codes.assign_attrs(long_name="; ".join(f"{k}: {v}" for k, v in
-                                                  VALIDITY_LABELS.items()))
+    values = sorted(VALIDITY_LABELS)
+    return codes.assign_attrs(flag_attrs(
+        values, [VALIDITY_LABELS[v].replace(" %", "_percent") for v in values],
+        "closed form against FE: " + "; ".join(f"{k}: {v}" for k, v in
+                                               VALIDITY_LABELS.items())))
 
 
 def add_S(grid, target):
@@ -132,9 +209,13 @@ def add_error_parts(grid):
 def analyse(grid, target, projectile):
     """The FE grid with every analytic and derived report quantity added (the FE and
     closed-form values rounded first, see the module docstring)."""
+    coords = {name: dict(grid[name].attrs) for name in grid.coords}
     grid = round_dataset(add_analytic(grid.transpose("velocity", "depth", ...), target,
                                       projectile))
-    return add_error_parts(add_S(add_errors(grid), target))
+    out = add_error_parts(add_S(add_errors(grid), target))
+    for name, attrs in coords.items():  # xr.where drops the coordinates' units and long_name
+        out[name].attrs = attrs
+    return out
 
 
 def layer_mask(grid, index):

@@ -17,6 +17,8 @@ from cavex.verification.report_analysis import (
     attribution,
     layer_names,
     part_medians,
+    state_labels,
+    state_meaning,
 )
 
 LABELS = {key: label for key, label, _ in MODELS}
@@ -162,9 +164,10 @@ def failed_table(grid):
 def cell_rows(grid, target):
     """One row per (V, L) cell: the grid numbers as printed in the appendix."""
     names = layer_names(target)
+    states = {key: state_labels(grid, key) for key in ("dynamic", "quasi_static")}
     rows = []
-    for V in grid.velocity.values:
-        for L in grid.depth.values:
+    for i, V in enumerate(grid.velocity.values):
+        for j, L in enumerate(grid.depth.values):
             c = grid.sel(velocity=V, depth=L)
             failed = bool(c["failed"])
             flags = ["FE FAILED"] if failed else [
@@ -173,7 +176,7 @@ def cell_rows(grid, target):
                          "n/a" if failed else f"{float(c['sigma_r']) / 1e6:.4f}",
                          "n/a" if failed else f"{float(c['error_estimate']):.3e}",
                          *(pct(float(c[f"rel_err_{k}"])) for k, _, _ in MODELS),
-                         str(c["state_dynamic"].values), str(c["state_quasi_static"].values),
+                         states["dynamic"][i, j], states["quasi_static"][i, j],
                          _mm(c["plastic_radius"]), _mm(c["b_dynamic"]),
                          _mm(c["b_quasi_static"]), ", ".join(flags) or "-"])
     return rows
@@ -230,3 +233,18 @@ def resolution_text(grid, stats):
                      "are not resolved by the FE (dots on the error maps, 'unresolved' in the "
                      "cell table).")
     return "\n".join(lines)
+
+
+def states_text(grid, target):
+    """What the response-state labels of the state map mean (those present in the grid)."""
+    names = layer_names(target)
+    used = {int(x) for key in ("dynamic", "quasi_static")
+            for x in np.unique(grid[f"state_{key}"].values)}
+    present = [label for code, label in enumerate(
+        grid["state_dynamic"].attrs["flag_meanings"].split()) if code in used]
+    return "\n".join(
+        ["Response states (the paper's Fig. 2): the letter says how many layers still "
+         "surround the cavity at that nose depth (a-e: three, f-h: two, `single`: one; a layer "
+         "stops surrounding it once its interface comes within the shank radius r of the "
+         "cavity centre) and where the elastic-plastic boundary b lies among them:", ""]
+        + [f"- `{label}`: {state_meaning(label, names)}" for label in present])

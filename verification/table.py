@@ -13,7 +13,10 @@ velocity ``V``, on a grid, as an :class:`xarray.Dataset`:
   ``sigma_r_first_layer`` / ``failed_first_layer`` on ``velocity``: the first layer alone,
   semi-infinite, for the crater stage;
 - attributes: the TOML text of the target and projectile, their fingerprint, the solver
-  settings (JSON), package versions and the creation time.
+  settings (JSON), package versions and the creation time; ``Conventions = "CF-1.10"``: every
+  variable and coordinate has ``units`` (UDUNITS spelling, :mod:`cavex.verification.cf_metadata`)
+  and ``long_name``, and ``failed``, ``failed_first_layer`` and ``wall_layer`` carry
+  ``flag_values`` / ``flag_meanings``.
 
 The FE cells are run with the shared case runner (:mod:`cavex.verification.runner`) on cases
 from :func:`cavex.verification.cases.make_fe_cases`.
@@ -40,6 +43,7 @@ from cavex.paths import check_output_file
 from cavex.verification.cases import fe_cases, make_fe_cases
 from cavex.verification.cases import projectile_table as projectile_to_table
 from cavex.verification.cases import target_table as target_to_table
+from cavex.verification.cf_metadata import CONVENTIONS, UNITS, boolean_attrs, flag_attrs
 from cavex.verification.number_format import round_dataset
 from cavex.verification.runner import check_execution, run_cases
 
@@ -265,23 +269,25 @@ def assemble_table(target, projectile, velocities, depths, cells, crater, settin
                            _attrs("1", "FE relative discretisation error (Richardson)")),
         "plastic_radius": (grid, cells["plastic_radius"],
                            _attrs("m", "FE elastic-plastic boundary radius b")),
-        "failed": (grid, cells["failed"], _attrs("1", "FE run failed (cell is NaN)")),
+        "failed": (grid, cells["failed"],
+                   boolean_attrs("FE run failed (cell is NaN)", "ok", "failed")),
         "wall_layer": ("depth", np.array([wall_layer(target, projectile, L) for L in d],
                                          dtype=np.int32),
-                       _attrs("1", "index of the layer at the cavity wall; names in "
-                                   "attribute layer_names")),
+                       flag_attrs(range(len(names)), names, "index of the layer at the cavity "
+                                  "wall; names in attribute layer_names", np.int32)),
         "sigma_r_first_layer": ("velocity", cells_first(crater, "sigma_r"),
                                 _attrs("Pa", "FE cavity-wall stress, first layer alone "
                                              "(crater stage)")),
         "failed_first_layer": ("velocity", cells_first(crater, "failed"),
-                               _attrs("1", "FE first-layer run failed")),
+                               boolean_attrs("FE first-layer run failed", "ok", "failed")),
     }
     for boundary in ("dynamic", "quasi-static"):
         data["sigma_r_" + boundary.replace("-", "_")] = (
             grid, _analytic_grid(target, projectile, v, d, boundary),
             _attrs("Pa", f"analytic cavity-wall stress, {boundary} boundary (reference)"))
-    coords = {"velocity": ("velocity", v, _attrs("m/s", "cavity expansion velocity")),
-              "depth": ("depth", d, _attrs("m", "nose-tip depth L"))}
+    coords = {"velocity": ("velocity", v, _attrs(UNITS["velocity"],
+                                                 "cavity expansion velocity V")),
+              "depth": ("depth", d, _attrs(UNITS["length"], "nose-tip depth L"))}
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(table_attrs(target, projectile, settings))
     ds.attrs["layer_names"] = json.dumps(names)
@@ -301,6 +307,7 @@ def _attrs(units, long_name):
 def table_attrs(target, projectile, settings):
     """Global attributes: TOML text, fingerprint, settings, versions, creation time."""
     return {
+        "Conventions": CONVENTIONS,
         "title": "cavex FE-tabulated cavity-wall stress sigma_r(V, L)",
         "target": config_text(target, projectile),
         "fingerprint": fingerprint(target, projectile),

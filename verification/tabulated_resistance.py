@@ -276,6 +276,12 @@ def compare_trajectories(target, projectile, table, crater="nose-base"):
         ``final_time_s`` and ``at_H1`` (velocity and time when the nose tip reaches ``H1``:
         the residual velocity after the concrete; None if it stops before).
     """
+    return {name: trajectory_summary(run, target)
+            for name, run in comparison_runs(target, projectile, table, crater).items()}
+
+
+def comparison_runs(target, projectile, table, crater="nose-base"):
+    """The trajectories :func:`compare_trajectories` summarises: ``{name: Trajectory}``."""
     if not hasattr(table, "attrs"):
         table = load_table(table)
     models = {
@@ -285,8 +291,7 @@ def compare_trajectories(target, projectile, table, crater="nose-base"):
         "paper": ClosedFormResistance(target, projectile, "paper"),
         "FE table": TabulatedResistance(table, target, projectile),
     }
-    return {name: trajectory_summary(penetrate(target, projectile, r, crater=crater), target)
-            for name, r in models.items()}
+    return {name: penetrate(target, projectile, r, crater=crater) for name, r in models.items()}
 
 
 def trajectory_summary(trajectory, target):
