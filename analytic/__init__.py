@@ -6,11 +6,13 @@ from cavex.analytic.cavity import (
     cavity_stress,
     plastic_radius,
     quasi_static_coefficients,
+    response_state,
 )
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.nose import nose_force, ogive_coefficients
 from cavex.analytic.paper_model import (
     PaperCoefficients,
+    PaperModel,
     paper_coefficients,
     paper_phase_depths,
     paper_stress,
@@ -18,7 +20,7 @@ from cavex.analytic.paper_model import (
 from cavex.analytic.penetration import Trajectory, penetrate
 from cavex.analytic.resistance import ClosedFormResistance
 
-__all__ = ["CavityState", "ClosedFormResistance", "PaperCoefficients", "Trajectory",
+__all__ = ["CavityState", "ClosedFormResistance", "PaperCoefficients", "PaperModel", "Trajectory",
            "cavity_solution", "cavity_stress", "nose_force", "ogive_coefficients",
            "paper_coefficients", "paper_phase_depths", "paper_stress", "penetrate",
-           "plastic_radius", "quasi_static_coefficients", "spherical_problem"]
+           "plastic_radius", "quasi_static_coefficients", "response_state", "spherical_problem"]

@@ -19,12 +19,19 @@ def spherical_problem(target, projectile, depth, switch="cavity"):
     """``(layers, interfaces)`` of the spherical problem at nose-tip depth ``depth`` (m)."""
     require(math.isfinite(depth) and depth >= 0.0, "depth", "a finite number >= 0", depth)
     require_choice(switch, SWITCHES, "switch")
-    radii = [H - depth + projectile.l for H in target.interface_depths]
+    first, radii = surrounding(target.interface_depths, projectile, depth, switch)
+    return target.layers[first:], radii
+
+
+def surrounding(interface_depths, projectile, depth, switch):
+    """``(first, radii)``: index of the layer at the cavity wall and the interface radii of the
+    layers that surround the cavity, for validated arguments (the integrator's hot path)."""
+    radii = [H - depth + projectile.l for H in interface_depths]
     if switch == "cavity":
         first = sum(1 for h in radii if h <= projectile.r)
     else:
-        first = sum(1 for H in target.interface_depths if depth >= H)
-    return target.layers[first:], radii[first:]
+        first = sum(1 for H in interface_depths if depth >= H)
+    return first, radii[first:]
 
 
 def wall_layer(target, projectile, depth, switch="cavity"):

@@ -24,6 +24,8 @@ same equations with the layers relabelled (Eqs. 26-28 for two, Eq. 29 for one).
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from cavex.errors import require, require_choice
 
 # Readings of the paper's undefined eps: (2E/3) eps^k = Y -> (k, Y). k = 3 spherical (physics.md,
@@ -169,6 +171,51 @@ def response_index(depth, boundary_reached, next_yields):
     return index
 
 
+class PaperModel:
+    """The paper's case selection and equations for one target, projectile and ``epsilon``
+    reading, with everything that does not depend on the depth computed once.
+
+    :func:`paper_coefficients` is this model's :meth:`coefficients`; the penetration
+    integrator holds one model and calls :meth:`terms` at every force evaluation.
+    """
+
+    def __init__(self, target, projectile, epsilon="quasi-static"):
+        check_target(target)
+        self.target, self.projectile = target, projectile
+        self.eps = [layer_epsilon(m, epsilon) for m in target.layers]
+        # per wall layer ``first``: the layers around the cavity, their eps, interface depths
+        # and case thresholds, and whether their materials passed the checks
+        self._segments = [
+            (target.layers[first:], self.eps[first:], target.interface_depths[first:],
+             case_thresholds(self.eps[first:], projectile.r, projectile.l,
+                             target.interface_depths[first:]))
+            for first in range(len(target.layers))]
+        self._checked = set()
+
+    def coefficients(self, depth):
+        """:class:`PaperCoefficients` at nose-tip depth ``depth`` (m), >= 0."""
+        A, B, tau, rho, equation, state = self.terms(depth)
+        return PaperCoefficients(A=A, B=B, tau=tau, rho=rho, equation=equation, state=state)
+
+    def terms(self, depth):
+        """``(A, B, tau, rho, equation, state)`` at nose-tip depth ``depth`` (m), >= 0: the
+        fields of :meth:`coefficients` as a tuple (the integrator's hot path)."""
+        if not (isinstance(depth, (int, float)) and math.isfinite(depth) and depth >= 0.0):
+            require(False, "depth", "a finite number >= 0", depth)
+        first = self.target.layer_at(depth)  # nose-tip switch: interfaces go to the deeper layer
+        layers, eps, interface_depths, thresholds = self._segments[first]
+        if first not in self._checked:
+            for offset, material in enumerate(layers):
+                check_paper_material(material, first + offset)
+            self._checked.add(first)
+        r, nose = self.projectile.r, self.projectile.l
+        if interface_depths and not interface_depths[0] - depth + nose > r:  # nearest interface
+            h = interface_depths[0] - depth + nose
+            require(False, "depth", f"such that the next interface is beyond the cavity "
+                    f"(h = {h} m <= r = {r} m: nose length l shorter than r)", depth)
+        return apply_equation(layers, eps, r, nose, depth, interface_depths, thresholds)
+
+
 def paper_coefficients(target, projectile, depth, epsilon="quasi-static"):
     """Coefficients ``A``, ``B`` of the paper's wall stress at nose depth ``depth``.
 
@@ -187,23 +234,7 @@ def paper_coefficients(target, projectile, depth, epsilon="quasi-static"):
     -------
     PaperCoefficients
     """
-    check_target(target)
-    require(isinstance(depth, (int, float)) and math.isfinite(depth) and depth >= 0.0,
-            "depth", "a finite number >= 0", depth)
-    eps_all = [layer_epsilon(m, epsilon) for m in target.layers]
-    first = target.layer_at(depth)  # nose-tip switch: interfaces belong to the deeper layer
-    layers = target.layers[first:]
-    eps = eps_all[first:]
-    heights = [H - depth + projectile.l for H in target.interface_depths[first:]]
-    for offset, material in enumerate(layers):
-        check_paper_material(material, first + offset)
-    r = projectile.r
-    for h in heights:
-        require(h > r, "depth", f"such that the next interface is beyond the cavity (h = {h} m "
-                f"<= r = {r} m: nose length l shorter than r)", depth)
-    A, B, tau, rho, equation, state = select_equation(
-        layers, eps, r, projectile.l, depth, target.interface_depths[first:])
-    return PaperCoefficients(A=A, B=B, tau=tau, rho=rho, equation=equation, state=state)
+    return PaperModel(target, projectile, epsilon).coefficients(depth)
 
 
 def select_equation(layers, eps, r, nose, depth, interface_depths, forms=None):
@@ -213,13 +244,25 @@ def select_equation(layers, eps, r, nose, depth, interface_depths, forms=None):
     their interface depths ``H_i``; ``forms`` overrides printed equations by number (readings of
     the Table 2 study).
     """
-    forms = {**FORMS, **(forms or {})}
+    thresholds = case_thresholds(eps, r, nose, interface_depths)
+    return apply_equation(layers, eps, r, nose, depth, interface_depths, thresholds, forms)
+
+
+def case_thresholds(eps, r, nose, interface_depths):
+    """The depths ``(L_b, L_y)`` of each interface (innermost first) that
+    :func:`response_index` compares the nose depth with; they do not depend on the depth."""
+    reached = [H + nose - r / eps[k] for k, H in enumerate(interface_depths)]
+    yields = [H + nose - r / eps[k + 1] for k, H in enumerate(interface_depths)]
+    return reached, yields
+
+
+def apply_equation(layers, eps, r, nose, depth, interface_depths, thresholds, forms=None):
+    """:func:`select_equation` with the :func:`case_thresholds` given."""
+    forms = {**FORMS, **forms} if forms else FORMS
     if len(layers) == 1:
         return (*forms[29](layers[0], eps[0]), 29, "single")
     heights = [H - depth + nose for H in interface_depths]
-    reached = [H + nose - r / eps[k] for k, H in enumerate(interface_depths)]
-    yields = [H + nose - r / eps[k + 1] for k, H in enumerate(interface_depths)]
-    index = response_index(depth, reached, yields)
+    index = response_index(depth, *thresholds)
     equations = TWO_LAYER_EQUATIONS if len(layers) == 2 else THREE_LAYER_EQUATIONS
     equation, state = equations[index]
     return (*forms[equation](*layers, *eps, r, *heights), equation, state)
@@ -229,10 +272,26 @@ def paper_stress(target, projectile, depth, velocity, epsilon="quasi-static"):
     """The paper's cavity-wall radial stress ``sigma_r`` (Pa) at nose depth ``depth``.
 
     See :func:`paper_coefficients`; ``velocity`` is the cavity expansion velocity (m/s), >= 0.
+    ``depth`` and ``velocity`` may be arrays (broadcast together): the coefficients are computed
+    once per distinct depth and applied to all its velocities. Float for scalar input.
     """
-    require(isinstance(velocity, (int, float)) and math.isfinite(velocity) and velocity >= 0.0,
-            "velocity", "a finite number >= 0", velocity)
-    return paper_coefficients(target, projectile, depth, epsilon).stress(velocity)
+    velocity_array = np.asarray(velocity, dtype=float)
+    ok = np.isfinite(velocity_array) & (velocity_array >= 0.0)
+    if not ok.all():
+        require(False, "velocity", "a finite number >= 0",
+                np.broadcast_to(velocity, ok.shape)[~ok].flat[0].item())
+    model = PaperModel(target, projectile, epsilon)
+    depth_array = np.asarray(depth, dtype=float)
+    if depth_array.ndim == 0 and velocity_array.ndim == 0:
+        return model.coefficients(float(depth)).stress(float(velocity))
+    depths, velocities = np.broadcast_arrays(depth_array, velocity_array)
+    out = np.empty(depths.shape)
+    unique, inverse = np.unique(depths, return_inverse=True)
+    inverse = inverse.reshape(depths.shape)
+    for j, L in enumerate(unique):
+        at = inverse == j
+        out[at] = model.coefficients(float(L)).stress(velocities[at])
+    return out
 
 
 def paper_single_coefficients(material, epsilon="quasi-static"):
