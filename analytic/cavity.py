@@ -61,6 +61,7 @@ import numpy as np
 from numba import njit
 
 from cavex.errors import CavexNumericalError, require, require_choice
+from cavex.materials import MAX_VELOCITY
 
 BOUNDARIES = ("dynamic", "quasi-static")
 
@@ -399,9 +400,9 @@ def _check_arrays(layers, interfaces, velocity, radius, free_radius, boundary):
     ok = (radius > 0.0) & (radius < math.inf)
     if not _holds(ok):
         _refuse(ok, "radius", "a finite number > 0", radius)
-    ok = (velocity >= 0.0) & (velocity < math.inf)
+    ok = (velocity >= 0.0) & (velocity <= MAX_VELOCITY)
     if not _holds(ok):
-        _refuse(ok, "velocity", "a finite number >= 0", velocity)
+        _refuse(ok, "velocity", f"in [0, {MAX_VELOCITY:g}] m/s", velocity)
     require_choice(boundary, BOUNDARIES, "boundary")
     previous = radius
     for i, h in enumerate(columns):

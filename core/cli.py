@@ -2,6 +2,7 @@
 
 import argparse
 import json
+import os
 import sys
 
 from cavex.analytic.paper_model import EPSILON_READINGS
@@ -115,7 +116,11 @@ def main(argv=None):
         print(f"cavex: error: cannot read or write {where}{exc.strerror or exc}",
               file=sys.stderr)
         return 2
-    print(text)
+    try:
+        print(text)
+        sys.stdout.flush()
+    except BrokenPipeError:  # the reader (e.g. `| head`) stopped: not an error of cavex
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return 0
 
 
@@ -135,23 +140,28 @@ def _penetrate(args, target, projectile):
     written = write_outputs(job, args.out)
     phases = phases_as_dicts(job["runs"]["runway"])
     if args.json:
-        settings = {k: job[k] for k in ("model", "boundary", "epsilon", "crater")}
+        settings = {k: job[k] for k in ("model", "boundary", "epsilon", "crater",
+                                        "target_label", "notes")}
         return json.dumps({**settings, "phases": phases, "table2": job["table2"],
                            "outputs": written}, indent=2)
     return _penetration_text(job, phases, written)
 
 
 def _penetration_text(job, phases, written):
-    lines = [f"model {job['model']}, boundary {job['boundary']}, epsilon {job['epsilon']}, "
-             f"crater from {job['crater']}", "", "phases (runway):",
+    settings = (f"epsilon {job['epsilon']}" if job["model"] == "paper"
+                else f"boundary {job['boundary']}")
+    lines = [f"model {job['model']}, {settings}, crater from {job['crater']}"]
+    lines += [f"note: {note}" for note in job["notes"]]
+    lines += ["", f"phases ({job['target_label']}):",
              f"{'#':>2} {'label':<24} {'L (m)':>8} {'V (m/s)':>9} {'t (ms)':>8}  ends because"]
     lines += [f"{p['phase']:>2} {p['label']:<24} {p['end_depth_m']:8.4f} "
               f"{p['end_velocity_m_s']:9.2f} {p['end_time_s'] * 1e3:8.3f}  {p['end_reason']}"
               for p in phases]
-    lines += ["", "beside the paper's Table 2:",
-              f"{'row':<32} {'L ours':>7} {'paper':>6} {'V ours':>8} {'paper':>7} "
-              f"{'t ours':>7} {'paper':>6}"]
-    for row in job["table2"]:
+    if job["table2"] is not None:
+        lines += ["", "beside the paper's Table 2:",
+                  f"{'row':<32} {'L ours':>7} {'paper':>6} {'V ours':>8} {'paper':>7} "
+                  f"{'t ours':>7} {'paper':>6}"]
+    for row in job["table2"] or []:
         ours, paper = row["ours"], row["paper"]
         mine = ("{:7.3f} {:>6} {:8.1f} {:>7} {:7.2f} {:>6.2f}".format(
             ours["depth_m"], paper["depth_m"], ours["velocity_m_s"], paper["velocity_m_s"],

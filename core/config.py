@@ -7,7 +7,7 @@ from cavex.errors import CavexInputError, check_keys, prefixed, require
 from cavex.materials import Material, Projectile, Target
 
 LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c"}
-PROJECTILE_KEYS = {"r", "l", "R", "crh", "m", "V0"}
+PROJECTILE_KEYS = {"r", "l", "R", "crh", "m", "V0", "length", "inertia", "cg", "mu"}
 TOP_KEYS = {"projectile", "layers"}
 # written by `cavex calibrate` beside the calibrated target; read by `cavex validate`
 # (cavex.verification.calibration), ignored by the commands that only need the target

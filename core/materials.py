@@ -7,6 +7,10 @@ from itertools import accumulate
 
 from cavex.errors import is_finite_number, require
 
+#: Largest velocity accepted (m/s), striking or expansion: far beyond it (hypervelocity impact)
+#: a rigid projectile and an elastic-plastic cavity expansion no longer describe the target.
+MAX_VELOCITY = 1e4
+
 
 def _positive(name, value):
     require(is_finite_number(value) and math.isfinite(value) and value > 0,
@@ -126,6 +130,9 @@ class Target:
         return Target((self.layers[index],), ())
 
 
+DEFAULT_DENSITY = 7850.0  # kg/m^3, steel: the body's length when ``length`` is absent
+
+
 @dataclass(frozen=True)
 class Projectile:
     """Rigid ogive-nosed projectile.
@@ -141,7 +148,18 @@ class Projectile:
     m : float
         Mass (kg).
     V0 : float
-        Striking velocity (m/s), > 0.
+        Striking velocity (m/s), in (0, 1e4].
+    length : float, optional
+        Overall length, nose tip to tail (m), longer than the tangent ogive
+        (:attr:`ogive_length`). Used by the 3-D trajectory model only (``docs/oblique.md``);
+        absent: :attr:`body_length`, a solid steel body of the given mass.
+    inertia : float, optional
+        Transverse moment of inertia about the centre of mass (kg m^2), > 0; absent: a solid
+        body of uniform density (``cavex.analytic.projectile_body``).
+    cg : float, optional
+        Centre of mass, m from the nose tip, in (0, length); absent: uniform density.
+    mu : float
+        Coulomb friction coefficient on the surface, >= 0 (default 0).
     """
 
     r: float
@@ -150,21 +168,56 @@ class Projectile:
     V0: float
     R: float | None = None
     crh: float | None = field(default=None, compare=False)
+    length: float | None = None
+    inertia: float | None = None
+    cg: float | None = None
+    mu: float = 0.0
 
     def __post_init__(self):
         for name in ("r", "l", "m", "V0"):
             _positive(name, getattr(self, name))
+        require(self.V0 <= MAX_VELOCITY, "V0",
+                f"<= {MAX_VELOCITY:g} m/s (rigid-projectile penetration)", self.V0)
         _exactly_one("R", "crh", (self.R, self.crh))
         if self.R is None:
             _positive("crh", self.crh)
             object.__setattr__(self, "R", 2.0 * self.r * self.crh)
         _positive("R", self.R)
         require(self.R >= self.r, "R", f">= r = {self.r} (ogive)", self.R)
+        if self.length is not None:
+            _positive("length", self.length)
+            require(self.length > self.ogive_length, "length",
+                    f"> the tangent ogive's length {self.ogive_length:.6g} m", self.length)
+        if self.inertia is not None:
+            _positive("inertia", self.inertia)
+        if self.cg is not None:
+            _positive("cg", self.cg)
+            require(self.cg < self.body_length, "cg",
+                    f"< the overall length {self.body_length:.6g} m", self.cg)
+        require(is_finite_number(self.mu) and math.isfinite(self.mu) and self.mu >= 0.0, "mu",
+                "a finite number >= 0", self.mu)
 
     @property
     def psi(self):
         """Calibre-radius-head ``psi = R / (2 r)``."""
         return self.R / (2.0 * self.r)
+
+    @property
+    def body_length(self):
+        """Overall length (m): ``length``, or, absent, that of a solid steel body
+        (:data:`DEFAULT_DENSITY`) of mass ``m``: tangent ogive plus shank of the same volume
+        (0.1498 m, 6.0 calibres, for the paper's Table 1 projectile)."""
+        if self.length is not None:
+            return self.length
+        r, R, ln = self.r, self.R, self.ogive_length
+        s = R - r
+        # volume of the tangent ogive: int_0^ln pi (sqrt(R^2 - x^2) - s)^2 dx
+        nose = math.pi * ((R * R + s * s) * ln - ln ** 3 / 3.0
+                          - s * (ln * math.sqrt(R * R - ln * ln) + R * R * math.asin(ln / R)))
+        shank = self.m / DEFAULT_DENSITY - nose
+        require(shank > 0.0, "length", "given (a steel body of this mass is shorter than its "
+                "nose)", None)
+        return ln + shank / (math.pi * r * r)
 
     @property
     def ogive_length(self):

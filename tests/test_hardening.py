@@ -282,3 +282,46 @@ def test_dataset_written_by_write_table_loads(tmp_path, good_table):
     path = tmp_path / "ok.nc"
     write_table(good_table, path)
     assert isinstance(load_table(path), xr.Dataset)
+
+
+# --- huge values, crater notes, other targets ------------------------------------------
+
+@pytest.mark.parametrize("argv", [
+    ["stress", "--velocity", "1.2e154", "--depth", "0.3", "--json"],
+    ["stress", "--velocity", "1e300", "--depth", "0.3"],
+    ["stress", "--velocity", "1e300", "--depth", "0.3", "--model", "paper"],
+    ["stress", "--velocity", "1.5e154", "--depth", "0.3", "--boundary", "dynamic"],
+    ["fem", "--velocity", "1e300", "--depth", "0.3"],
+    ["table", "-o", "{tmp}/t.nc", "--velocities", "0", "2e4"],
+])
+def test_velocities_beyond_rigid_penetration_are_refused(capsys, tmp_path, argv):
+    line = refused(capsys, tmp_path, [a.format(tmp=tmp_path) for a in argv], "m/s")
+    assert "10000" in line and "problems[" not in line
+
+
+def test_largest_velocity_gives_finite_numbers(capsys):
+    code, out, _ = run(capsys, "stress", "--velocity", "1e4", "--depth", "0.3", "--json")
+    assert code == 0 and math.isfinite(json.loads(out)["sigma_r_Pa"])
+
+
+def test_a_config_with_a_thin_first_layer_says_so_and_skips_table2(capsys, tmp_path):
+    thin = tmp_path / "thin.toml"
+    thin.write_text(default_config_text().replace("thickness = 0.65", "thickness = 0.05"))
+    code, out, err = run(capsys, "penetrate", "--config", thin, "--out", tmp_path / "o", "--json")
+    assert code == 0, err
+    job = json.loads(out)
+    assert job["table2"] is None and job["target_label"] == "layered target"
+    assert len(job["notes"]) == 1 and "below the first layer" in job["notes"][0]
+    code, out, _ = run(capsys, "penetrate", "--out", tmp_path / "d", "--json")
+    default = json.loads(out)
+    assert default["notes"] == [] and len(default["table2"]) == 4
+
+
+def test_a_closed_pipe_is_not_an_error(tmp_path):
+    import subprocess
+    import sys
+
+    command = (f"{sys.executable} -m cavex.cli stress --velocity 300 --depth 0.3 | head -c 10")
+    done = subprocess.run(["bash", "-o", "pipefail", "-c", command], capture_output=True,
+                          text=True, timeout=120)
+    assert "Traceback" not in done.stderr and "BrokenPipe" not in done.stderr

@@ -7,7 +7,7 @@ the default error target: a problem whose estimated discretisation error exceeds
 
 from dataclasses import replace
 
-from cavex.analytic.cavity import cavity_solution
+from cavex.analytic.cavity import cavity_solution, check_problem
 from cavex.analytic.geometry import spherical_problem
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET, MAX_REFINEMENTS
 from cavex.fem.expansion import expand_cavities
@@ -108,6 +108,7 @@ def compare_at_depth(target, projectile, depth, velocity, nu=None,
     if fields is not None:
         fields = check_output_dir(fields, "fields")
     request = (target, projectile, depth, velocity, nu)
+    check_problem(*fe_problem(*request), "dynamic")  # named without the batch's index
     (problem,), (result,) = _run([request], error_target, MAX_REFINEMENTS, fields is not None,
                                  **numerics)
     if not result.ok:

@@ -9,8 +9,9 @@ import csv
 import io
 from pathlib import Path
 
-from cavex.analytic.penetration import penetrate
+from cavex.analytic.penetration import crater_depth, penetrate
 from cavex.analytic.resistance import ClosedFormResistance
+from cavex.config import load_config
 from cavex.verification.number_format import format_number
 from cavex.verification.runner import save_figure, write_text_atomic
 from cavex.verification.table2 import table2_comparison
@@ -29,12 +30,28 @@ def penetration_job(target, projectile, *, model="derived", boundary="quasi-stat
                 single, projectile, model, boundary, epsilon=epsilon), crater=crater)}
     title = resistance_title(model, boundary, epsilon, table_path)
     if table_path is not None:
-        model = f"FE table {table_path} (first layer alone: {model})"
+        model = f"FE table {Path(table_path).name} (first layer alone: {model})"
+    paper = (target, projectile) == load_config()
     return {"model": model, "boundary": boundary, "epsilon": epsilon, "crater": crater,
-            "runs": runs, "table2": table2_comparison(runs["runway"]),
+            "runs": runs, "table2": table2_comparison(runs["runway"]) if paper else None,
+            "target_label": "runway (the paper's Table 1)" if paper else "layered target",
+            "notes": crater_notes(target, projectile, crater),
             "interface_depths": target.interface_depths, "title": title,
             "table": None if table_path is None else str(table_path),
             "layer_names": [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]}
+
+
+def crater_notes(target, projectile, crater):
+    """What the user must know about the crater stage: it uses the first layer's properties,
+    which is wrong where the crater reaches deeper than that layer."""
+    if crater is None or not target.interface_depths:
+        return []
+    depth, first = crater_depth(projectile, crater), target.interface_depths[0]
+    if depth <= first:
+        return []
+    return [f"the crater ({depth:.4g} m, 4.5 r from the {crater}) reaches below the first layer "
+            f"({first:.4g} m thick); the crater stage uses the first layer's properties "
+            "throughout"]
 
 
 def resistance_title(model, boundary, epsilon, table_path=None):

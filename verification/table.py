@@ -39,6 +39,7 @@ from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.errors import CavexInputError, require
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
+from cavex.materials import MAX_VELOCITY
 from cavex.paths import check_output_file
 from cavex.verification.cases import fe_cases, make_fe_cases
 from cavex.verification.cases import projectile_table as projectile_to_table
@@ -125,8 +126,9 @@ def check_grid(velocities, depths):
     v = np.asarray(velocities, dtype=float)
     d = np.asarray(depths, dtype=float)
     shown_v, shown_d = [float(x) for x in v.ravel()], [float(x) for x in d.ravel()]
-    require(v.ndim == 1 and np.all(np.isfinite(v)) and np.all(v >= 0.0), "velocities",
-            "finite values >= 0 (m/s)", shown_v)
+    require(v.ndim == 1 and np.all(np.isfinite(v)) and np.all(v >= 0.0)
+            and np.all(v <= MAX_VELOCITY), "velocities", f"values in [0, {MAX_VELOCITY:g}] m/s",
+            shown_v)
     require(np.unique(v).size >= 2, "velocities", "at least two different values", shown_v)
     require(v.min() == 0.0, "velocities",
             "a grid that includes V = 0 (the nose tip sees V cos(phi) -> 0)", shown_v)
