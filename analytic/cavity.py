@@ -496,7 +496,7 @@ def cavity_solution(layers, interfaces, velocity, radius, *, boundary="dynamic",
     radius : float or array_like
         Cavity radius ``a`` (m), > 0.
     boundary : {"dynamic", "quasi-static"}
-        Yield-at-boundary convention (physics.md section 2).
+        Yield-at-boundary convention (docs/problem.md section 2).
     free_radius : float or array_like, optional
         Traction-free outer boundary (m, current configuration), ``sigma_r = 0`` there; > the
         cavity radius; layers beyond it are ignored. None (or ``inf``): unbounded medium.

@@ -1,14 +1,14 @@
 r"""The paper's printed cavity-wall stress, Eqs. (19)-(29) of She (2020), as the model ``"paper"``.
 
 The derived model (:mod:`cavex.analytic.cavity`) solves the layered cavity-expansion problem of
-physics.md from first principles. This module instead implements the closed forms *as the paper
+docs/problem.md from first principles. This module instead implements the closed forms *as the paper
 prints them*, so that the paper's own numbers (its Table 2) can be reproduced and the effect of
 each of its choices measured. Every departure from the printed text is listed in
 ``docs/paper_model.md``; the comments marked ``CORRECTION (i)`` are OCR/typesetting fixes and the
 ones marked ``PRINTED (ii)`` keep a genuine error of the paper on purpose.
 
 Notation (as the paper): ``p_i = alpha_i lam_i = 6 lam_i/(3 + 2 lam_i)`` (twice the ``alpha`` of
-physics.md), ``eps_i = a/b`` when the elastic-plastic boundary ``b`` lies in layer ``i``, cavity
+docs/problem.md), ``eps_i = a/b`` when the elastic-plastic boundary ``b`` lies in layer ``i``, cavity
 radius ``a = r`` (the projectile radius; the paper's ``Vt`` and ``a``), interface radii
 ``h_i = H_i - L + l`` (Eq. 16). The wall stress is ``sigma_r = tau A + B rho V^2``, i.e.
 ``S = A + B rho V^2 / tau`` with the ``tau`` and ``rho`` that the equation itself uses (Eqs. 23-25
@@ -28,7 +28,7 @@ import numpy as np
 
 from cavex.errors import require, require_choice
 
-# Readings of the paper's undefined eps: (2E/3) eps^k = Y -> (k, Y). k = 3 spherical (physics.md,
+# Readings of the paper's undefined eps: (2E/3) eps^k = Y -> (k, Y). k = 3 spherical (docs/problem.md,
 # consistent with the printed A), k = 2 the incompressible cylindrical cavity; Y is tau or the
 # uniaxial strength sigma_c = 3 tau/(3 - lam) of Eq. 2 (docs/table2.md: "cylindrical-sigma_c" is
 # the only reading that puts Table 2's L1 at its printed 0.40 m).
@@ -81,7 +81,7 @@ class PaperCoefficients:
 
 
 def alpha_lambda(material):
-    """The paper's ``alpha_i lam_i = 6 lam/(3 + 2 lam)`` (``2 alpha`` of physics.md)."""
+    """The paper's ``alpha_i lam_i = 6 lam/(3 + 2 lam)`` (``2 alpha`` of docs/problem.md)."""
     return 6.0 * material.lam / (3.0 + 2.0 * material.lam)
 
 
@@ -98,7 +98,7 @@ def layer_epsilon(material, epsilon="quasi-static"):
     material : Material
     epsilon : str
         One of :data:`EPSILON_READINGS`: ``(2E/3) eps^k = Y`` with ``k = 3`` (``"quasi-static"``,
-        the spherical elastic zone's yield of physics.md; the only reading consistent with the
+        the spherical elastic zone's yield of docs/problem.md; the only reading consistent with the
         ``2/3`` of the printed ``A``) or ``k = 2`` (``"cylindrical"``, the incompressible
         cylindrical cavity), and ``Y = tau`` or, with the ``-sigma_c`` suffix, ``sigma_c``.
     """

@@ -1,7 +1,7 @@
 r"""Verification of the layered analytic cavity-expansion model (``cavex.analytic.cavity``).
 
 The closed forms are checked against an independent numerical integration of the momentum
-equation of physics.md section 2, written here from the physics and not from the module:
+equation of docs/problem.md section 2, written here from the physics and not from the module:
 
 .. math:: \frac{d\sigma_r}{dy} = \frac{2 D}{y} + 2\rho V^2 (1 - y^3), \qquad y = a/r,
 
@@ -392,7 +392,7 @@ def test_far_interfaces_reduce_to_single_layer(n_layers, velocity, boundary):
 # --------------------------------------------------------------------------------------------
 
 def hopkins(material, velocity):
-    """``S = (2/3)[1 + ln(2E/(3 tau))] + (3/2) rho V^2/tau`` (physics.md section 4)."""
+    """``S = (2/3)[1 + ln(2E/(3 tau))] + (3/2) rho V^2/tau`` (docs/problem.md section 4)."""
     E, tau = material.E, material.tau
     return ((2.0 / 3.0) * (1.0 + math.log(2.0 * E / (3.0 * tau)))
             + 1.5 * material.rho * velocity ** 2 / tau)
@@ -519,9 +519,9 @@ INF = float("inf")
     ({"radius": -0.01}, "radius", "> 0"),
     ({"radius": NAN}, "radius", "> 0"),
     ({"radius": INF}, "radius", "finite"),
-    ({"velocity": -1.0}, "velocity", ">= 0"),
-    ({"velocity": NAN}, "velocity", ">= 0"),
-    ({"velocity": INF}, "velocity", "finite"),
+    ({"velocity": -1.0}, "velocity", "in [0, 10000] m/s"),
+    ({"velocity": NAN}, "velocity", "in [0, 10000] m/s"),
+    ({"velocity": INF}, "velocity", "in [0, 10000] m/s"),
     ({"boundary": "static"}, "boundary", "'dynamic' or 'quasi-static'"),
     ({"interfaces": [0.01]}, "interfaces[0]", "outside the cavity"),
     ({"interfaces": [RADIUS]}, "interfaces[0]", "outside the cavity"),

@@ -342,8 +342,8 @@ def test_paper_stress_on_arrays():
 # --------------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize(("change", "parameter", "accepted", "value"), [
-    ({"velocity": np.array([[100.0, -1.0]])}, "velocity", ">= 0", "-1.0"),
-    ({"velocity": np.array([100.0, np.nan])}, "velocity", ">= 0", "nan"),
+    ({"velocity": np.array([[100.0, -1.0]])}, "velocity", "in [0, 10000] m/s", "-1.0"),
+    ({"velocity": np.array([100.0, np.nan])}, "velocity", "in [0, 10000] m/s", "nan"),
     ({"radius": np.array([RADIUS, 0.0])}, "radius", "> 0", "0.0"),
     ({"interfaces": np.array([INTERFACES, [0.1, 0.05]])}, "interfaces[1]", "increasing",
      "0.05"),

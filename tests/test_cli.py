@@ -26,7 +26,7 @@ from cavex.config import default_config_text, load_config
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 TRAJECTORY_COLUMNS = ["t_s", "depth_m", "velocity_m_s", "deceleration_m_s2", "phase"]
 PHASE_COLUMNS = ["phase", "label", "end_depth_m", "end_velocity_m_s", "end_time_s", "end_reason"]
-# physics.md section 3, Table 2: (L m, v m/s, t ms)
+# docs/problem.md section 3, Table 2: (L m, v m/s, t ms)
 PAPER_TABLE2 = [(0.12, 894.7, 0.12), (0.40, 506.4, 0.53), (0.65, 284.3, 1.20), (0.79, 0.0, 2.40)]
 ROUNDOFF = 1e-15
 CSV_ROUNDING = 5e-9 * (1 + 1e-6)  # half a unit in the 9th significant digit, relative
@@ -255,7 +255,7 @@ def test_console_script_exit_codes(tmp_path):
                          capture_output=True, text=True, timeout=120, check=False)
     assert bad.returncode == 2 and bad.stdout == ""
     assert bad.stderr.splitlines() == [
-        "cavex: error: parameter 'velocity' must be a finite number >= 0 (got -1.0)"]
+        "cavex: error: parameter 'velocity' must be in [0, 10000] m/s (got -1.0)"]
     good = subprocess.run([str(script), "stress", "--velocity", "500", "--depth", "0.3",
                            "--json"], capture_output=True, text=True, timeout=120, check=False)
     assert (good.returncode, good.stderr) == (0, "")

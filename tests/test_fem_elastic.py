@@ -12,7 +12,7 @@ A, B, E, P = 1.0, 2.0, 1.0, 1e-9  # tiny load: finite-strain effects ~1e-9, far 
 
 
 def lame_displacement(r, nu):
-    """Lame thick sphere, inner pressure ``P``, free outer surface (physics.md section 4)."""
+    """Lame thick sphere, inner pressure ``P``, free outer surface (docs/problem.md section 4)."""
     k = P * A ** 3 / (B ** 3 - A ** 3)
     return k * (1 - 2 * nu) / E * r + k * B ** 3 * (1 + nu) / (2 * E) / r ** 2
 

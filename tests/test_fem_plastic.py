@@ -14,7 +14,7 @@ A, B, Y = 1.0, 3.0, 1e-6  # Y/E = 1e-6: small strain, as Hill's solution assumes
 
 
 def hill_pressure(c):
-    """Hill: ``p = 2Y ln(c/a) + (2Y/3)(1 - c^3/b^3)`` (physics.md section 4)."""
+    """Hill: ``p = 2Y ln(c/a) + (2Y/3)(1 - c^3/b^3)`` (docs/problem.md section 4)."""
     return 2 * Y * np.log(c / A) + 2 * Y / 3 * (1 - c ** 3 / B ** 3)
 
 

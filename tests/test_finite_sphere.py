@@ -2,10 +2,10 @@ r"""The finite sphere: a traction-free outer boundary at ``free_radius`` (analyt
 
 Checked against
 
-- an independent numerical integration of the momentum equation of physics.md section 2,
+- an independent numerical integration of the momentum equation of docs/problem.md section 2,
   written here, started at ``y_c = a/c`` with ``sigma_r(c) = 0`` instead of at ``y = 0``
   (required 1e-8 relative; measured worst 1.2e-12 over every case below);
-- Hill's hollow sphere (physics.md section 4) at ``V = 0``, Tresca: the closed form is exactly
+- Hill's hollow sphere (docs/problem.md section 4) at ``V = 0``, Tresca: the closed form is exactly
   ``2 tau ln(b/a) + (2 tau/3)(1 - b^3/c^3)`` and, once the plastic zone reaches the surface,
   the limit ``2 tau ln(c/a)`` (measured: equal to the last bit);
 - the unbounded medium as ``c`` grows: the difference falls as ``c^-3`` at ``V = 0`` (the

@@ -41,7 +41,7 @@ def target(table1):
 
 
 def eq7(projectile, stress, velocity):
-    """Paper Eq. 7 by adaptive quadrature, written out from physics.md section 3."""
+    """Paper Eq. 7 by adaptive quadrature, written out from docs/problem.md section 3."""
     R, r = projectile.R, projectile.r
     s0 = (R - r) / R
     phi0 = math.asin(s0)

@@ -1,4 +1,4 @@
-"""Rigid-projectile penetration against exact solutions (physics.md sections 3 and 4).
+"""Rigid-projectile penetration against exact solutions (docs/problem.md sections 3 and 4).
 
 Measured on this machine with the default ``rtol=1e-9, atol=1e-12`` (DOP853):
 
@@ -51,7 +51,7 @@ def test_default_config_is_table1(default, table1):
 
 def _cavity_ode_coefficients(material, radius=1.0):
     """``(sigma_0, sigma_2)`` of a single layer, quasi-static convention, by integrating the ODE
-    ``d sigma/dy = 2 D/y + 2 rho V^2 (1 - y^3)`` of physics.md section 2 numerically."""
+    ``d sigma/dy = 2 D/y + 2 rho V^2 (1 - y^3)`` of docs/problem.md section 2 numerically."""
     eps = (1.5 * material.tau / material.E) ** (1.0 / 3.0)
     alpha = 3.0 * material.lam / (3.0 + 2.0 * material.lam)
     k = 3.0 * material.tau / (3.0 + 2.0 * material.lam)

@@ -30,7 +30,7 @@ def penetration_job(target, projectile, *, model="derived", boundary="quasi-stat
                 single, projectile, model, boundary, epsilon=epsilon), crater=crater)}
     title = resistance_title(model, boundary, epsilon, table_path)
     if table_path is not None:
-        model = f"FE table {Path(table_path).name} (first layer alone: {model})"
+        model = f"FE table {table_path} (first layer alone: {model})"
     paper = (target, projectile) == load_config()
     return {"model": model, "boundary": boundary, "epsilon": epsilon, "crater": crater,
             "runs": runs, "table2": table2_comparison(runs["runway"]) if paper else None,
