@@ -5,6 +5,7 @@ import json
 import os
 import sys
 
+from cavex import __version__
 from cavex.analytic.paper_model import EPSILON_READINGS
 from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
@@ -13,20 +14,40 @@ from cavex.paths import check_output_dir
 DEFAULT_PENETRATION_DIR = "results/penetration"
 
 
+class _Help(argparse.ArgumentDefaultsHelpFormatter):
+    """Every option's help shows its default, unless the help already says it."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if "default" in text or action.default in (None, False, argparse.SUPPRESS):
+            return text
+        return super()._get_help_string(action)
+
+
 class _Parser(argparse.ArgumentParser):
-    """Argument errors as one line on stderr and exit code 2."""
+    """Argument errors as one line on stderr and exit code 2; help shows the defaults."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", _Help)
+        super().__init__(*args, **kwargs)
 
     def error(self, message):
         raise CavexInputError(message)
 
 
+DESCRIPTION = ("cavex: layered spherical cavity-expansion resistance, checked against a finite-"
+               "element solution, and the rigid projectile through a layered target (an airport "
+               "runway). SI units, compression positive. Bad input: one line on stderr, exit "
+               "code 2; a numerical failure: exit code 1.")
+
+
 def build_parser():
-    parser = _Parser(prog="cavex", description=__doc__)
-    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    parser = _Parser(prog="cavex", description=DESCRIPTION)
+    parser.add_argument("--version", action="version", version=f"cavex {__version__}")
+    commands = parser.add_subparsers(dest="command", parser_class=_Parser, metavar="COMMAND")
     penetrate = commands.add_parser("penetrate", help="integrate the projectile through the target")
     _common(penetrate)
-    penetrate.add_argument("--out", default=DEFAULT_PENETRATION_DIR,
-                           help=f"output folder (default {DEFAULT_PENETRATION_DIR})")
+    penetrate.add_argument("--out", default=DEFAULT_PENETRATION_DIR, help="output folder")
     penetrate.add_argument("--crater", choices=("nose-base", "nose-tip"), default="nose-base",
                            help="where the crater depth 4.5 r is measured from")
     penetrate.add_argument("--resistance", choices=("closed-form", "table"),
@@ -46,7 +67,8 @@ def build_parser():
                      "and meshio, history CSV)")
     table = commands.add_parser("table", help="FE-tabulated sigma_r(V, L) for the target")
     table.add_argument("--config", help="target TOML file (default: the paper's Table 1)")
-    table.add_argument("--velocities", nargs="+", type=float, help="m/s (default 0..1200)")
+    table.add_argument("--velocities", nargs="+", type=float,
+                       help="m/s (default 0, 100, ..., 1200)")
     table.add_argument("--depths", nargs="+", type=float, help="nose depths, m")
     table.add_argument("-o", "--out", default="results/table.nc", help="NetCDF file to write")
     table.add_argument("--nu", type=float, help="Poisson's ratio for every layer")
@@ -81,7 +103,43 @@ def build_parser():
     validate.add_argument("--json", action="store_true", help="print JSON")
     validate.add_argument("--out", help="output folder (default results/validation)")
     _parallel(validate)
+    trajectory = commands.add_parser("trajectory", help="oblique shot with attitude: the rigid "
+                                     "projectile in 3-D through the layers (docs/oblique.md)")
+    trajectory.add_argument("--config", help="target TOML file (default: the paper's Table 1)")
+    trajectory.add_argument("--velocity", type=float, help="striking speed (m/s; default V0)")
+    trajectory.add_argument("--obliquity", type=float, default=0.0,
+                            help="angle of the velocity from the target normal (deg)")
+    trajectory.add_argument("--attack", type=float, default=0.0,
+                            help="angle of attack, axis from velocity (deg)")
+    trajectory.add_argument("--attack-plane", type=float, default=0.0,
+                            help="plane of the angle of attack about the velocity (deg; 0: "
+                            "in the plane of obliquity toward +x)")
+    trajectory.add_argument("--spin", type=float, default=0.0, help="spin about the axis (rad/s)")
+    trajectory.add_argument("--resistance", choices=("derived", "paper", "table", "law"),
+                            default="derived", help="surface stress law")
+    trajectory.add_argument("--boundary", choices=("quasi-static", "dynamic"),
+                            default="quasi-static", help="convention of the derived law")
+    trajectory.add_argument("--table", help="NetCDF table from `cavex table` (--resistance table)")
+    trajectory.add_argument("--law-A", dest="law_A", type=float, help="A of sigma_n = A + B "
+                            "V_n^2 (Pa)")
+    trajectory.add_argument("--law-B", dest="law_B", type=float, help="B (kg/m^3)")
+    trajectory.add_argument("--no-free-surface", action="store_true",
+                            help="no free-surface reduction of the derived law")
+    trajectory.add_argument("--compare-homogeneous", action="store_true",
+                            help="also the same shot into the first layer alone")
+    trajectory.add_argument("--json", action="store_true", help="print JSON")
+    trajectory.add_argument("--out", default="results/trajectory",
+                            help="output folder (default results/trajectory)")
+    _describe(commands)
     return parser
+
+
+def _describe(commands):
+    """Each subcommand's ``--help`` opens with its one-line summary."""
+    for action in commands._choices_actions:  # argparse keeps the summaries only here
+        sub = commands.choices[action.dest]
+        if sub.description is None:
+            sub.description = action.help
 
 
 def _parallel(command):
@@ -101,8 +159,12 @@ def _common(command):
 
 def main(argv=None):
     """Entry point; returns the exit code (0 ok, 1 numerical failure, 2 bad input)."""
+    parser = build_parser()
     try:
-        args = build_parser().parse_args(argv)
+        args = parser.parse_args(argv)
+        if args.command is None:  # bare `cavex`: what it can do
+            parser.print_help()
+            return 0
         target, projectile = load_config(args.config) if "config" in args else (None, None)
         text = COMMANDS[args.command](args, target, projectile)
     except CavexInputError as exc:
@@ -242,7 +304,13 @@ def _validate(args, target, projectile):
                          args.scheduler)
 
 
-COMMANDS = {"penetrate": _penetrate, "stress": _stress, "fem": _fem, "table": _table,
+def _trajectory(args, target, projectile):
+    from cavex.verification.trajectory_report import trajectory_main
+
+    return trajectory_main(args, target, projectile)
+
+
+COMMANDS = {"trajectory": _trajectory, "penetrate": _penetrate, "stress": _stress, "fem": _fem, "table": _table,
             "verify": _verify, "batch": _batch, "calibrate": _calibrate,
             "validate": _validate}
 

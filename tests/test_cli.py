@@ -203,7 +203,6 @@ BAD_INPUTS = [
     (["penetrate", "--out", "OUT", "--config", "CONFIG:lam"], "'layers[0].lam'"),
     (["penetrate", "--out", "OUT", "--config", "CONFIG:negative_V0"], "'projectile.V0'"),
     (["penetrate", "--out", "OUT", "--config", "missing.toml"], "missing.toml"),
-    ([], "command"),
     # BUG: `--velocity inf` passes the `>= 0` check of the paper path of stress_at_depth and
     # prints "Infinity" (not JSON) with exit code 0.
     (["stress", "--velocity", "inf", "--depth", "0.3", "--model", "paper", "--json"],

@@ -325,3 +325,24 @@ def test_a_closed_pipe_is_not_an_error(tmp_path):
     done = subprocess.run(["bash", "-o", "pipefail", "-c", command], capture_output=True,
                           text=True, timeout=120)
     assert "Traceback" not in done.stderr and "BrokenPipe" not in done.stderr
+
+
+# --- what the command line says about itself ----------------------------------------------
+
+def test_version_bare_usage_and_help_with_defaults(capsys):
+    from cavex import __version__
+
+    with pytest.raises(SystemExit) as done:
+        main(["--version"])
+    assert done.value.code == 0 and capsys.readouterr().out.strip() == f"cavex {__version__}"
+    code, out, err = run(capsys)
+    assert code == 0 and out.startswith("usage: cavex") and "penetrate" in out and err == ""
+    for command in ("penetrate", "stress", "fem", "table", "verify", "batch"):
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        text = capsys.readouterr().out
+        description = text.split("\n\n")[1]
+        assert not description.startswith("options"), (command, text)
+    with pytest.raises(SystemExit):
+        main(["penetrate", "--help"])
+    assert "(default: results/penetration)" in capsys.readouterr().out

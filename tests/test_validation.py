@@ -1,0 +1,404 @@
+"""Validation against experiments: shot files, the empirical model, the (f_c, rho) mapping,
+calibration and ``cavex validate`` / ``cavex calibrate`` (docs/validation.md).
+
+Tolerances, each from a measurement or a printed precision:
+
+- Li and Chen (2003) print X/d = 6.21 (3 digits, +-0.005/6.21 = 0.08 %); the issue asks for
+  0.5 %; measured 0.087 % (6.2154).
+- the Forrestal and Li-Chen forms of the same model agree to round-off (1e-12).
+- calibration recovery: the fitted parameters are written with 6 significant digits (half a
+  unit: 5e-6 relative) and the least-squares tolerances are 1e-12; measured: recovered exactly
+  to the written digits (2 and 3 parameters); asserted at 1e-5, twice the rounding.
+- depths in the result files carry 6 significant digits: half a unit, 5e-6 relative.
+"""
+
+import csv
+import json
+import math
+import tomllib
+
+import numpy as np
+import pytest
+
+from cavex.analytic.penetration import crater_depth, penetrate
+from cavex.analytic.resistance import ClosedFormResistance
+from cavex.cli import main
+from cavex.errors import CavexInputError
+from cavex.verification import empirical
+from cavex.verification.calibration import fit, read_calibration
+from cavex.verification.concrete import Mapping, aci_modulus, concrete_material, shot_target
+from cavex.verification.shots import Shot, parse_shots, read_shots, shot_projectile
+from cavex.verification.table import analytic_table
+from cavex.verification.tabulated_resistance import TabulatedResistance
+from cavex.verification.validation import (
+    TABLE_DEPTHS,
+    closed_form_depth,
+    penetration_depth,
+    ratio_statistics,
+    table_velocities,
+)
+
+SHOTS = "examples/shots_forrestal1994.csv"
+COLUMNS = "id,mass_kg,diameter_m,length_m,crh,V0_m_s,fc_Pa,rho_kg_m3,depth_m"
+GOOD_ROW = "A1,0.906,0.0269,0.2424,2.0,277.0,35200000.0,2370.0,0.173"
+DIGITS_6 = 5e-6 * (1 + 1e-9)  # half a unit in the 6th significant digit, relative
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+# --- the empirical model ----------------------------------------------------------------------
+
+def test_li_chen_worked_example_forrestal_shot_14():
+    """Forrestal 1994 shot 14 (0.906 kg, 26.9 mm, CRH 2, 277 m/s, 35.2 MPa, 2370 kg/m^3,
+    measured 173 mm): Li and Chen (2003) print X/d = 6.21 with S = 12, crater of 2 calibres."""
+    x_d = empirical.penetration_calibres(0.906, 0.0269, 2.0, 277.0, 35.2e6, 2370.0, S=12.0,
+                                         crater_calibres=2.0)
+    assert x_d == pytest.approx(6.21, rel=5e-3)
+    assert abs(x_d - 6.21) < 0.006  # measured 6.2154: within the printed 3 digits + 1e-3
+    assert 0.0269 * x_d == pytest.approx(0.167, abs=5e-4)  # "about 167 mm"
+    # S = 82.6 f_c^-0.544 at 35.2 MPa is 11.90, printed by Li and Chen as 12
+    assert empirical.strength_factor(35.2e6) == pytest.approx(11.903, abs=1e-3)
+    assert round(empirical.strength_factor(35.2e6)) == 12
+    # the shot in the committed data file (F94-52) is that shot
+    shot = read_shots(SHOTS).by_id(["F94-52"])[0]
+    assert (shot.mass, shot.diameter, shot.crh, shot.V0, shot.fc, shot.rho, shot.depth) == (
+        0.906, 0.0269, 2.0, 277.0, 35.2e6, 2370.0, 0.173)
+    assert empirical.shot_depth(shot, S=12.0) == pytest.approx(0.0269 * x_d, rel=1e-15)
+
+
+def forrestal_dimensional(m, d, crh, v, fc, rho, S):
+    """Forrestal et al. (1994) in their own variables (a = d/2, crater 4a), typed from the
+    paper's equations independently of the module."""
+    a = d / 2.0
+    n_star = (8.0 * crh - 1.0) / (24.0 * crh ** 2)
+    v1_sq = (m * v ** 2 - 4.0 * math.pi * a ** 3 * S * fc) / (m + 4.0 * math.pi * a ** 3
+                                                              * n_star * rho)
+    return m / (2.0 * math.pi * a ** 2 * rho * n_star) * math.log(
+        1.0 + n_star * rho * v1_sq / (S * fc)) + 4.0 * a
+
+
+@pytest.mark.parametrize("v, fc, crh", [(277.0, 35.2e6, 2.0), (800.0, 32.4e6, 2.0),
+                                        (600.0, 95e6, 3.0), (1200.0, 40e6, 0.5)])
+def test_li_chen_form_equals_forrestal_form(v, fc, crh):
+    S = empirical.strength_factor(fc)
+    ours = empirical.forrestal_depth(0.9, 0.0269, crh, v, fc, 2370.0)
+    assert ours == pytest.approx(forrestal_dimensional(0.9, 0.0269, crh, v, fc, 2370.0, S),
+                                 rel=1e-12)
+
+
+def test_empirical_crater_branch_is_continuous():
+    """A projectile that stops in the crater: the branch meets the tunnel form at X = 2d."""
+    m, d, fc, rho = 0.9, 0.0269, 35e6, 2370.0
+    S, n_star = empirical.strength_factor(fc), empirical.ogive_factor(2.0)
+    # V_1 = 0 at: m V^2 = 4 pi a^3 S f_c
+    v_star = math.sqrt(4.0 * math.pi * (d / 2) ** 3 * S * fc / m)
+    for factor in (1.0 - 1e-9, 1.0 + 1e-9):
+        assert empirical.penetration_calibres(m, d, 2.0, v_star * factor, fc, rho) == \
+            pytest.approx(2.0, rel=1e-8)
+    slow = empirical.penetration_calibres(m, d, 2.0, 0.5 * v_star, fc, rho)
+    I, N = empirical.li_chen_functions(m, d, 2.0, 0.5 * v_star, fc, rho)  # noqa: E741
+    assert slow < 2.0 and slow == pytest.approx(
+        math.sqrt(I * (8 / math.pi) * (1 + math.pi / (2 * N)) / (1 + I / N)), rel=1e-14)
+    assert n_star == pytest.approx(15.0 / 96.0, rel=1e-15)
+
+
+# --- mapping and projectile -------------------------------------------------------------------
+
+def test_concrete_mapping_and_projectile():
+    fc, rho = 35.2e6, 2370.0
+    material = concrete_material(fc, rho)
+    # ACI 318-19 19.2.2.1(a), typed in: 0.043 * 2370^1.5 * sqrt(35.2) MPa = 29.435 GPa
+    assert material.E == pytest.approx(0.043 * 2370.0 ** 1.5 * 35.2 ** 0.5 * 1e6, rel=1e-14)
+    assert material.E == pytest.approx(29.435e9, rel=1e-4)
+    assert aci_modulus(fc, rho) == material.E
+    # Richart et al. (1928): N_phi = 4.1 -> lam; physics.md N_phi = (3 + 2 lam)/(3 - lam)
+    lam = material.lam
+    assert (3 + 2 * lam) / (3 - lam) == pytest.approx(4.1, rel=1e-14)
+    assert math.degrees(math.asin(3 * lam / (6 + lam))) == pytest.approx(37.4, abs=0.05)
+    assert material.tau == pytest.approx((3 - lam) * fc / 3, rel=1e-14)
+    assert (material.nu, material.rho) == (0.2, rho)
+    calibrated = concrete_material(fc, rho, Mapping(lam=0.5, strength_factor=2.0,
+                                                    modulus_factor=0.5))
+    assert calibrated.tau == pytest.approx(2.5 * 2 * fc / 3, rel=1e-14)
+    assert calibrated.E == pytest.approx(0.5 * material.E, rel=1e-14)
+    with pytest.raises(CavexInputError, match="parameter 'lam' must be a number in"):
+        Mapping(lam=3.5)
+    # the inertial coefficient B = sigma_r per rho V^2 (docs/validation.md, Results)
+    from cavex.analytic.cavity import quasi_static_coefficients
+
+    for lam, b in ((0.0, 1.5), (0.6, 4.58)):
+        m = concrete_material(fc, rho, Mapping(lam=lam))
+        assert quasi_static_coefficients([m], [], 0.01345)[1] / rho == pytest.approx(b, abs=5e-3)
+    shot = read_shots(SHOTS).shots[0]
+    p = shot_projectile(shot)
+    assert (p.r, p.R, p.m, p.V0) == (0.01345, 0.0538, 0.904, 800.0)
+    assert p.l == pytest.approx(p.ogive_length, rel=1e-14)  # tangent ogive: r sqrt(4 crh - 1)
+    assert p.l == pytest.approx(0.01345 * math.sqrt(7.0), rel=1e-14)
+
+
+# --- shot files -------------------------------------------------------------------------------
+
+def test_shot_file_reading_keeps_comments_and_extra_columns():
+    data = read_shots(SHOTS)
+    assert len(data.shots) == 17 and data.shots[0].id == "F94-39"
+    assert any("Forrestal, Altman, Cargile, Hanchak (1994)" in c for c in data.comments)
+    text = ("# a comment\n\nid,extra,mass_kg,diameter_m,crh,V0_m_s,fc_Pa,rho_kg_m3,depth_m,"
+            "length_m\n" "X,hello,1,0.03,3,500,4e7,2400,0.5,\n")
+    (shot,) = parse_shots(text).shots
+    assert shot.extra == {"extra": "hello"} and shot.length is None and shot.line == 4
+    assert shot == Shot("X", 1.0, 0.03, None, 3.0, 500.0, 4e7, 2400.0, 0.5)
+
+
+BAD_FILES = [
+    (f"{COLUMNS}\n{GOOD_ROW}\nB2,0.9,0.0269,,2.0,fast,3.5e7,2370,0.2\n",
+     r"line 3 \(shot 'B2'\), column 'V0_m_s': must be a finite number > 0 \(got 'fast'\)"),
+    (f"# c\n{COLUMNS}\nB2,-0.9,0.0269,,2.0,300,3.5e7,2370,0.2\n",
+     r"line 3 \(shot 'B2'\), column 'mass_kg'"),
+    (f"{COLUMNS}\nB2,0.9,0.0269,,2.0,300,35.2,2370,0.2\n",
+     r"line 2 \(shot 'B2'\), column 'fc_Pa': .*is it in MPa"),
+    (f"{COLUMNS}\nB2,0.9,0.0269,,2.0,300,3.5e7,2.37,0.2\n",
+     r"column 'rho_kg_m3': .*is it in g/cm\^3"),
+    (f"{COLUMNS}\nB2,0.9,0.0269,,0.2,300,3.5e7,2370,0.2\n", r"column 'crh'"),
+    (f"{COLUMNS}\nB2,0.9,0.0269,,2,300,3.5e7,2370,nan\n", r"column 'depth_m'"),
+    (f"{COLUMNS}\n{GOOD_ROW}\n{GOOD_ROW}\n", r"line 3, column 'id': shot 'A1' repeats line 2"),
+    (f"{COLUMNS}\nB2,0.9,0.0269,2.0,300,3.5e7,2370,0.2\n", r"line 2: has 8 cells, the header "
+     r"has 9"),
+    (f"{COLUMNS.replace(',fc_Pa', '')}\nB2,0.9,0.0269,,2,300,2370,0.2\n",
+     r"line 1 \(header\): missing column 'fc_Pa'"),
+    (f"{COLUMNS}\n,0.9,0.0269,,2,300,3.5e7,2370,0.2\n", r"line 2, column 'id'"),
+    (f"# only comments\n{COLUMNS}\n", r"has a header but no shots"),
+]
+
+
+@pytest.mark.parametrize("text, message", BAD_FILES)
+def test_bad_shot_files_are_refused_naming_row_and_column(capsys, tmp_path, text, message):
+    path = tmp_path / "bad.csv"
+    path.write_text(text)
+    with pytest.raises(CavexInputError, match=message):
+        read_shots(path)
+    out_dir, cal = tmp_path / "out", tmp_path / "cal" / "c.toml"
+    for argv in (["validate", "--shots", str(path), "--out", str(out_dir)],
+                 ["calibrate", "--shots", str(path), "--out", str(cal)]):
+        code, out, err = run(capsys, *argv)
+        assert (code, out) == (2, "")
+        assert err.startswith("cavex: error: shots file") and err.count("\n") == 1
+        assert ("line " in err and ("column" in err or "cells" in err)) or "no shots" in err
+    assert not out_dir.exists() and not cal.parent.exists()
+
+
+def test_bad_calibration_files_are_refused(capsys, tmp_path):
+    good = tmp_path / "good.toml"
+    assert run(capsys, "calibrate", "--shots", SHOTS, "--out", str(good), "--ids", "F94-52",
+               "--params", "strength_factor")[0] == 0
+    text = good.read_text()
+    cases = [(text.replace("lam = ", "lamb = ", 1), "unknown key 'calibration.lamb'"),
+             (text.replace('model = "derived-quasi-static"', 'model = "quick"'),
+              "parameter 'model' must be one of"),
+             (text.replace('params = ["strength_factor"]', 'params = ["tau"]'),
+              "unknown calibration parameter 'tau'"),
+             (text.replace("[calibration]", "[calibrations]"), "unknown key 'calibrations'"),
+             ("[calibration\n", "is not valid TOML")]
+    for i, (bad, message) in enumerate(cases):
+        path = tmp_path / f"bad{i}.toml"
+        path.write_text(bad)
+        out_dir = tmp_path / f"out{i}"
+        code, out, err = run(capsys, "validate", "--shots", SHOTS, "--calibration", str(path),
+                             "--out", str(out_dir))
+        assert (code, out) == (2, "") and message in err and err.count("\n") == 1
+        assert not out_dir.exists()
+    for argv, message in ((["--params", "lam", "lam"], "names without repeats"),
+                          (["--model", "fem"], "parameter 'model' must be one of"),
+                          (["--ids", "F94-1"], "shot id(s) 'F94-1' not in shots file")):
+        out = tmp_path / "never.toml"
+        code, _, err = run(capsys, "calibrate", "--shots", SHOTS, "--out", str(out), *argv)
+        assert code == 2 and message in err and not out.exists()
+
+
+# --- predictions ------------------------------------------------------------------------------
+
+def test_crater_stop_branch_is_continuous_with_the_integrator():
+    shot = read_shots(SHOTS).by_id(["F94-52"])[0]
+    target, projectile = shot_target(shot), shot_projectile(shot)
+    resistance = ClosedFormResistance(target, projectile)
+    lc = crater_depth(projectile)
+    v_star = math.sqrt(lc * resistance.crater_force(0.0) / projectile.m)
+    from dataclasses import replace
+
+    above = penetration_depth(target, replace(projectile, V0=v_star * (1 + 1e-7)), resistance)
+    below = penetration_depth(target, replace(projectile, V0=v_star * (1 - 1e-7)), resistance)
+    assert above == pytest.approx(lc, rel=1e-6) and below == pytest.approx(lc, rel=1e-6)
+    assert below <= lc <= above
+    slow = penetration_depth(target, replace(projectile, V0=0.5 * v_star), resistance)
+    assert slow == pytest.approx(0.5 * lc, rel=1e-12)  # X^2 = m V0^2 L_c / F(0)
+    fast = replace(projectile, V0=1.5 * v_star)
+    assert penetration_depth(target, fast, resistance) == float(
+        penetrate(target, fast, resistance).depth[-1])
+
+
+def test_table_grid_reproduces_the_closed_form_it_tabulates():
+    """The FE table's grid (50 m/s in V, PCHIP in V^2) filled with the dynamic closed form
+    gives the closed form's depth: measured 2.5e-5 (800 m/s), asserted 1e-4."""
+    shots = read_shots(SHOTS).shots
+    velocities = table_velocities(shots)
+    assert velocities[0] == 0.0 and velocities[-1] >= 800.0 * 0.6506
+    for shot in (shots[0], shots[13]):  # 800 and 277 m/s
+        target, projectile = shot_target(shot), shot_projectile(shot)
+        table = analytic_table(target, projectile, velocities, TABLE_DEPTHS, boundary="dynamic")
+        tabulated = penetration_depth(target, projectile,
+                                      TabulatedResistance(table, target, projectile))
+        closed = closed_form_depth(shot, "derived dynamic")
+        assert tabulated == pytest.approx(closed, rel=1e-4)
+
+
+def test_ratio_statistics():
+    stats = ratio_statistics([0.5, 2.0, None, 1.0])
+    assert stats["n"] == 3
+    assert stats["mean_ratio"] == pytest.approx(3.5 / 3, rel=DIGITS_6)
+    assert stats["std_ratio"] == pytest.approx(np.std([0.5, 2.0, 1.0], ddof=1), rel=DIGITS_6)
+    assert stats["mean_abs_log_ratio"] == pytest.approx(2 * math.log(2) / 3, rel=DIGITS_6)
+    assert ratio_statistics([None]) == {"n": 0, "mean_ratio": None, "std_ratio": None,
+                                        "mean_abs_log_ratio": None}
+
+
+# --- calibration ------------------------------------------------------------------------------
+
+def synthetic_file(path, mapping, model="derived quasi-static"):
+    """The committed shots' inputs with depths predicted by cavex's own model."""
+    data = read_shots(SHOTS)
+    with open(path, "w", newline="") as handle:
+        handle.write("# synthetic: depths from cavex's derived quasi-static model\n")
+        writer = csv.writer(handle)
+        writer.writerow(COLUMNS.split(","))
+        for s in data.shots:
+            writer.writerow([s.id, s.mass, s.diameter, s.length, s.crh, s.V0, s.fc, s.rho,
+                             repr(closed_form_depth(s, model, mapping))])
+
+
+def test_synthetic_shots_calibrate_back_to_their_parameters(capsys, tmp_path):
+    truth = Mapping(lam=0.45, strength_factor=0.7)
+    shots_path = tmp_path / "synthetic.csv"
+    synthetic_file(shots_path, truth)
+    cal = tmp_path / "cal.toml"
+    code, out, err = run(capsys, "calibrate", "--shots", str(shots_path), "--out", str(cal))
+    assert (code, err) == (0, "")
+    fitted = read_calibration(cal)
+    assert fitted.params == ("lam", "strength_factor")
+    assert fitted.mapping.lam == pytest.approx(0.45, rel=1e-5)
+    assert fitted.mapping.strength_factor == pytest.approx(0.7, rel=1e-5)
+    assert dict(fitted.statistics)["mean_abs_log_ratio"] < 1e-5
+    # three parameters, another model, from the Python API
+    truth3 = Mapping(lam=0.8, strength_factor=0.6, modulus_factor=1.5)
+    shots = read_shots(SHOTS).shots[::3]
+    synthetic = [Shot(s.id, s.mass, s.diameter, s.length, s.crh, s.V0, s.fc, s.rho,
+                      closed_form_depth(s, "paper", truth3)) for s in shots]
+    got = fit(synthetic, "paper", ("lam", "strength_factor", "modulus_factor")).mapping
+    assert (got.lam, got.strength_factor, got.modulus_factor) == pytest.approx(
+        (0.8, 0.6, 1.5), rel=1e-5)
+
+
+def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
+    """The calibration TOML is a configuration: `cavex penetrate --config CAL.toml` gives the
+    depth `cavex validate --calibration CAL.toml` predicts for the reference shot."""
+    ids = ["F94-52", "F94-50"]
+    small = tmp_path / "shots.csv"
+    lines = read_shots_text_lines(ids)
+    small.write_text("\n".join(lines) + "\n")
+    cal = tmp_path / "cal.toml"
+    assert run(capsys, "calibrate", "--shots", str(small), "--out", str(cal), "--ids",
+               "F94-52", "--params", "strength_factor")[0] == 0
+    data = tomllib.loads(cal.read_text())
+    assert data["calibration"]["shots"] == ["F94-52"]
+    assert abs(math.log(data["calibration"]["strength_factor"])) > 0.1  # it moved
+    assert data["calibration"]["reference_shot"] == "F94-52"
+    code, out, err = run(capsys, "penetrate", "--config", str(cal), "--json", "--out",
+                         str(tmp_path / "pen"))
+    assert (code, err) == (0, "")
+    final = json.loads(out)["phases"][-1]["end_depth_m"]
+    out_dir = tmp_path / "val"
+    code, out, err = run(capsys, "validate", "--shots", str(small), "--calibration", str(cal),
+                         "--json", "--out", str(out_dir))
+    assert (code, err) == (0, "")
+    result = json.loads(out)
+    rows = {row["id"]: row for row in result["shots"]}
+    assert rows["F94-52"]["predicted"]["derived quasi-static calibrated"] == pytest.approx(
+        final, rel=DIGITS_6)
+    # the JSON of the issue, and the statistics recomputed from it
+    assert set(result["summary"]) == {"derived quasi-static", "derived dynamic", "paper",
+                                      "FE table", "Forrestal 1994",
+                                      "derived quasi-static calibrated"}
+    for model, stats in result["summary"].items():
+        ratios = [row["predicted"][model] / row["measured"] for row in result["shots"]]
+        assert stats["n"] == 2
+        assert stats["mean_ratio"] == pytest.approx(np.mean(ratios), rel=DIGITS_6)
+        assert stats["std_ratio"] == pytest.approx(np.std(ratios, ddof=1), rel=DIGITS_6)
+        assert stats["mean_abs_log_ratio"] == pytest.approx(np.mean(np.abs(np.log(ratios))),
+                                                            rel=DIGITS_6)
+    assert result["held_out"] == ["F94-50"]
+    assert result["held_out_summary"]["paper"]["n"] == 1
+    # the calibrated model fits its one shot (one parameter, one shot: exactly)
+    assert rows["F94-52"]["ratio"]["derived quasi-static calibrated"] == pytest.approx(1.0,
+                                                                                      abs=1e-5)
+    empirical_depth = empirical.shot_depth(read_shots(small).by_id(["F94-50"])[0])
+    assert rows["F94-50"]["predicted"]["Forrestal 1994"] == pytest.approx(empirical_depth,
+                                                                          rel=DIGITS_6)
+    # files; one FE table per distinct target (two here), reused by a rerun
+    names = {p.name for p in out_dir.iterdir()}
+    assert {"validation.json", "predictions.csv", "report.md", "predicted_vs_measured.png",
+            "ratio_vs_velocity.png", "tables"} <= names
+    assert len(list((out_dir / "tables").glob("table_*.nc"))) == 2
+    for png in ("predicted_vs_measured.png", "ratio_vs_velocity.png"):
+        assert (out_dir / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    first = (out_dir / "validation.json").read_text()
+    code, out, err = run(capsys, "validate", "--shots", str(small), "--calibration", str(cal),
+                         "--out", str(out_dir))
+    assert code == 0 and "FE tables built 0, reused 2" in out
+    assert (out_dir / "validation.json").read_text() == first
+
+
+def read_shots_text_lines(ids):
+    """The committed file's comment lines, header and the rows of ``ids``."""
+    lines = open(SHOTS, encoding="utf-8").read().splitlines()
+    return [line for line in lines if line.startswith("#") or line.startswith("id,")
+            or line.split(",")[0] in ids]
+
+
+# --- the committed report ---------------------------------------------------------------------
+
+def test_committed_validation_report_is_consistent():
+    """results/validation/: every statistic equals the one recomputed from the per-shot depths
+    written beside it (6 digits), the held-out shots are those in no calibration's fit, the
+    calibration files hold the parameters the report used, and the report's verdict line is
+    the one the numbers give."""
+    from pathlib import Path
+
+    from cavex.verification.validation_output import verdict
+
+    folder = Path("results/validation")
+    result = json.loads((folder / "validation.json").read_text())
+    data = read_shots(SHOTS)
+    assert [row["id"] for row in result["shots"]] == [s.id for s in data.shots]
+    fitted = set()
+    for c in result["calibrations"]:
+        stored = read_calibration(c["file"])
+        assert stored.mapping.as_dict() == c["mapping"] and list(stored.shots) == c["shots"]
+        fitted |= set(c["shots"])
+    assert result["held_out"] == [s.id for s in data.shots if s.id not in fitted]
+    for name, rows in (("summary", result["shots"]), ("held_out_summary",
+                       [r for r in result["shots"] if r["id"] in result["held_out"]])):
+        for model, stats in result[name].items():
+            ratios = [r["predicted"][model] / r["measured"] for r in rows
+                      if r["predicted"][model] is not None]
+            assert stats["n"] == len(ratios)
+            assert stats["mean_ratio"] == pytest.approx(np.mean(ratios), rel=DIGITS_6)
+            assert stats["std_ratio"] == pytest.approx(np.std(ratios, ddof=1), rel=DIGITS_6)
+            assert stats["mean_abs_log_ratio"] == pytest.approx(
+                np.mean(np.abs(np.log(ratios))), rel=DIGITS_6)
+    for row, shot in zip(result["shots"], data.shots, strict=True):
+        assert row["predicted"]["Forrestal 1994"] == pytest.approx(empirical.shot_depth(shot),
+                                                                   rel=DIGITS_6)
+    sentence = verdict(result["held_out_summary"], result["calibrations"])
+    assert sentence in (folder / "report.md").read_text()

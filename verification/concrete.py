@@ -1,0 +1,95 @@
+r"""From a shot's concrete, ``(f_c, rho)``, to cavex's material parameters.
+
+A published test reports the unconfined compressive strength ``f_c`` and the density ``rho``;
+cavex's models need ``E, nu, rho, lam, tau`` (:class:`cavex.materials.Material`). The mapping
+(``docs/validation.md``) and its sources:
+
+- ``E = e * 0.043 rho^1.5 sqrt(f_c)`` (MPa, ``rho`` in kg/m^3, ``f_c`` in MPa): ACI 318-19,
+  19.2.2.1(a) (``w_c`` 1440-2560 kg/m^3); ``e`` = ``modulus_factor`` (1 unless calibrated).
+- ``nu = 0.2``: EN 1992-1-1 (2004), 3.1.3(4), uncracked concrete. Only the FE solver uses it
+  (the closed forms are incompressible): a realistic ``nu`` is what the FE-tabulated
+  resistance adds.
+- ``lam`` (pressure sensitivity of the paper's Mohr-Coulomb ``sigma_r - sigma_theta =
+  lam sigma + tau``) from the triaxial strength of concrete, ``f_cc = f_c + 4.1 f_l`` (Richart,
+  Brandtzaeg and Brown 1928, Univ. Illinois Eng. Exp. Station Bull. 185): the Mohr-Coulomb
+  ``N_phi = (1 + sin phi)/(1 - sin phi) = 4.1`` (``phi`` = 37.4 deg) and, with
+  ``N_phi = (3 + 2 lam)/(3 - lam)`` (physics.md), ``lam = 3 (N_phi - 1)/(N_phi + 2) = 1.525``.
+- ``sigma_c = s * f_c``, ``tau = (3 - lam) sigma_c / 3``: the yield line passes through the
+  uniaxial compressive strength (``s`` = ``strength_factor``, 1 unless calibrated; a fitted
+  ``s`` absorbs what the idealisation leaves out: rate and size effects, the curvature of the
+  real failure envelope at the cavity pressures, compaction).
+- tension cut-off: none in the closed forms; the Mohr-Coulomb line implies a uniaxial tensile
+  strength ``f_c / N_phi`` (0.24 ``f_c``, three times the usual 0.08 ``f_c``). The FE solver
+  can cut tension off (``Numerics.tension_cutoff``); the validation keeps the FE at the
+  Mohr-Coulomb apex so that FE and closed forms differ only by compressibility and finite
+  strain.
+
+The free parameters of a calibration are ``lam``, ``strength_factor`` and ``modulus_factor``
+(:data:`FREE_PARAMETERS`).
+"""
+
+import math
+from dataclasses import dataclass, fields, replace
+
+from cavex.errors import CavexInputError, require
+from cavex.materials import Material, Target
+
+RICHART_CONFINEMENT = 4.1  # f_cc = f_c + 4.1 f_l (Richart, Brandtzaeg and Brown 1928)
+DEFAULT_NU = 0.2  # EN 1992-1-1, 3.1.3(4)
+LAYER_NAME = "concrete"
+FREE_PARAMETERS = ("lam", "strength_factor", "modulus_factor")
+# accepted ranges (lower, upper) of the parameters; lam < 3 is the material's own limit
+BOUNDS = {"lam": (0.0, 2.9), "strength_factor": (0.05, 20.0), "modulus_factor": (0.05, 20.0),
+          "nu": (-0.99, 0.4999)}
+
+
+def mohr_coulomb_lambda(confinement=RICHART_CONFINEMENT):
+    """``lam`` of the paper's Mohr-Coulomb with ``N_phi = confinement``:
+    ``lam = 3 (N_phi - 1)/(N_phi + 2)`` (inverse of physics.md's ``N_phi = (3+2 lam)/(3-lam)``)."""
+    return 3.0 * (confinement - 1.0) / (confinement + 2.0)
+
+
+def aci_modulus(fc, rho):
+    """ACI 318-19 19.2.2.1(a): ``E_c = 0.043 w_c^1.5 sqrt(f_c')`` (MPa) in Pa, ``fc`` in Pa."""
+    return 0.043 * rho ** 1.5 * math.sqrt(fc / 1e6) * 1e6
+
+
+@dataclass(frozen=True)
+class Mapping:
+    """Parameters of the ``(f_c, rho)`` -> material mapping (defaults: the sources above)."""
+
+    lam: float = mohr_coulomb_lambda()
+    strength_factor: float = 1.0
+    modulus_factor: float = 1.0
+    nu: float = DEFAULT_NU
+
+    def __post_init__(self):
+        for item in fields(self):
+            lower, upper = BOUNDS[item.name]
+            value = getattr(self, item.name)
+            require(isinstance(value, (int, float)) and not isinstance(value, bool)
+                    and math.isfinite(value) and lower <= value <= upper, item.name,
+                    f"a number in [{lower:g}, {upper:g}]", value)
+
+    def with_values(self, names, values):
+        """A copy with the parameters ``names`` set to ``values``."""
+        return replace(self, **{n: float(v) for n, v in zip(names, values, strict=True)})
+
+    def as_dict(self):
+        return {item.name: getattr(self, item.name) for item in fields(self)}
+
+
+def concrete_material(fc, rho, mapping=None):
+    """The :class:`~cavex.materials.Material` of a concrete of strength ``fc`` (Pa) and density
+    ``rho`` (kg/m^3) under ``mapping`` (default :class:`Mapping`)."""
+    mapping = mapping or Mapping()
+    try:
+        return Material(E=mapping.modulus_factor * aci_modulus(fc, rho), nu=mapping.nu, rho=rho,
+                        lam=mapping.lam, sigma_c=mapping.strength_factor * fc, name=LAYER_NAME)
+    except CavexInputError as exc:
+        raise CavexInputError(f"concrete f_c = {fc:g} Pa, rho = {rho:g} kg/m^3: {exc}") from None
+
+
+def shot_target(shot, mapping=None):
+    """The semi-infinite one-layer target of a shot (thick concrete)."""
+    return Target((concrete_material(shot.fc, shot.rho, mapping),), ())
