@@ -194,6 +194,7 @@ def _point(props, interfaces, row, a, c, v2, dynamic, zones, p, keep_zones):
                 else:  # Newton on the convex g(y) from the inner end: monotone
                     y = y_in
                     converged = False
+                    last = np.inf
                     for _ in range(NEWTON_ITERATIONS):
                         s = (s_out + (4.0 * E / 9.0) * (y ** 3 - y_out ** 3)
                              + rho_v2 * 2.0 * ((y - y_out) - 0.25 * (y ** 4 - y_out ** 4)))
@@ -202,9 +203,14 @@ def _point(props, interfaces, row, a, c, v2, dynamic, zones, p, keep_zones):
                                                            + 2.0 * rho_v2 * (1.0 - y ** 3))
                         step = g / dg
                         y -= step
-                        if abs(step) <= 4e-16 * y:
+                        # converged: the step is at the last bits of y, or it has stopped
+                        # shrinking at the level of the rounding noise of g (~1e-15 y when the
+                        # terms of g cancel)
+                        if abs(step) <= 4e-16 * y or (abs(step) <= 1e-12 * y
+                                                      and abs(step) >= last):
                             converged = True
                             break
+                        last = abs(step)
                     if not converged:
                         flags |= FAILED
                     y_yield = max(y, y_out)
