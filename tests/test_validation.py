@@ -115,7 +115,7 @@ def test_concrete_mapping_and_projectile():
     assert material.E == pytest.approx(0.043 * 2370.0 ** 1.5 * 35.2 ** 0.5 * 1e6, rel=1e-14)
     assert material.E == pytest.approx(29.435e9, rel=1e-4)
     assert aci_modulus(fc, rho) == material.E
-    # Richart et al. (1928): N_phi = 4.1 -> lam; physics.md N_phi = (3 + 2 lam)/(3 - lam)
+    # Richart et al. (1928): N_phi = 4.1 -> lam; docs/problem.md N_phi = (3 + 2 lam)/(3 - lam)
     lam = material.lam
     assert (3 + 2 * lam) / (3 - lam) == pytest.approx(4.1, rel=1e-14)
     assert math.degrees(math.asin(3 * lam / (6 + lam))) == pytest.approx(37.4, abs=0.05)

@@ -13,7 +13,7 @@ cavex's models need ``E, nu, rho, lam, tau`` (:class:`cavex.materials.Material`)
   lam sigma + tau``) from the triaxial strength of concrete, ``f_cc = f_c + 4.1 f_l`` (Richart,
   Brandtzaeg and Brown 1928, Univ. Illinois Eng. Exp. Station Bull. 185): the Mohr-Coulomb
   ``N_phi = (1 + sin phi)/(1 - sin phi) = 4.1`` (``phi`` = 37.4 deg) and, with
-  ``N_phi = (3 + 2 lam)/(3 - lam)`` (physics.md), ``lam = 3 (N_phi - 1)/(N_phi + 2) = 1.525``.
+  ``N_phi = (3 + 2 lam)/(3 - lam)`` (docs/problem.md), ``lam = 3 (N_phi - 1)/(N_phi + 2) = 1.525``.
 - ``sigma_c = s * f_c``, ``tau = (3 - lam) sigma_c / 3``: the yield line passes through the
   uniaxial compressive strength (``s`` = ``strength_factor``, 1 unless calibrated; a fitted
   ``s`` absorbs what the idealisation leaves out: rate and size effects, the curvature of the
@@ -45,7 +45,7 @@ BOUNDS = {"lam": (0.0, 2.9), "strength_factor": (0.05, 20.0), "modulus_factor": 
 
 def mohr_coulomb_lambda(confinement=RICHART_CONFINEMENT):
     """``lam`` of the paper's Mohr-Coulomb with ``N_phi = confinement``:
-    ``lam = 3 (N_phi - 1)/(N_phi + 2)`` (inverse of physics.md's ``N_phi = (3+2 lam)/(3-lam)``)."""
+    ``lam = 3 (N_phi - 1)/(N_phi + 2)`` (inverse of docs/problem.md's ``N_phi = (3+2 lam)/(3-lam)``)."""
     return 3.0 * (confinement - 1.0) / (confinement + 2.0)
 
 
