@@ -346,3 +346,17 @@ def test_version_bare_usage_and_help_with_defaults(capsys):
     with pytest.raises(SystemExit):
         main(["penetrate", "--help"])
     assert "(default: results/penetration)" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("argv", "name"), [
+    (["validate", "--shots", "{shots}", "--out", "{tmp}/v", "--workers", "0"], "'workers'"),
+    (["validate", "--shots", "{shots}", "--out", "{tmp}/v", "--scheduler", "bogus"],
+     "'scheduler'"),
+    (["calibrate", "--shots", "{shots}", "--out", "{tmp}/c.toml", "--workers", "0"],
+     "'workers'"),
+    (["validate", "--shots", "{shots}", "--out", "/proc/cavex-test"], "'out'"),
+    (["calibrate", "--shots", "{shots}", "--out", "{tmp}"], "'out'"),
+])
+def test_validation_commands_check_before_work(capsys, tmp_path, argv, name):
+    shots = Path(__file__).resolve().parents[1] / "examples" / "shots_forrestal1994.csv"
+    refused(capsys, tmp_path, [a.format(shots=shots, tmp=tmp_path) for a in argv], name)

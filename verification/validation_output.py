@@ -20,7 +20,7 @@ import numpy as np
 
 from cavex.errors import CavexInputError
 from cavex.paths import check_output_dir
-from cavex.verification.runner import save_figure, write_text_atomic
+from cavex.verification.runner import check_execution, save_figure, write_text_atomic
 from cavex.verification.shots import read_shots
 from cavex.verification.validation import (
     CLOSED_FORMS,
@@ -51,6 +51,7 @@ def validate_main(shots_path, calibration_paths=(), out_dir=None, as_json=False,
         raise CavexInputError(f"two calibrations of the same model ({', '.join(repeated)}); "
                               "give one per model")
     out = check_output_dir(out_dir or DEFAULT_OUT, "out")
+    check_execution(workers, scheduler)
     began = time.monotonic()
     result = run(shot_file, calibrations, tables_dir=out / "tables", workers=workers,
                  scheduler=scheduler, progress=progress)
