@@ -36,7 +36,7 @@ from cavex.verification.report_analysis import analyse
 from cavex.verification.table import analytic_table, write_table
 
 # relative spread between CPUs, per kind of number (module docstring)
-SPREAD = {TRAJECTORY_DIGITS: 1e-13, CLOSED_FORM_DIGITS: 1e-13, FE_DIGITS: 1e-11,
+SPREAD = {TRAJECTORY_DIGITS: 1e-8, CLOSED_FORM_DIGITS: 1e-13, FE_DIGITS: 1e-11,
           ESTIMATE_DIGITS: 1e-9}
 NUMBER = re.compile(r"^-?(\d+)(?:\.(\d+))?(?:e[+-]\d+)?$")
 
@@ -106,8 +106,8 @@ def test_format_number_keeps_integers_and_strings():
     assert format_number(True) == "True" and format_number("crater") == "crater"
     assert format_number(1000.0) == "1000" and format_number(0.0) == "0"
     assert format_number(0.11624999999999999) == "0.11625"
-    assert format_number(961.3510282727193) == "961.351028"
-    assert format_number(1.2017468457095811e-05) == "1.20174685e-05"
+    assert format_number(961.3510282727193) == "961.351"
+    assert format_number(1.2017468457095811e-05) == "1.20175e-05"
     assert format_number(-2.5e-20, 3) == "-2.5e-20" and format_number(math.nan) == "nan"
     assert round_nested({"a": [0.1 + 0.2, 2, "x", None], "b": (1 / 3,)}, 3) == {
         "a": [0.3, 2, "x", None], "b": [0.333]}
@@ -154,7 +154,7 @@ def test_penetration_csv_is_byte_identical_and_has_nine_digits(penetration, tmp_
 
 
 def test_another_cpu_writes_the_same_penetration_text(penetration):
-    """Every trajectory value away from a 9-digit rounding boundary formats the same after a
+    """Every trajectory value away from a 6-digit rounding boundary formats the same after a
     1e-13 relative perturbation (which changes its 17-digit text)."""
     spread = SPREAD[TRAJECTORY_DIGITS]
     values = [float(x) for run in penetration["runs"].values()
@@ -172,17 +172,18 @@ def test_another_cpu_writes_the_same_penetration_text(penetration):
 
 def test_penetration_csv_unchanged_by_a_perturbed_trajectory(penetration, tmp_path,
                                                               monkeypatch):
-    """Writer input multiplied by (1 + 1e-13), values near a boundary left out of the check."""
+    """Writer input multiplied by (1 + 1e-8), the measured spread of an integrated trajectory,
+    values near a boundary left out of the check."""
     monkeypatch.setattr(penetration_report, "_write_figures", lambda job, out: [])
     run = penetration["runs"]["runway"]
     columns = run.as_columns()
     generic = np.ones(len(run.t), dtype=bool)
     for name, column in columns.items():
         if name != "phase":
-            generic &= [far_from_boundary(float(x), TRAJECTORY_DIGITS, 1e-13) for x in column]
+            generic &= [far_from_boundary(float(x), TRAJECTORY_DIGITS, 1e-8) for x in column]
     picked = {k: v[generic] for k, v in columns.items()}
-    perturbed = {k: v if k == "phase" else v * (1 + 1e-13) for k, v in picked.items()}
-    assert generic.mean() > 0.95
+    perturbed = {k: v if k == "phase" else v * (1 + 1e-8) for k, v in picked.items()}
+    assert generic.mean() > 0.5  # rows checked (measured 0.64: a row needs all 4 columns clear)
     a = penetration_report._write_csv(tmp_path / "a.csv", picked)
     b = penetration_report._write_csv(tmp_path / "b.csv", perturbed)
     assert a.read_bytes() == b.read_bytes()
