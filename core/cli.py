@@ -145,6 +145,8 @@ def _describe(commands):
 def _parallel(command):
     command.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://127.0.0.1:8786")
     command.add_argument("--workers", type=int, help="local worker processes (default: CPUs)")
+    command.add_argument("--progress", action=argparse.BooleanOptionalAction,
+                         help="progress bar on stderr (default: when stderr is a terminal)")
 
 
 def _common(command):
@@ -274,34 +276,35 @@ def _table(args, target, projectile):
     from cavex.verification.table import table_main
 
     return table_main(args.config, args.velocities, args.depths, args.out, args.nu,
-                      args.workers, args.scheduler)
+                      args.workers, args.scheduler, progress=args.progress)
 
 
 def _verify(args, target, projectile):
     from cavex.verification.report import verify_main
 
-    return verify_main(args.config, args.quick, args.out, args.scheduler, args.workers)
+    return verify_main(args.config, args.quick, args.out, args.scheduler, args.workers,
+                       progress=args.progress)
 
 
 def _batch(args, target, projectile):
     from cavex.verification.batch import batch_main
 
     return batch_main(args.sweep, args.out, args.scheduler, args.workers,
-                      allow_large=args.allow_large)
+                      progress=args.progress, allow_large=args.allow_large)
 
 
 def _calibrate(args, target, projectile):
     from cavex.verification.calibration import calibrate_main
 
     return calibrate_main(args.shots, args.out, args.params, args.model, args.ids,
-                          args.workers, args.scheduler)
+                          args.workers, args.scheduler, progress=args.progress)
 
 
 def _validate(args, target, projectile):
     from cavex.verification.validation_output import validate_main
 
     return validate_main(args.shots, args.calibration, args.out, args.json, args.workers,
-                         args.scheduler)
+                         args.scheduler, progress=args.progress)
 
 
 def _trajectory(args, target, projectile):
@@ -310,9 +313,9 @@ def _trajectory(args, target, projectile):
     return trajectory_main(args, target, projectile)
 
 
-COMMANDS = {"trajectory": _trajectory, "penetrate": _penetrate, "stress": _stress, "fem": _fem, "table": _table,
-            "verify": _verify, "batch": _batch, "calibrate": _calibrate,
-            "validate": _validate}
+COMMANDS = {"penetrate": _penetrate, "stress": _stress, "fem": _fem, "table": _table,
+            "verify": _verify, "batch": _batch, "calibrate": _calibrate, "validate": _validate,
+            "trajectory": _trajectory}
 
 if __name__ == "__main__":
     sys.exit(main())

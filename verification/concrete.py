@@ -45,7 +45,8 @@ BOUNDS = {"lam": (0.0, 2.9), "strength_factor": (0.05, 20.0), "modulus_factor": 
 
 def mohr_coulomb_lambda(confinement=RICHART_CONFINEMENT):
     """``lam`` of the paper's Mohr-Coulomb with ``N_phi = confinement``:
-    ``lam = 3 (N_phi - 1)/(N_phi + 2)`` (inverse of docs/problem.md's ``N_phi = (3+2 lam)/(3-lam)``)."""
+    ``lam = 3 (N_phi - 1)/(N_phi + 2)`` (inverse of docs/problem.md's
+    ``N_phi = (3 + 2 lam)/(3 - lam)``)."""
     return 3.0 * (confinement - 1.0) / (confinement + 2.0)
 
 

@@ -337,7 +337,8 @@ def summary_text(summary):
     ])
 
 
-def verify_main(config_path=None, quick=False, out_dir=None, scheduler=None, workers=None):
+def verify_main(config_path=None, quick=False, out_dir=None, scheduler=None, workers=None,
+                progress=None):
     """The ``cavex verify`` job: load the config, write the report, return a printable summary."""
     from cavex.config import default_config_text, load_config
 
@@ -347,7 +348,7 @@ def verify_main(config_path=None, quick=False, out_dir=None, scheduler=None, wor
     out_dir = check_output_dir(DEFAULT_OUT if out_dir is None else out_dir, "out")
     check_execution(workers, scheduler)
     summary = verify(target, projectile, quick=quick, out_dir=out_dir, scheduler=scheduler,
-                     workers=workers, config_text=config)
+                     workers=workers, config_text=config, progress=progress)
     return summary_text(summary)
 
 
