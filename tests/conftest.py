@@ -1,7 +1,8 @@
 """Shared fixtures for the cavex tests.
 
-The numbers here are typed in from the paper's Table 1 (She 2020; docs/problem.md section 3), not read
-from ``core/data/runway.toml``, so that the embedded default can be checked against them.
+The numbers here are typed in from the paper's Table 1 (She 2020; docs/problem.md section 3),
+not read from ``core/data/runway.toml``, so that the embedded default can be checked against
+them.
 """
 
 import pytest
