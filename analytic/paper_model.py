@@ -9,8 +9,8 @@ ones marked ``PRINTED (ii)`` keep a genuine error of the paper on purpose.
 
 Notation (as the paper): ``p_i = alpha_i lam_i = 6 lam_i/(3 + 2 lam_i)`` (twice the ``alpha``
 of docs/problem.md), ``eps_i = a/b`` when the elastic-plastic boundary ``b`` lies in layer
-``i``, cavity radius ``a = r`` (the projectile radius; the paper's ``Vt`` and ``a``), interface radii
-``h_i = H_i - L + l`` (Eq. 16). The wall stress is ``sigma_r = tau A + B rho V^2``, i.e.
+``i``, cavity radius ``a = r`` (the projectile radius; the paper's ``Vt`` and ``a``), interface
+radii ``h_i = H_i - L + l`` (Eq. 16). The wall stress is ``sigma_r = tau A + B rho V^2``, i.e.
 ``S = A + B rho V^2 / tau`` with the ``tau`` and ``rho`` that the equation itself uses (Eqs. 23-25
 and 28 normalise by the *outermost yielded* layer, not by the layer at the wall).
 
@@ -29,8 +29,8 @@ import numpy as np
 from cavex.errors import require, require_choice
 
 # Readings of the paper's undefined eps: (2E/3) eps^k = Y -> (k, Y). k = 3 spherical
-# (docs/problem.md, consistent with the printed A), k = 2 the incompressible cylindrical cavity; Y is tau or the
-# uniaxial strength sigma_c = 3 tau/(3 - lam) of Eq. 2 (docs/table2.md: "cylindrical-sigma_c" is
+# (docs/problem.md, consistent with the printed A), k = 2 the incompressible cylindrical cavity;
+# Y is tau or the uniaxial strength sigma_c = 3 tau/(3 - lam) of Eq. 2 (docs/table2.md: "cylindrical-sigma_c" is
 # the only reading that puts Table 2's L1 at its printed 0.40 m).
 EPSILON_FORMS = {
     "quasi-static": (3.0, "tau"),
