@@ -30,8 +30,8 @@ from cavex.errors import require, require_choice
 
 # Readings of the paper's undefined eps: (2E/3) eps^k = Y -> (k, Y). k = 3 spherical
 # (docs/problem.md, consistent with the printed A), k = 2 the incompressible cylindrical cavity;
-# Y is tau or the uniaxial strength sigma_c = 3 tau/(3 - lam) of Eq. 2 (docs/table2.md: "cylindrical-sigma_c" is
-# the only reading that puts Table 2's L1 at its printed 0.40 m).
+# Y is tau or the uniaxial strength sigma_c = 3 tau/(3 - lam) of Eq. 2 (docs/table2.md:
+# "cylindrical-sigma_c" is the only reading that puts Table 2's L1 at its printed 0.40 m).
 EPSILON_FORMS = {
     "quasi-static": (3.0, "tau"),
     "cylindrical": (2.0, "tau"),
