@@ -29,7 +29,7 @@ class Material:
     """Incompressible-idealised elastic-perfectly plastic Mohr-Coulomb material.
 
     Yield in the paper's form ``sigma_r - sigma_theta = lam * sigma + tau`` with
-    ``tau = (3 - lam) sigma_c / 3`` (physics.md section 1).
+    ``tau = (3 - lam) sigma_c / 3`` (docs/problem.md section 1).
 
     Parameters
     ----------

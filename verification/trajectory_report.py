@@ -1,0 +1,275 @@
+"""``cavex trajectory``: one oblique shot through the layered target (docs/oblique.md).
+
+The job runs :func:`cavex.analytic.oblique.fly` for the runway (and, with
+``compare_homogeneous``, for the first layer alone, as the paper does), writes the histories as
+CSV (9 significant digits) and the figures: side view to scale with the projectile outline at
+intervals, pitch against time, axial and lateral overload against time and depth with the
+interfaces marked, a 3-D view of the path in the layered block (pyvista, off-screen).
+"""
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from cavex.analytic.oblique import Shot, fly, rotation
+from cavex.paths import check_output_dir
+from cavex.verification.number_format import format_number
+from cavex.verification.runner import save_figure, write_text_atomic
+
+DEFAULT_DIR = "results/trajectory"
+
+
+def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="quasi-static",
+                   free_surface=True, table=None, law_A=None, law_B=None,
+                   compare_homogeneous=False):
+    """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``."""
+    options = {"boundary": boundary, "free_surface": free_surface, "table": table,
+               "law_A": law_A, "law_B": law_B}
+    if table is not None:
+        from cavex.verification.table import load_table
+        options["table"] = load_table(table)
+    runs = {"runway": fly(target, projectile, shot, resistance, **options)}
+    if compare_homogeneous and len(target.layers) > 1:
+        single = target.single(0)
+        if resistance == "table":  # the table belongs to the runway; first layer by closed form
+            options = {**options, "table": None}
+            resistance_single = "derived"
+        else:
+            resistance_single = resistance
+        runs["first layer only"] = fly(single, projectile, shot, resistance_single, **options)
+    settings = {"speed_m_s": shot.speed, "obliquity_deg": shot.obliquity,
+                "attack_deg": shot.attack, "attack_plane_deg": shot.attack_plane,
+                "spin_rad_s": shot.spin, "resistance": resistance, "boundary": boundary,
+                "free_surface": free_surface}
+    return {"runs": runs, "settings": settings, "target": target}
+
+
+def summary(result):
+    """End state and phases (JSON-ready), plus the largest pitch rate and overloads."""
+    h = result.history
+    rate = np.gradient(h["pitch_deg"], h["t_s"]) if h["t_s"].size > 2 else np.zeros(1)
+    return {"end": result.end, "phases": result.phases,
+            "max_pitch_rate_deg_s": float(np.max(np.abs(rate))),
+            "max_axial_g": float(np.max(h["axial_g"])),
+            "max_lateral_g": float(np.max(h["lateral_g"]))}
+
+
+def write_outputs(job, out):
+    """CSV, summary JSON and figures into ``out``; returns the paths written."""
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, result in job["runs"].items():
+        path = folder / f"history_{name.replace(' ', '_')}.csv"
+        write_text_atomic(path, history_csv(result.history))
+        written.append(str(path))
+    path = folder / "summary.json"
+    text = json.dumps({"settings": job["settings"],
+                       "runs": {k: summary(v) for k, v in job["runs"].items()}}, indent=2)
+    write_text_atomic(path, text + "\n")
+    written.append(str(path))
+    written += figures(job, folder)
+    return written
+
+
+def history_csv(history):
+    names = list(history)
+    rows = [",".join(names)]
+    columns = [history[n] for n in names]
+    for i in range(columns[0].size):
+        rows.append(",".join(format_number(float(c[i])) for c in columns))
+    return "\n".join(rows) + "\n"
+
+
+# --- figures ----------------------------------------------------------------------------------
+
+def figures(job, folder):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    written = [side_view(job, folder / "path_side.png"),
+               pitch_time(job, folder / "pitch_time.png"),
+               overloads(job, folder / "overload.png")]
+    picture = view_3d(job, folder / "path_3d.png")
+    if picture:
+        written.append(picture)
+    return written
+
+
+def _interfaces(ax, target, vertical=True):
+    for H in target.interface_depths:
+        (ax.axhline if vertical else ax.axvline)(H, color="0.5", lw=0.8, ls="--")
+
+
+def outline_points(result, y):
+    """Closed outline of the projectile (x, z) in the plane of obliquity at state ``y``."""
+    body = result.model.body
+    ax, rad = body.outline[:, 0], body.outline[:, 1]
+    top = np.stack([ax, rad, np.zeros_like(ax)], -1)
+    bottom = np.stack([ax[::-1], -rad[::-1], np.zeros_like(ax)], -1)
+    pts = np.concatenate([top, bottom, top[:1]])
+    rot = rotation(y[3:7])
+    # in the plane that contains the axis and the body e2 axis (the plane of obliquity
+    # for in-plane shots)
+    world = y[0:3] + pts @ rot.T
+    return world[:, 0], world[:, 2]
+
+
+def side_view(job, path):
+    import matplotlib.pyplot as plt
+
+    target = job["target"]
+    fig, ax = plt.subplots(figsize=(7, 6))
+    for k, (name, result) in enumerate(job["runs"].items()):
+        h = result.history
+        color = f"C{k}"
+        ax.plot(h["cg_x_m"], h["cg_z_m"], color=color, lw=1, label=f"{name}: centre of mass")
+        t_end = h["t_s"][-1]
+        for t in np.linspace(0.0, t_end, 9):
+            xs, zs = outline_points(result, result.state(t))
+            ax.plot(xs, zs, color=color, lw=0.8)
+    _interfaces(ax, target)
+    ax.axhline(0.0, color="k", lw=1)
+    ax.set_aspect("equal")
+    ax.invert_yaxis()
+    ax.set_xlabel("x (m, horizontal, plane of obliquity)")
+    ax.set_ylabel("z (m, depth)")
+    ax.set_title(_title(job) + "\nprojectile outline at 9 equal time intervals")
+    ax.legend(fontsize=8, loc="lower left")
+    return save_figure(fig, path, dpi=120, bbox_inches="tight")
+
+
+def _title(job):
+    s = job["settings"]
+    return (f"V0 = {s['speed_m_s']:g} m/s, obliquity {s['obliquity_deg']:g} deg, attack "
+            f"{s['attack_deg']:g} deg, resistance {s['resistance']}")
+
+
+def pitch_time(job, path):
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for k, (name, result) in enumerate(job["runs"].items()):
+        h = result.history
+        ax.plot(h["t_s"] * 1e3, h["pitch_deg"], color=f"C{k}", label=name)
+        for ph in result.phases[:-1]:
+            ax.axvline(ph["end_time_s"] * 1e3, color=f"C{k}", lw=0.6, ls=":")
+    ax.set_xlabel("t (ms)")
+    ax.set_ylabel("pitch (deg, axis from +z toward +x)")
+    ax.set_title(_title(job) + "\ndotted: phase ends (nose tip crosses an interface, ...)",
+                 fontsize=9)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return save_figure(fig, path, dpi=120, bbox_inches="tight")
+
+
+def overloads(job, path):
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(10, 7))
+    for k, (name, result) in enumerate(job["runs"].items()):
+        h = result.history
+        for row, key in enumerate(("axial_g", "lateral_g")):
+            axes[row, 0].plot(h["t_s"] * 1e3, h[key] / 1e3, color=f"C{k}", label=name)
+            axes[row, 1].plot(h["tip_z_m"], h[key] / 1e3, color=f"C{k}", label=name)
+    for row, key in enumerate(("axial", "lateral")):
+        axes[row, 0].set_ylabel(f"{key} overload (10^3 g)")
+        axes[row, 0].set_xlabel("t (ms)")
+        axes[row, 1].set_xlabel("nose-tip depth (m); dashed: interfaces")
+        _interfaces(axes[row, 1], job["target"], vertical=False)
+        for a in axes[row]:
+            a.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=8)
+    fig.suptitle(_title(job), fontsize=10)
+    return save_figure(fig, path, dpi=120, bbox_inches="tight")
+
+
+def view_3d(job, path):
+    """The path in the layered block, rendered off-screen with pyvista; None if pyvista
+    cannot render here (no OpenGL)."""
+    try:
+        import pyvista as pv
+    except ImportError:  # pragma: no cover
+        return None
+    target = job["target"]
+    result = job["runs"]["runway"]
+    h = result.history
+    x = np.concatenate([h["tip_x_m"], h["cg_x_m"]])
+    lo, hi = min(x.min(), -0.2) - 0.2, max(x.max(), 0.2) + 0.2
+    bottom = max(h["tip_z_m"].max() + 0.3, (target.interface_depths or (0.5,))[-1] + 0.3)
+    ylo = min(h["tip_y_m"].min(), 0.0) - 0.3
+    try:
+        plotter = pv.Plotter(off_screen=True, window_size=(900, 700))
+        tops = [0.0, *target.interface_depths, bottom]
+        colors = ["#bbbbbb", "#a0785a", "#6b8e23", "#777777"]
+        for i in range(len(tops) - 1):
+            box = pv.Box(bounds=(lo, hi, ylo, 0.0, -tops[i + 1], -tops[i]))
+            plotter.add_mesh(box, color=colors[i % len(colors)], opacity=0.25,
+                             show_edges=True)
+        points = np.stack([h["cg_x_m"], h["cg_y_m"], -h["cg_z_m"]], -1)
+        plotter.add_mesh(pv.lines_from_points(points), color="red", line_width=4)
+        for t in np.linspace(0.0, h["t_s"][-1], 6):
+            y = result.state(t)
+            rot = rotation(y[3:7])
+            axis = rot[:, 0]
+            body = result.model.body
+            centre = y[0:3] + axis * (body.cg - body.length / 2.0)
+            cyl = pv.Cylinder(center=(centre[0], centre[1], -centre[2]),
+                              direction=(axis[0], axis[1], -axis[2]), radius=body.radius,
+                              height=body.length)
+            plotter.add_mesh(cyl, color="navy")
+        plotter.add_axes()
+        plotter.camera_position = [(lo - 1.0, ylo - 2.5, 1.0), ((lo + hi) / 2, 0, -bottom / 2),
+                                   (0, 0, 1)]
+        tmp = str(path) + ".tmp.png"
+        plotter.screenshot(tmp)
+        plotter.close()
+        Path(tmp).replace(path)
+    except Exception:  # noqa: BLE001 (no OpenGL context: the 3-D view is optional)
+        return None
+    return str(path)
+
+
+# --- CLI --------------------------------------------------------------------------------------
+
+def trajectory_main(args, target, projectile):
+    """``cavex trajectory``: checks, runs, writes, returns the text to print."""
+    from cavex.errors import CavexInputError
+
+    if (args.resistance == "table") != (args.table is not None):
+        raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
+                              "neither)")
+    if (args.resistance == "law") != (args.law_A is not None and args.law_B is not None):
+        raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
+                              "'--resistance law' (all or none)")
+    folder = check_output_dir(args.out, "out")
+    shot = Shot(projectile.V0 if args.velocity is None else args.velocity, args.obliquity,
+                args.attack, args.attack_plane, args.spin)
+    projectile.body_length  # noqa: B018 (a projectile without a length refuses here)
+    job = trajectory_job(target, projectile, shot, args.resistance, boundary=args.boundary,
+                         free_surface=not args.no_free_surface, table=args.table,
+                         law_A=args.law_A, law_B=args.law_B,
+                         compare_homogeneous=args.compare_homogeneous)
+    written = write_outputs(job, folder)
+    runs = {k: summary(v) for k, v in job["runs"].items()}
+    if args.json:
+        main = runs["runway"]
+        return json.dumps({"end": main["end"], "phases": main["phases"],
+                           "settings": job["settings"], "runs": runs, "outputs": written},
+                          indent=2)
+    lines = [_title(job)]
+    for name, s in runs.items():
+        e = s["end"]
+        lines += ["", f"{name}:",
+                  f"{'phase':<10} {'ends at t (ms)':>14} {'tip z (m)':>10} {'pitch':>8} "
+                  f"{'speed':>8}  because"]
+        lines += [f"{p['label']:<10} {p['end_time_s'] * 1e3:14.4f} "
+                  f"{p['end_nose_tip_m'][2]:10.4f} {p['end_pitch_deg']:8.2f} "
+                  f"{p['end_speed_m_s']:8.2f}  {p['end_reason']}" for p in s["phases"]]
+        lines.append(f"end: {e['state']}, nose tip ({e['nose_tip_m'][0]:.4f}, "
+                     f"{e['nose_tip_m'][1]:.4f}, {e['nose_tip_m'][2]:.4f}) m, pitch "
+                     f"{e['pitch_deg']:.2f} deg; peaks: axial {s['max_axial_g']:.0f} g, "
+                     f"lateral {s['max_lateral_g']:.0f} g")
+    lines += ["", "wrote: " + ", ".join(written)]
+    return "\n".join(lines)
