@@ -287,7 +287,7 @@ def calibrate_main(shots_path, out_path, params=None, option="derived-quasi-stat
     Returns the summary text. Nothing is written when an input is refused or the fit fails.
     """
     from cavex.paths import check_output_file
-    from cavex.verification.runner import _show_progress, check_execution, write_text_atomic
+    from cavex.verification.runner import check_execution, show_progress, write_text_atomic
 
     shot_file = read_shots(shots_path)
     shots = shot_file.by_id(ids) if ids else shot_file.shots
@@ -295,7 +295,7 @@ def calibrate_main(shots_path, out_path, params=None, option="derived-quasi-stat
     out = check_output_file(out_path, "out")
     check_execution(workers, scheduler)
     require(out.suffix == ".toml", "out", "a path ending in .toml", str(out_path))
-    show = _show_progress(progress)
+    show = show_progress(progress)
     tables = TableCache(workers=workers, scheduler=scheduler, progress=show)
     began = time.monotonic()
     calibration = fit(shots, option, params, tables=tables, progress=show)

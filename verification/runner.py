@@ -88,7 +88,7 @@ def run_cases(function, cases, *, store=None, scheduler=None, workers=None, prog
     with _locked(store):
         results = _load_store(store, cases) if store is not None else {}
         todo = [case for case in cases if case["id"] not in results]
-        bar = _Progress(len(cases), len(results), _show_progress(progress))
+        bar = Progress(len(cases), len(results), show_progress(progress))
 
         def finished(chunk, chunk_results):
             for case, result in zip(chunk, chunk_results, strict=True):
@@ -478,13 +478,13 @@ def _connect(client_class, address):
 
 # --- progress -----------------------------------------------------------------------------------
 
-def _show_progress(progress):
+def show_progress(progress):
     if progress is None:
         return bool(getattr(sys.stderr, "isatty", lambda: False)())
     return bool(progress)
 
 
-class _Progress:
+class Progress:
     """Progress bar with ETA on stderr through tqdm (works in terminals, notebooks and logs);
     nothing when disabled."""
 

@@ -186,12 +186,12 @@ def predictions(shots, models, tables=None, progress=None):
 
     ``models`` maps a column name to ``(model, mapping)`` (``mapping`` None: default).
     """
-    from cavex.verification.runner import _Progress, _show_progress
+    from cavex.verification.runner import Progress, show_progress
 
     tables = tables or TableCache()
     depths = {name: [] for name in models}
     failures = {}
-    bar = _Progress(len(shots) * len(models), 0, _show_progress(progress), unit="prediction")
+    bar = Progress(len(shots) * len(models), 0, show_progress(progress), unit="prediction")
     for name, (model, mapping) in models.items():
         for shot in shots:
             try:

@@ -67,10 +67,10 @@ def run(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
         progress=None):
     """:func:`cavex.verification.validation.validate` plus the compressibility column and the
     shots file's description."""
-    from cavex.verification.runner import _show_progress
+    from cavex.verification.runner import show_progress
 
     tables = TableCache(tables_dir, workers=workers, scheduler=scheduler,
-                        progress=_show_progress(progress))
+                        progress=show_progress(progress))
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
                       progress=progress)
     dynamic = [c for c in calibrations if c.model == "derived dynamic"]
