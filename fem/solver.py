@@ -25,7 +25,6 @@ energy are evaluated on request.
 from types import SimpleNamespace
 
 import numpy as np
-from scipy.linalg import solve_banded
 
 from cavex.errors import CavexNumericalError
 from cavex.fem.newton import (
@@ -275,11 +274,8 @@ class RadialSolver:
         residual = -d["f"] - s.mass @ d["a"]
         r_wall = s.R_dofs[s.wall] + d["u"][s.wall]
         residual[s.wall] += load * 4.0 * np.pi * r_wall ** 2
-        rhs = np.where(s.free, residual, 0.0)
-        band = s.mass_band.copy()
-        band.reshape(-1)[s.fixed_entries] = 0.0
-        band.reshape(-1)[s.fixed_diagonal] = 1.0
-        d["a"] += solve_banded((s.degree, s.degree), band, rhs)
+        increment, _ = s.solve(s.mass_band.copy(), residual, np.zeros(s.n_cases, dtype=bool))
+        d["a"] += increment
         self.cases["load"][:] = load
 
     # ------------------------------------------------------------------ views of one case
