@@ -1,210 +1,37 @@
 r"""Oblique penetration with attitude: a rigid projectile in 3-D through the layered target.
 
-Differential-area force law (``docs/oblique.md``): every surface element of the rigid body
-(:mod:`cavex.analytic.projectile_body`) that is inside the target and moving into it
-(``V_n = v_P . n > 0``, ``n`` its outward normal, ``v_P`` its velocity) feels the normal
-stress ``sigma_n`` of a stress law at its own normal velocity, plus Coulomb friction
-``mu sigma_n`` against its tangential velocity. The summed forces and moments about the centre
-of mass drive the rigid body:
+The rigid body (:mod:`cavex.analytic.projectile_body`) moves under the differential-area force
+law of :mod:`cavex.analytic.surface_force`: every surface element inside the target and moving
+into it feels the normal stress of a stress law (:mod:`cavex.analytic.stress_laws`) at its own
+normal velocity, plus Coulomb friction; the summed force and moment drive the six degrees of
+freedom. This module sets up the shot, integrates the equations of motion with
+``scipy.integrate.solve_ivp`` between events (the nose tip crossing an interface, ricochet,
+perforation, the axis parallel to the surface, stop) and samples the history.
 
-.. math:: m \dot{\mathbf v} = \sum_i \mathbf f_i, \quad
-          I \dot{\boldsymbol\omega} + \boldsymbol\omega \times I \boldsymbol\omega
-          = \sum_i \mathbf p_i \times \mathbf f_i \ \text{(body frame)}, \quad
-          \dot q = \tfrac12 q \otimes (0, \boldsymbol\omega), \quad \dot{\mathbf x} = \mathbf v,
-
-``f_i = -A_i w_i sigma_n,i (n_i + mu t_i)`` (``t_i`` the unit tangential velocity, ``w_i`` the
-embedded fraction of the element). Target frame: free surface ``z = 0``, ``z`` positive into
-the target, ``x`` along the striking velocity's horizontal component.
-
-Stress laws (one object, ``stress(z, n, V_n)`` on arrays of wetted elements):
-
-- :class:`DerivedLaw`: the layered cavity-expansion wall stress of :mod:`cavex.analytic.cavity`
-  (either boundary convention) for a cavity of the shank radius ``a = r`` whose wall is the
-  element: the element's own layer at the wall, then the layers met *along its outward normal*,
-  each interface plane at radius ``a + d`` (``d`` the distance from the element to the plane
-  along ``n``), the free surface ``z = 0`` (for an upward normal) as the traction-free sphere
-  ``free_radius = a + z / (-n_z)``. A horizontal normal sees its own layer alone.
-- :class:`PaperLaw`, :class:`TableLaw`: laws that exist only as functions of the 1-D nose depth
-  ``L``; an element at depth ``z`` is mapped to ``L = z + l - r`` (the 1-D cavity wall ahead of
-  the cavity centre ``L - l`` is at ``z``) and its normal velocity: vertical distances, no
-  free-surface reduction.
-- :class:`PlainLaw`: ``sigma_n = A + B V_n^2`` everywhere in the target.
+Target frame: free surface ``z = 0``, ``z`` positive into the target, ``x`` along the striking
+velocity's horizontal component, ``y`` completing a right-handed frame. Pitch: angle (deg)
+between the axis (tail to nose) and ``+z``, positive toward ``+x``.
 """
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from cavex.analytic.cavity import material_table, solve_flat
-from cavex.analytic.paper_model import PaperModel
 from cavex.analytic.projectile_body import build_body
-from cavex.errors import CavexInputError, CavexNumericalError, require
+from cavex.analytic.stress_laws import OK, make_law, raise_for
+from cavex.analytic.surface_force import derivative, mirror_state, rotation_matrix, surface_loads
+from cavex.errors import CavexNumericalError, require
 
 G = 9.80665  # m/s^2, for overloads in g
-HORIZONTAL = 1e-12  # |n_z| below which a normal counts as horizontal
-FAR = 1e6  # m: interface radius standing for "never met"
 STOP_ENERGY = 1e-6  # stop when translational + transverse rotational energy < this x initial
 MAX_TIME = 1.0  # s
-ROUND_OFF = 1e-9  # normal velocities below this x the body's velocity scale count as zero
-METHOD, RTOL, ATOL = "RK45", 1e-6, 1e-9  # the final depth converged to 1e-4 (benchmark)
+METHOD, RTOL, ATOL = "RK45", 1e-6, 1e-9  # convergence: docs/oblique.md
 # contact regularisation: the stress rises linearly over 0 < V_n < RAMP (m/s); without it a
 # shank sliding along the tunnel wall chatters (V_n changes sign every step) and the adaptive
 # integrator stalls. Its effect is measured in docs/oblique.md.
 RAMP = 1.0
-RESISTANCES = ("derived", "paper", "table", "law")
-BOUNDARIES = ("quasi-static", "dynamic")
-
-
-# ------------------------------------------------------------------------------------------
-# Stress laws
-# ------------------------------------------------------------------------------------------
-
-class DerivedLaw:
-    """Layered cavity-expansion stress along each element's normal (see module docstring).
-
-    Elements are grouped by the sequence of layers their normal ray meets (own layer and
-    direction: at most ``2 n_layers`` groups); each group is one call of the compiled walk
-    :func:`cavex.analytic.cavity.solve_flat` on all its elements, which is what
-    :func:`cavex.analytic.cavity.cavity_stress` calls after checking its arguments (the test
-    ``test_oblique_law`` checks the two agree element by element).
-    """
-
-    name = "derived"
-
-    def __init__(self, target, radius, boundary="quasi-static", free_surface=True,
-                 bottom=None):
-        require(boundary in BOUNDARIES, "boundary", "'quasi-static' or 'dynamic'", boundary)
-        self.target, self.radius, self.boundary = target, float(radius), boundary
-        self.free_surface, self.bottom = free_surface, bottom
-        self.depths = np.asarray(target.interface_depths, dtype=float)
-        n = len(target.layers)
-        self._down = [(material_table(tuple(target.layers[k:])), self.depths[k:])
-                      for k in range(n)]
-        self._up = [(material_table(tuple(target.layers[k::-1])), self.depths[:k][::-1])
-                    for k in range(n)]
-        self._dynamic = boundary == "dynamic"
-        self._a = np.array([self.radius])
-
-    def rays(self, z, nz):
-        """``(group, layer index, interface radii, free radius)`` of every element: the
-        spherical problem each one is the wall of (also what the tests hand to
-        ``cavity_stress``)."""
-        k = np.searchsorted(self.depths, z, side="right")
-        a = self.radius
-        out = []
-        for direction in (1, -1, 0):
-            if direction == 1:
-                sel = nz > HORIZONTAL
-            elif direction == -1:
-                sel = nz < -HORIZONTAL
-            else:
-                sel = np.abs(nz) <= HORIZONTAL
-            for layer in np.unique(k[sel]):
-                idx = np.flatnonzero(sel & (k == layer))
-                zi, ni = z[idx], nz[idx]
-                if direction == 1:
-                    planes = self._down[layer][1]
-                    d = (planes[None, :] - zi[:, None]) / ni[:, None]
-                    c = (np.full(idx.size, np.inf) if self.bottom is None
-                         else a + (self.bottom - zi) / ni)
-                    table = self._down[layer][0]
-                elif direction == -1:
-                    planes = self._up[layer][1]
-                    d = (zi[:, None] - planes[None, :]) / (-ni[:, None])
-                    c = (a + zi / (-ni) if self.free_surface
-                         else np.full(idx.size, np.inf))
-                    table = self._up[layer][0]
-                else:
-                    d = np.empty((idx.size, 0))
-                    c = np.full(idx.size, np.inf)
-                    table = material_table((self.target.layers[layer],))
-                radii = a + np.minimum(np.maximum(d, 1e-12), FAR)
-                layers = (self.target.layers[layer:] if direction == 1 else
-                          self.target.layers[layer::-1] if direction == -1 else
-                          (self.target.layers[layer],))
-                out.append((idx, layers, table, radii, c))
-        return out
-
-    def stress(self, z, normals, vn):
-        sigma = np.empty(z.size)
-        for idx, _, table, radii, c in self.rays(z, normals[:, 2]):
-            values, _, _ = solve_flat(table, np.ascontiguousarray(radii), vn[idx], self._a,
-                                      np.ascontiguousarray(c), self._dynamic)
-            sigma[idx] = values[:, 0]
-        return sigma
-
-
-class PaperLaw:
-    """The paper's printed ``sigma_r = tau A + B rho V^2`` at the mapped nose depth
-    ``L = z + l - r``, tabulated once on a depth grid (``spacing``, linear between nodes: the
-    case switches, where the printed coefficients jump, are smeared over one cell)."""
-
-    name = "paper"
-
-    def __init__(self, target, projectile, epsilon="quasi-static", spacing=2e-4, extent=None):
-        model = PaperModel(target, projectile, epsilon)
-        self.offset = projectile.l - projectile.r
-        deepest = (target.interface_depths[-1] if target.interface_depths else 0.0) + 0.5
-        self.grid = np.arange(0.0, (extent or deepest) + spacing, spacing)
-        terms = [model.terms(float(L)) for L in self.grid]
-        self.s0 = np.array([t[2] * t[0] for t in terms])
-        self.s2 = np.array([t[1] * t[3] for t in terms])
-
-    def stress(self, z, normals, vn):
-        L = np.maximum(z + self.offset, 0.0)
-        return np.interp(L, self.grid, self.s0) + np.interp(L, self.grid, self.s2) * vn ** 2
-
-
-class TableLaw:
-    """FE-tabulated ``sigma_r(V, L)`` (:class:`~cavex.verification.tabulated_resistance.
-    TabulatedResistance`) at the mapped depth ``L = z + l - r`` and ``V = V_n``: resampled once
-    on a fine ``(L, V^2)`` grid through the table's own interpolant, then bilinear. Depths above
-    the table's shallowest row take that row; velocities beyond the table's are refused."""
-
-    name = "table"
-
-    def __init__(self, resistance, depth_points=600, velocity_points=121, extent=None):
-        self.resistance = resistance
-        p = resistance.projectile
-        self.offset = p.l - p.r
-        lo = float(resistance.depths[0])
-        hi = max(float(resistance.depths[-1]), lo + 1e-3) if extent is None else extent
-        self.grid = np.linspace(lo, hi, depth_points)
-        self.vmax = float(resistance.velocities[-1])
-        self.v2 = np.linspace(0.0, self.vmax ** 2, velocity_points)
-        self.values = np.array([resistance.wall_stress(L, np.sqrt(self.v2)) for L in self.grid])
-
-    def stress(self, z, normals, vn):
-        if vn.size and vn.max() > self.vmax:
-            raise CavexInputError(f"normal velocity {vn.max():.6g} m/s exceeds the table's "
-                                  f"largest velocity {self.vmax:g} m/s")
-        L = np.clip(z + self.offset, self.grid[0], self.grid[-1])
-        fi = (L - self.grid[0]) / (self.grid[1] - self.grid[0])
-        i = np.minimum(fi.astype(int), self.grid.size - 2)
-        u = fi - i
-        fj = vn ** 2 / self.v2[1]
-        j = np.minimum(fj.astype(int), self.v2.size - 2)
-        w = fj - j
-        V = self.values
-        return ((1 - u) * ((1 - w) * V[i, j] + w * V[i, j + 1])
-                + u * ((1 - w) * V[i + 1, j] + w * V[i + 1, j + 1]))
-
-
-class PlainLaw:
-    """``sigma_n = A + B V_n^2`` (A in Pa, B in kg/m^3) everywhere in the target."""
-
-    name = "law"
-
-    def __init__(self, A, B):
-        for name, value in (("law_A", A), ("law_B", B)):
-            require(isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0,
-                    name, "a finite number >= 0", value)
-        self.A, self.B = float(A), float(B)
-
-    def stress(self, z, normals, vn):
-        return self.A + self.B * vn ** 2
 
 
 # ------------------------------------------------------------------------------------------
@@ -272,15 +99,6 @@ def quaternion_from_matrix(m):
     return q / np.linalg.norm(q)
 
 
-def rotation(q):
-    """Rotation matrix (body to target) of a quaternion ``(w, x, y, z)`` (normalised here)."""
-    w, x, y, z = q / math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-
-
 def pitch_yaw(axis):
     """Pitch (deg): angle of the axis from +z in the x-z plane, positive toward +x; yaw (deg):
     angle of the axis out of the x-z plane, positive toward +y."""
@@ -329,8 +147,10 @@ class ObliqueModel:
         self.mu = float(projectile.mu)
         self.interfaces = list(target.interface_depths)
         b = self.body
-        self._p, self._n, self._area, self._h = b.points, b.normals, b.areas, b.sizes
+        self._p = b.points
         self._inertia = b.inertia
+        self._surface = (b.points, b.normals, b.areas, b.sizes, b.partners, b.length, self.mu,
+                         self.ramp, np.inf if bottom is None else float(bottom), *law.data)
         self._tip = b.tip
         self.evaluations = 0
 
@@ -338,57 +158,30 @@ class ObliqueModel:
     def loads(self, y):
         """``(F, M_body, power, rotation)``: total surface force (target frame), moment about
         the centre of mass (body frame), power of the surface forces, rotation matrix."""
-        self.evaluations += 1
-        rot = rotation(y[3:7])
-        p = self._p @ rot.T
-        n = self._n @ rot.T
-        omega_t = rot @ y[10:13]
-        vel = y[7:10] + _cross(omega_t, p)
-        vn = np.einsum("ij,ij->i", vel, n)
-        # round-off guard: a normal velocity below 1e-9 of the body's velocity scale is zero
-        scale = math.sqrt(float(y[7:10] @ y[7:10])) + self.body.length * math.sqrt(
-            float(omega_t @ omega_t))
-        z = y[2] + p[:, 2]
-        frac = np.clip(0.5 + z / self._h, 0.0, 1.0)
-        if self.bottom is not None:
-            frac = np.minimum(frac, np.clip(0.5 + (self.bottom - z) / self._h, 0.0, 1.0))
-        wet = np.flatnonzero((frac > 0.0) & (vn > ROUND_OFF * scale))
-        if wet.size == 0:
-            return np.zeros(3), np.zeros(3), 0.0, rot
-        zi = np.maximum(z[wet], 1e-12)
-        sigma = self.law.stress(zi, n[wet], vn[wet])
-        load = sigma * self._area[wet] * frac[wet]
-        if self.ramp > 0.0:
-            load *= np.minimum(vn[wet] / self.ramp, 1.0)
-        f = -load[:, None] * n[wet]
-        if self.mu > 0.0:
-            vt = vel[wet] - vn[wet, None] * n[wet]
-            speed = np.linalg.norm(vt, axis=1)
-            ok = speed > 1e-12
-            f[ok] -= (self.mu * load[ok] / speed[ok])[:, None] * vt[ok]
-        force = f.sum(axis=0)
-        moment = rot.T @ _cross(p[wet], f).sum(axis=0)
-        power = float(np.einsum("ij,ij->", f, vel[wet]))
-        return force, moment, power, rot
+        force, moment, power, status, vn = surface_loads(y, *self._surface)
+        if status != OK:
+            raise_for(status, vn)
+        return force, moment, power, rotation_matrix(y[3:7])
 
     def rhs(self, t, y):
-        force, moment, power, rot = self.loads(y)
-        w, I = y[10:13], self._inertia  # noqa: E741 (the inertia tensor)
-        q = y[3:7]
-        dq = 0.5 * np.array([
-            -q[1] * w[0] - q[2] * w[1] - q[3] * w[2],
-            q[0] * w[0] + q[2] * w[2] - q[3] * w[1],
-            q[0] * w[1] - q[1] * w[2] + q[3] * w[0],
-            q[0] * w[2] + q[1] * w[1] - q[2] * w[0]])
-        dw = (moment - _cross(w, I * w)) / I
-        return np.concatenate([y[7:10], dq, force / self.body.mass, dw, [power]])
+        self.evaluations += 1
+        dy, status, vn = derivative(y, self.body.mass, self._inertia, *self._surface)
+        if status != OK:
+            raise_for(status, vn)
+        return dy
 
     # -- kinematics -----------------------------------------------------------------------
     def initial_state(self, shot):
+        """State at first contact. A negative obliquity is the mirror image (``x -> -x``) of
+        the shot at ``|obliquity|`` and opposite spin, built by :func:`mirror_state` so that
+        the two trajectories are mirrors to the last bit."""
+        if shot.obliquity < 0.0:
+            return mirror_state(self.initial_state(
+                replace(shot, obliquity=-shot.obliquity, spin=-shot.spin)))
         d, axis, e2, e3 = shot.initial_axes()
         rot = np.column_stack([axis, e2, e3])
         q = quaternion_from_matrix(rot)
-        rot = rotation(q)
+        rot = rotation_matrix(q)
         tip_offset = rot @ self._tip
         x = -tip_offset  # nose tip above the origin
         if shot.tip_depth is None:  # the deepest point of the body on the surface
@@ -408,14 +201,14 @@ class ObliqueModel:
         return 0.5 * self.body.mass * float(y[7:10] @ y[7:10]) + rotational
 
     def tip(self, y):
-        return y[0:3] + rotation(y[3:7]) @ self._tip
+        return y[0:3] + rotation_matrix(y[3:7]) @ self._tip
 
     def axis(self, y):
-        return rotation(y[3:7])[:, 0]
+        return rotation_matrix(y[3:7])[:, 0]
 
     def extreme_depths(self, y):
         """Deepest and shallowest depth of the body surface (elements and tip)."""
-        z = y[2] + (self._p @ rotation(y[3:7]).T)[:, 2]
+        z = y[2] + (self._p @ rotation_matrix(y[3:7]).T)[:, 2]
         tz = self.tip(y)[2]
         return max(z.max(), tz), min(z.min(), tz)
 
@@ -553,32 +346,6 @@ class ObliqueModel:
             history[f"moment_{c}_N_m"] = moments[:, j]
         history["work_J"] = Y[13]
         return history
-
-
-def _cross(a, b):
-    """``a x b`` for ``(3,)`` or ``(n, 3)`` arrays (``np.cross`` costs ~20 us per call)."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
-
-
-def make_law(target, projectile, resistance="derived", *, boundary="quasi-static",
-             free_surface=True, table=None, law_A=None, law_B=None, epsilon="quasi-static",
-             bottom=None):
-    """The stress law for ``resistance`` (see the module docstring)."""
-    require(resistance in RESISTANCES, "resistance", "one of " + ", ".join(RESISTANCES),
-            resistance)
-    if resistance == "derived":
-        return DerivedLaw(target, projectile.r, boundary, free_surface, bottom)
-    if resistance == "paper":
-        return PaperLaw(target, projectile, epsilon)
-    if resistance == "table":
-        require(table is not None, "table", "given for --resistance table", None)
-        from cavex.verification.tabulated_resistance import TabulatedResistance
-        return TableLaw(TabulatedResistance(table, target, projectile))
-    require(law_A is not None and law_B is not None, "law_A", "given with law_B for "
-            "--resistance law", law_A)
-    return PlainLaw(law_A, law_B)
 
 
 def fly(target, projectile, shot=None, resistance="derived", *, body=None, bottom=None,

@@ -16,9 +16,11 @@ it meets target material only in a tail slap or a ricochet, outside this model).
 
 Surface quadrature: Gauss-Legendre in ``phi`` (the rule of :func:`cavex.analytic.nose.nose_rule`,
 so that an axisymmetric stress field gives the 1-D nose force to round-off), the midpoint rule
-in ``theta`` and in the shank's axial coordinate. Each element carries its centroid, normal,
-area and a size ``h = sqrt(area)`` (the depth band over which it is counted as partly
-embedded, see :mod:`cavex.analytic.oblique`).
+in ``theta`` and in the shank's axial coordinate. The azimuths are placed in mirror pairs
+``theta_k = (k + 1/2) 2 pi / n`` and ``-theta_k`` (computed as the negative, so that the pair's
+coordinates are exact mirrors); ``partners`` maps each element to its mirror image. Each
+element carries its centroid, normal, area and a size ``h = sqrt(area)`` (the depth band
+over which it is counted as partly embedded, see :mod:`cavex.analytic.surface_force`).
 
 Mass properties: ``m`` is given; ``cg`` (from the tip) and the transverse inertia ``I_t``
 about the centre of mass are taken from the projectile when given, else computed for a solid
@@ -55,6 +57,9 @@ class Body:
     areas, sizes : ndarray, shape (n,)
     nose : ndarray of bool, shape (n,)
         True for the ogive's elements.
+    partners : ndarray of int, shape (n,)
+        Index of each element's mirror image ``theta -> -theta`` (itself on the mirror
+        plane).
     outline : ndarray, shape (k, 2)
         Half-profile ``(axial coordinate from the cg, radius)`` from tip to tail, for drawing.
     """
@@ -71,6 +76,7 @@ class Body:
     areas: np.ndarray
     sizes: np.ndarray
     nose: np.ndarray
+    partners: np.ndarray
     outline: np.ndarray
 
     @property
@@ -136,7 +142,11 @@ def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rin
     nodes, weights = np.polynomial.legendre.leggauss(nose_points)
     phi = phi0 + (0.5 * math.pi - phi0) * 0.5 * (nodes + 1.0)
     dphi = weights * 0.5 * (0.5 * math.pi - phi0)
-    theta = (np.arange(azimuths) + 0.5) * 2.0 * math.pi / azimuths
+    k = np.arange(azimuths)
+    half = (k + 0.5 < 0.5 * azimuths)
+    theta = np.where(half, (k + 0.5) * 2.0 * math.pi / azimuths,
+                     -((azimuths - k - 0.5) * 2.0 * math.pi / azimuths))
+    mirror = azimuths - 1 - k  # theta_mirror = -theta
     dtheta = 2.0 * math.pi / azimuths
     P, T = np.meshgrid(phi, theta, indexing="ij")
     DP = np.broadcast_to(dphi[:, None], P.shape)
@@ -165,4 +175,7 @@ def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rin
         areas=np.concatenate([nose_area, shank_area]),
         sizes=np.concatenate([nose_size, shank_size]),
         nose=np.concatenate([np.ones(nose_area.size, bool), np.zeros(shank_area.size, bool)]),
+        partners=np.concatenate([(ring * azimuths + mirror[None, :]).ravel()
+                                 for ring in (np.arange(nose_points)[:, None],
+                                              nose_points + np.arange(shank_rings)[:, None])]),
         outline=outline)

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.oblique import Shot, fly, rotation
+from cavex.analytic.oblique import Shot, fly
+from cavex.analytic.surface_force import rotation_matrix as rotation
 from cavex.paths import check_output_dir
 from cavex.verification.number_format import format_number
 from cavex.verification.runner import save_figure, write_text_atomic
