@@ -23,15 +23,16 @@ from cavex.analytic.projectile_body import build_body
 from cavex.analytic.stress_laws import OK, make_law, raise_for
 from cavex.analytic.surface_force import derivative, mirror_state, rotation_matrix, surface_loads
 from cavex.errors import CavexNumericalError, require
+from cavex.materials import MAX_VELOCITY
 
 G = 9.80665  # m/s^2, for overloads in g
 STOP_ENERGY = 1e-6  # stop when translational + transverse rotational energy < this x initial
 MAX_TIME = 1.0  # s
 METHOD, RTOL, ATOL = "RK45", 1e-6, 1e-9  # convergence: docs/oblique.md
-# contact regularisation: the stress rises linearly over 0 < V_n < RAMP (m/s); without it a
-# shank sliding along the tunnel wall chatters (V_n changes sign every step) and the adaptive
-# integrator stalls. Its effect is measured in docs/oblique.md.
-RAMP = 1.0
+# contact regularisation: the stress rises linearly over 0 < V_n < CONTACT_RAMP (m/s); without
+# it a shank sliding along the tunnel wall chatters (V_n changes sign every step) and the
+# adaptive integrator stalls. Its effect is measured in docs/oblique.md.
+CONTACT_RAMP = 0.1
 
 
 # ------------------------------------------------------------------------------------------
@@ -55,7 +56,8 @@ class Shot:
     tip_depth: float | None = None
 
     def __post_init__(self):
-        require(math.isfinite(self.speed) and self.speed > 0, "speed", "> 0 m/s", self.speed)
+        require(math.isfinite(self.speed) and 0.0 < self.speed <= MAX_VELOCITY, "velocity",
+                f"in (0, {MAX_VELOCITY:g}] m/s", self.speed)
         require(math.isfinite(self.obliquity) and abs(self.obliquity) < 90.0, "obliquity",
                 "in (-90, 90) degrees", self.obliquity)
         require(math.isfinite(self.attack) and 0.0 <= self.attack < 90.0, "attack",
@@ -137,20 +139,23 @@ class ObliqueModel:
     """
 
     def __init__(self, target, projectile, law, *, body=None, bottom=None, rtol=RTOL,
-                 atol=ATOL, method=METHOD, ramp=RAMP):
+                 atol=ATOL, method=METHOD, contact_ramp=None):
         self.target, self.projectile, self.law = target, projectile, law
         self.body = body or build_body(projectile)
         self.bottom = bottom
         self.rtol, self.atol, self.method = rtol, atol, method
-        require(math.isfinite(ramp) and ramp >= 0.0, "ramp", ">= 0 m/s", ramp)
-        self.ramp = float(ramp)
+        contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
+        require(isinstance(contact_ramp, (int, float)) and math.isfinite(contact_ramp)
+                and 0.0 <= contact_ramp <= 100.0, "contact_ramp", "in [0, 100] m/s",
+                contact_ramp)
+        self.contact_ramp = float(contact_ramp)
         self.mu = float(projectile.mu)
         self.interfaces = list(target.interface_depths)
         b = self.body
         self._p = b.points
         self._inertia = b.inertia
         self._surface = (b.points, b.normals, b.areas, b.sizes, b.partners, b.length, self.mu,
-                         self.ramp, np.inf if bottom is None else float(bottom), *law.data)
+                         self.contact_ramp, np.inf if bottom is None else float(bottom), *law.data)
         self._tip = b.tip
         self.evaluations = 0
 
@@ -269,7 +274,8 @@ class ObliqueModel:
                                           f"s: {sol.message}")
             sols.append(sol)
             if sol.status == 0:
-                phases.append(self._phase(label, sol.t[-1], sol.y[:, -1], "time limit"))
+                t0, y, reason = sol.t[-1], sol.y[:, -1].copy(), "time limit"
+                phases.append(self._phase(label, t0, y, reason))
                 break
             which = next(i for i, te in enumerate(sol.t_events) if te.size)
             t0, y = sol.t_events[which][0], sol.y_events[which][0].copy()
@@ -349,10 +355,10 @@ class ObliqueModel:
 
 
 def fly(target, projectile, shot=None, resistance="derived", *, body=None, bottom=None,
-        rtol=RTOL, atol=ATOL, method=METHOD, ramp=RAMP, **law_options):
+        rtol=RTOL, atol=ATOL, method=METHOD, contact_ramp=None, **law_options):
     """One trajectory: :class:`Result` of ``shot`` (default: normal incidence at ``V0``)."""
     shot = shot or Shot(projectile.V0)
     law = make_law(target, projectile, resistance, bottom=bottom, **law_options)
     model = ObliqueModel(target, projectile, law, body=body, bottom=bottom, rtol=rtol,
-                         atol=atol, method=method, ramp=ramp)
+                         atol=atol, method=method, contact_ramp=contact_ramp)
     return model.run(shot)

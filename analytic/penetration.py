@@ -82,6 +82,9 @@ def crater_stage(projectile, force, depth, samples=50):
     """Crater trajectory samples ``(t, L, V, a)`` and the exit ``(t_c, V_c)``."""
     vc, stiffness = crater_exit(projectile, force, depth)
     omega = math.sqrt(stiffness / projectile.m)
+    if not omega > 0.0:  # V_c = V0 to round-off: a mass that the target cannot slow
+        raise CavexNumericalError(f"the crater does not slow the projectile (m = "
+                                  f"{projectile.m:g} kg, V0 = {projectile.V0:g} m/s)")
     tc = math.acos(vc / projectile.V0) / omega
     t = np.linspace(0.0, tc, samples)
     depths = projectile.V0 / omega * np.sin(omega * t)

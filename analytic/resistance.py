@@ -24,13 +24,27 @@ from cavex.analytic.paper_model import PaperModel
 from cavex.errors import CavexNumericalError, require, require_choice
 
 MODELS = ("derived", "paper")
+#: The derived model's default boundary convention: the closed form closest to the FE in every
+#: layer of the default target (results/verification/report.md; README "Commands").
+DEFAULT_BOUNDARY = "dynamic"
+PAPER_BOUNDARY = "quasi-static"  # the paper's printed model has its own convention
 RECENT = 32  # (depth, velocity) answers kept
 
 
-def check_model(model, boundary):
-    """The model is known, and the paper model is only offered with its quasi-static boundary."""
+def model_boundary(model, boundary=None):
+    """The boundary convention ``model`` runs with: ``boundary``, or when None the model's
+    default (:data:`DEFAULT_BOUNDARY` for "derived", the paper's quasi-static for "paper")."""
+    if boundary is None:
+        return PAPER_BOUNDARY if model == "paper" else DEFAULT_BOUNDARY
+    return boundary
+
+
+def check_model(model, boundary=None):
+    """The model is known, and the paper model is only offered with its quasi-static boundary
+    (None: the model's default, :func:`model_boundary`)."""
     require_choice(model, MODELS, "model")
-    require(model != "paper" or boundary == "quasi-static", "boundary",
+    boundary = model_boundary(model, boundary)
+    require(model != "paper" or boundary == PAPER_BOUNDARY, "boundary",
             "'quasi-static' for the paper model", boundary)
 
 
@@ -41,8 +55,10 @@ class ClosedFormResistance:
     ----------
     target, projectile : Target, Projectile
     model : {"derived", "paper"}
-    boundary : {"quasi-static", "dynamic"}
-        Yield-at-boundary convention of the derived model (the paper's is quasi-static).
+    boundary : {"dynamic", "quasi-static"}, optional
+        Yield-at-boundary convention of the derived model; default (None) "dynamic" for the
+        derived model and the paper's own quasi-static for the paper model (which accepts
+        no other).
     switch : {"cavity", "nose-tip"}, optional
         When a layer stops surrounding the cavity (see ``geometry``); default "cavity" for
         "derived" and "nose-tip" for "paper", as the paper does.
@@ -50,9 +66,10 @@ class ClosedFormResistance:
         The paper model's reading of epsilon (see ``paper_model``).
     """
 
-    def __init__(self, target, projectile, model="derived", boundary="quasi-static",
+    def __init__(self, target, projectile, model="derived", boundary=None,
                  switch=None, epsilon="quasi-static"):
         check_model(model, boundary)
+        boundary = model_boundary(model, boundary)
         self.target, self.projectile = target, projectile
         self.model, self.boundary, self.epsilon = model, boundary, epsilon
         self.switch = switch or ("cavity" if model == "derived" else "nose-tip")

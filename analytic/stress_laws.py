@@ -139,8 +139,9 @@ def raise_for(status, vn):
     if status == WALK_FAILED:
         raise CavexNumericalError("dynamic elastic-plastic boundary did not converge on a "
                                   f"surface element (V_n = {vn:.6g} m/s)")
-    raise CavexInputError(f"normal velocity {vn:.6g} m/s of a surface element exceeds the "
-                          "table's largest velocity")
+    raise CavexInputError(f"parameter 'table' must reach the normal velocity {vn:.6g} m/s of "
+                          "a surface element (its velocities stop below it: build it to a "
+                          "higher velocity, `cavex table --velocities`)")
 
 
 class _Law:
@@ -219,15 +220,22 @@ class TableLaw(_Law):
                      _EMPTY3, _NO_COUNTS, _EMPTY1)
 
 
+MAX_LAW_A = 1e12  # Pa
+MAX_LAW_B = 1e6  # kg/m^3
+
+
 class PlainLaw(_Law):
     """``sigma_n = A + B V_n^2`` (A in Pa, B in kg/m^3) everywhere in the target."""
 
     name = "law"
 
     def __init__(self, A, B):
-        for name, value in (("law_A", A), ("law_B", B)):
-            require(isinstance(value, (int, float)) and math.isfinite(value) and value >= 0.0,
-                    name, "a finite number >= 0", value)
+        # the upper bounds are far beyond any target (1 TPa; 40 times the densest solid) and
+        # keep the forces finite: 1e40 Pa stalls the integrator, 1e100 Pa overflows it
+        for name, value, top, unit in (("law_A", A, MAX_LAW_A, "Pa"),
+                                       ("law_B", B, MAX_LAW_B, "kg/m^3")):
+            require(isinstance(value, (int, float)) and math.isfinite(value)
+                    and 0.0 <= value <= top, name, f"in [0, {top:g}] {unit}", value)
         self.A, self.B = float(A), float(B)
         self.data = (DEPTH_QUADRATIC, np.array([0.0, 0.0, 1.0]), np.array([[self.A, self.B]]),
                      _EMPTY3, _NO_COUNTS, _EMPTY1)

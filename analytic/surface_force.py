@@ -13,7 +13,7 @@ surface forces. For surface element ``i`` (body-frame centroid ``p_i``, outward 
 embedded fraction ``w = clip(1/2 + z/h_i, 0, 1)`` (and ``clip(1/2 + (z_b - z)/h_i, 0, 1)`` at
 a finite bottom ``z_b``). A wetted element (``w > 0`` and ``V_n > 10^-9 (|v| + L |omega|)``,
 the round-off guard) carries the load ``P = A_i w sigma_n(z, n_3, V_n) min(V_n / V_r, 1)``
-(contact regularisation over ``0 < V_n < V_r``; ``V_r = 0``: none) and the force
+(contact regularisation over ``0 < V_n < V_r``, ``V_r`` = ``contact_ramp``; 0: none), force
 
 .. math:: \mathbf f = -P (\mathbf n + \mu \mathbf t), \quad
           \mathbf t = \mathbf u_t / |\mathbf u_t|, \quad
@@ -88,7 +88,7 @@ def mirror_state(y):
 
 
 @njit(cache=True, error_model="numpy")
-def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, ramp, bottom,
+def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, contact_ramp, bottom,
                   kind, scalars, values, tables, counts, depths, radii, zones, out):
     """Force, moment about the centre of mass (target frame) and power of element ``i``
     into ``out[0:7]``; returns ``(status, V_n)``."""
@@ -116,8 +116,8 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, ra
     if status != OK:
         return status, vn
     load = sigma * areas[i] * frac
-    if ramp > 0.0:
-        load *= min(vn / ramp, 1.0)
+    if contact_ramp > 0.0:
+        load *= min(vn / contact_ramp, 1.0)
     f0, f1, f2 = -load * n0, -load * n1, -load * n2
     if mu > 0.0:
         t0, t1, t2 = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
@@ -134,7 +134,7 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, ra
 
 
 @njit(cache=True, error_model="numpy")
-def surface_loads(y, points, normals, areas, sizes, partners, length, mu, ramp, bottom,
+def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
                   kind, scalars, values, tables, counts, depths):
     """``(F (3, target frame), M (3, body frame), power, status, V_n of a failed element)``
     of the surface forces in state ``y`` (module docstring; the law arrays are
@@ -157,11 +157,11 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, ramp, 
         if j < i:
             continue
         status, vn = _element_load(i, y, rot, omega, scale, points, normals, areas, sizes,
-                                   mu, ramp, bottom, kind, scalars, values, tables, counts,
+                                   mu, contact_ramp, bottom, kind, scalars, values, tables, counts,
                                    depths, radii, zones, one)
         if status == OK and j != i:
             status, vn = _element_load(j, y, rot, omega, scale, points, normals, areas,
-                                       sizes, mu, ramp, bottom, kind, scalars, values,
+                                       sizes, mu, contact_ramp, bottom, kind, scalars, values,
                                        tables, counts, depths, radii, zones, other)
             one += other
         if status != OK:
@@ -171,11 +171,11 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, ramp, 
 
 
 @njit(cache=True, error_model="numpy")
-def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length, mu, ramp,
+def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length, mu, contact_ramp,
                bottom, kind, scalars, values, tables, counts, depths):
     """``(dy/dt, status, V_n of a failed element)`` (module docstring)."""
     force, moment, power, status, vn = surface_loads(
-        y, points, normals, areas, sizes, partners, length, mu, ramp, bottom,
+        y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
         kind, scalars, values, tables, counts, depths)
     dy = np.empty(14)
     q0, q1, q2, q3 = y[3], y[4], y[5], y[6]

@@ -27,8 +27,8 @@ def main(n_depths=25, velocity=500.0):
         for i, (epd, growth) in enumerate(LEVELS):
             out = compare_at_depth(target, projectile, L, velocity, elements_per_decade=epd,
                                    growth_per_step=growth, error_estimate=False)
-            S[i, j] = out["fe_sigma_r"]
-        analytic[j] = out["analytic_sigma_r"]["dynamic"]
+            S[i, j] = out["fe_sigma_r_Pa"]
+        analytic[j] = out["analytic_sigma_r_Pa"]["dynamic"]
     change = np.abs(np.diff(S, axis=0)) / S[1:]
     second = np.abs(S[-1, 2:] - 2 * S[-1, 1:-1] + S[-1, :-2]) / S[-1, 1:-1]
     print(f"{'L (m)':>7} {'S coarse':>10} {'S mid':>10} {'S fine':>10} {'d1 %':>7} {'d2 %':>7} "

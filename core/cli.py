@@ -3,6 +3,7 @@
 import argparse
 import json
 import os
+import re
 import sys
 
 from cavex import __version__
@@ -30,6 +31,10 @@ class _Parser(argparse.ArgumentParser):
     def __init__(self, *args, **kwargs):
         kwargs.setdefault("formatter_class", _Help)
         super().__init__(*args, **kwargs)
+        # a value such as -1e3 or -inf, not an unknown option (argparse < 3.13 takes only
+        # -123 and -1.5 for numbers: `--spin -1e3` was "expected one argument")
+        self._negative_number_matcher = re.compile(
+            r"^-(\d+\.?\d*|\.\d+)(e[-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
 
     def error(self, message):
         raise CavexInputError(message)
@@ -72,15 +77,18 @@ def build_parser():
     table.add_argument("--depths", nargs="+", type=float, help="nose depths, m")
     table.add_argument("-o", "--out", default="results/table.nc", help="NetCDF file to write")
     table.add_argument("--nu", type=float, help="Poisson's ratio for every layer")
+    table.add_argument("--json", action="store_true", help="print JSON")
     _parallel(table)
     verify = commands.add_parser("verify", help="analytic against FE report for the target")
     verify.add_argument("--config", help="target TOML file (default: the paper's Table 1)")
     verify.add_argument("--quick", action="store_true", help="small grid (under a minute)")
     verify.add_argument("--out", help="report folder (default results/verification)")
+    verify.add_argument("--json", action="store_true", help="print JSON")
     _parallel(verify)
     batch = commands.add_parser("batch", help="run a sweep of FE cases (TOML) into one Dataset")
     batch.add_argument("sweep", help="sweep TOML file; its [target] section names the target")
     batch.add_argument("--out", help="output folder (default results/batch/<sweep name>)")
+    batch.add_argument("--json", action="store_true", help="print JSON")
     _parallel(batch)
     batch.add_argument("--allow-large", action="store_true",
                        help="run a sweep of more than 20000 FE cases")
@@ -90,10 +98,11 @@ def build_parser():
     calibrate.add_argument("--out", required=True, help="calibration TOML file to write")
     calibrate.add_argument("--params", nargs="+", help="free parameters: lam, strength_factor, "
                            "modulus_factor (default: lam strength_factor)")
-    calibrate.add_argument("--model", default="derived-quasi-static",
-                           help="derived-quasi-static (default), derived-dynamic, paper or "
+    calibrate.add_argument("--model", default="derived-dynamic",
+                           help="derived-dynamic (default), derived-quasi-static, paper or "
                                 "fe-table")
     calibrate.add_argument("--ids", nargs="+", help="fit only these shots (default: all)")
+    calibrate.add_argument("--json", action="store_true", help="print JSON")
     _parallel(calibrate)
     validate = commands.add_parser("validate", help="predicted against measured penetration "
                                    "depths (docs/validation.md)")
@@ -117,8 +126,11 @@ def build_parser():
     trajectory.add_argument("--spin", type=float, default=0.0, help="spin about the axis (rad/s)")
     trajectory.add_argument("--resistance", choices=("derived", "paper", "table", "law"),
                             default="derived", help="surface stress law")
-    trajectory.add_argument("--boundary", choices=("quasi-static", "dynamic"),
-                            default="quasi-static", help="convention of the derived law")
+    trajectory.add_argument("--boundary", choices=("dynamic", "quasi-static"),
+                            default="dynamic", help="convention of the derived law")
+    trajectory.add_argument("--contact-ramp", dest="contact_ramp", type=float, default=None,
+                            help="contact regularisation: the stress rises linearly over "
+                            "0 < V_n < this (m/s; default 0.1; docs/oblique.md)")
     trajectory.add_argument("--table", help="NetCDF table from `cavex table` (--resistance table)")
     trajectory.add_argument("--law-A", dest="law_A", type=float, help="A of sigma_n = A + B "
                             "V_n^2 (Pa)")
@@ -152,8 +164,9 @@ def _parallel(command):
 def _common(command):
     command.add_argument("--config", help="target TOML file (default: the paper's Table 1)")
     command.add_argument("--model", choices=("derived", "paper"), default="derived")
-    command.add_argument("--boundary", choices=("quasi-static", "dynamic"), default="quasi-static",
-                         help="yield-at-boundary convention of the derived model")
+    command.add_argument("--boundary", choices=("quasi-static", "dynamic"),
+                         help="yield-at-boundary convention of the derived model (default: "
+                         "dynamic; the paper model has its own, quasi-static)")
     command.add_argument("--epsilon", choices=EPSILON_READINGS, default="quasi-static",
                          help="the paper model's reading of epsilon (docs/table2.md)")
     command.add_argument("--json", action="store_true", help="print JSON")
@@ -180,6 +193,11 @@ def main(argv=None):
         print(f"cavex: error: cannot read or write {where}{exc.strerror or exc}",
               file=sys.stderr)
         return 2
+    except (KeyboardInterrupt, SystemError) as exc:  # Ctrl-C (numba: a SystemError around it)
+        if isinstance(exc, SystemError) and not isinstance(exc.__context__, KeyboardInterrupt):
+            raise
+        print("cavex: interrupted", file=sys.stderr)
+        return 130
     try:
         print(text)
         sys.stdout.flush()
@@ -252,17 +270,17 @@ def _fem(args, target, projectile):
                               fields=args.fields)
     if args.json:
         return json.dumps(result, indent=2)
-    fe, analytic = result["fe_sigma_r"], result["analytic_sigma_r"]
-    lines = [f"nose depth {result['depth']} m, V = {result['velocity']} m/s, cavity radius "
-             f"{result['radius']} m, layers {', '.join(result['layers'])}",
-             f"interfaces (m): requested {result['interfaces']}, FE final "
-             f"{result['interfaces_final']}",
+    fe, analytic = result["fe_sigma_r_Pa"], result["analytic_sigma_r_Pa"]
+    lines = [f"nose depth {result['depth_m']} m, V = {result['velocity_m_s']} m/s, cavity "
+             f"radius {result['cavity_radius_m']} m, layers {', '.join(result['layers'])}",
+             f"interfaces (m): requested {result['interface_radii_m']}, FE final "
+             f"{result['interface_radii_final_m']}",
              f"{'':<26} {'sigma_r (MPa)':>14} {'FE/analytic - 1':>16} {'b (m)':>10}",
-             f"{'FE':<26} {fe / 1e6:14.3f} {'':>16} {result['fe_plastic_radius']:10.5f}"]
+             f"{'FE':<26} {fe / 1e6:14.3f} {'':>16} {result['fe_plastic_radius_m']:10.5f}"]
     for boundary, stress in analytic.items():
         lines.append(f"{'analytic ' + boundary:<26} {stress / 1e6:14.3f} "
                      f"{result['relative_difference'][boundary]:16.4%} "
-                     f"{result['analytic_plastic_radius'][boundary]:10.5f}")
+                     f"{result['analytic_plastic_radius_m'][boundary]:10.5f}")
     estimate = result["error_estimate"]
     lines.append("FE estimated discretisation error: "
                  + ("not estimated" if estimate is None else f"{estimate:.3%}")
@@ -276,28 +294,28 @@ def _table(args, target, projectile):
     from cavex.verification.table import table_main
 
     return table_main(args.config, args.velocities, args.depths, args.out, args.nu,
-                      args.workers, args.scheduler, progress=args.progress)
+                      args.workers, args.scheduler, progress=args.progress, as_json=args.json)
 
 
 def _verify(args, target, projectile):
     from cavex.verification.report import verify_main
 
     return verify_main(args.config, args.quick, args.out, args.scheduler, args.workers,
-                       progress=args.progress)
+                       progress=args.progress, as_json=args.json)
 
 
 def _batch(args, target, projectile):
     from cavex.verification.batch import batch_main
 
     return batch_main(args.sweep, args.out, args.scheduler, args.workers,
-                      progress=args.progress, allow_large=args.allow_large)
+                      progress=args.progress, allow_large=args.allow_large, as_json=args.json)
 
 
 def _calibrate(args, target, projectile):
     from cavex.verification.calibration import calibrate_main
 
     return calibrate_main(args.shots, args.out, args.params, args.model, args.ids,
-                          args.workers, args.scheduler, progress=args.progress)
+                          args.workers, args.scheduler, progress=args.progress, as_json=args.json)
 
 
 def _validate(args, target, projectile):

@@ -113,8 +113,13 @@ class Target:
         require(len(self.layers) >= 1, "layers", "at least one layer", len(self.layers))
         require(len(self.thicknesses) == len(self.layers) - 1, "thickness",
                 "given for every layer but the last (semi-infinite)", len(self.thicknesses))
+        depth = 0.0
         for i, h in enumerate(self.thicknesses):
             _positive(f"layers[{i}].thickness", h)
+            # a thickness lost to round-off beside the depth above it is no layer
+            require(depth + h > depth and math.isfinite(depth + h), f"layers[{i}].thickness",
+                    f"large enough to move the interface below z = {depth:g} m", h)
+            depth += h
 
     @cached_property
     def interface_depths(self):
@@ -131,6 +136,8 @@ class Target:
 
 
 DEFAULT_DENSITY = 7850.0  # kg/m^3, steel: the body's length when ``length`` is absent
+MAX_CALIBRES = 1000  # longest body, in shank diameters (long-rod penetrators: ~30)
+MAX_FRICTION = 10.0  # largest Coulomb coefficient mu (dry friction: below ~1)
 
 
 @dataclass(frozen=True)
@@ -151,7 +158,8 @@ class Projectile:
         Striking velocity (m/s), in (0, 1e4].
     length : float, optional
         Overall length, nose tip to tail (m), longer than the tangent ogive
-        (:attr:`ogive_length`). Used by the 3-D trajectory model only (``docs/oblique.md``);
+        (:attr:`ogive_length`), at most :data:`MAX_CALIBRES` calibres. Used by the 3-D
+        trajectory model only (``docs/oblique.md``);
         absent: :attr:`body_length`, a solid steel body of the given mass.
     inertia : float, optional
         Transverse moment of inertia about the centre of mass (kg m^2), > 0; absent: a solid
@@ -159,7 +167,7 @@ class Projectile:
     cg : float, optional
         Centre of mass, m from the nose tip, in (0, length); absent: uniform density.
     mu : float
-        Coulomb friction coefficient on the surface, >= 0 (default 0).
+        Coulomb friction coefficient on the surface, in [0, 10] (default 0).
     """
 
     r: float
@@ -186,16 +194,17 @@ class Projectile:
         require(self.R >= self.r, "R", f">= r = {self.r} (ogive)", self.R)
         if self.length is not None:
             _positive("length", self.length)
-            require(self.length > self.ogive_length, "length",
-                    f"> the tangent ogive's length {self.ogive_length:.6g} m", self.length)
+            require(self.ogive_length < self.length <= MAX_CALIBRES * 2.0 * self.r, "length",
+                    f"in ({self.ogive_length:.6g}, {MAX_CALIBRES * 2.0 * self.r:g}] m (longer "
+                    f"than the tangent ogive, at most {MAX_CALIBRES} calibres)", self.length)
         if self.inertia is not None:
             _positive("inertia", self.inertia)
         if self.cg is not None:
             _positive("cg", self.cg)
             require(self.cg < self.body_length, "cg",
                     f"< the overall length {self.body_length:.6g} m", self.cg)
-        require(is_finite_number(self.mu) and math.isfinite(self.mu) and self.mu >= 0.0, "mu",
-                "a finite number >= 0", self.mu)
+        require(is_finite_number(self.mu) and 0.0 <= self.mu <= MAX_FRICTION, "mu",
+                f"in [0, {MAX_FRICTION:g}]", self.mu)
 
     @property
     def psi(self):
@@ -217,7 +226,10 @@ class Projectile:
         shank = self.m / DEFAULT_DENSITY - nose
         require(shank > 0.0, "length", "given (a steel body of this mass is shorter than its "
                 "nose)", None)
-        return ln + shank / (math.pi * r * r)
+        length = ln + shank / (math.pi * r * r)
+        require(length <= MAX_CALIBRES * 2.0 * r, "length", f"given (a steel body of this mass "
+                f"is {length:.6g} m long, over {MAX_CALIBRES} calibres)", None)
+        return length
 
     @property
     def ogive_length(self):

@@ -8,7 +8,11 @@ writes.
 """
 
 import os
+import shutil
+import signal
 import tempfile
+import threading
+from contextlib import contextmanager
 from pathlib import Path
 
 from cavex.errors import CavexInputError, require
@@ -57,3 +61,50 @@ def _check_writable(folder, option, text):
     except OSError as exc:
         raise CavexInputError(f"parameter '{option}' must be a writable location (got "
                               f"{text!r}: {exc.strerror or exc})") from None
+
+
+@contextmanager
+def staged_output(folder):
+    """Write a command's files into a hidden folder inside ``folder`` (the ``with`` target);
+    when the block ends normally, move them into ``folder`` (``os.replace``, with SIGINT and
+    SIGTERM held back for the moves), so that ``folder`` gets either every new file or none.
+
+    An exception or an interrupt (SIGINT or SIGTERM: :class:`KeyboardInterrupt`, also when the
+    exception was swallowed on its way, e.g. in a garbage-collector callback) removes the hidden
+    folder, and ``folder`` too if this created it and it is empty: Ctrl-C or ``kill`` in the
+    middle of writing leaves no partial set of outputs.
+    """
+    folder = Path(folder)
+    created = not folder.exists()
+    folder.mkdir(parents=True, exist_ok=True)
+    stage = Path(tempfile.mkdtemp(prefix=".cavex-partial-", dir=folder))
+    received = []
+
+    def interrupt(signum, frame):
+        received.append(signum)
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    caught = ()  # handlers are set in the main thread only; an ignored signal stays ignored
+    if threading.current_thread() is threading.main_thread():
+        caught = [s for s in (signal.SIGINT, signal.SIGTERM)
+                  if signal.getsignal(s) is not signal.SIG_IGN]
+    previous = [signal.signal(s, interrupt) for s in caught]
+    try:
+        yield stage
+        held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
+        try:
+            if received:  # interrupted, but the exception was swallowed on its way
+                raise KeyboardInterrupt(f"signal {received[0]}")
+            for path in sorted(stage.iterdir()):
+                os.replace(path, folder / path.name)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, held)
+    finally:
+        for s, handler in zip(caught, previous, strict=True):
+            signal.signal(s, signal.SIG_DFL if handler is None else handler)
+        shutil.rmtree(stage, ignore_errors=True)
+        if created:
+            try:
+                folder.rmdir()  # only if empty: nothing was moved in
+            except OSError:
+                pass

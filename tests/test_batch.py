@@ -75,7 +75,7 @@ def test_example_sweep_is_one_dataset(example):
                                                  concrete_E=20e9, elements_per_decade=20).item()))
     alone, = fe_cases([case])
     cell = ds.sel(velocity=800.0, depth=0.8, nu=0.4999, concrete_E=20e9, elements_per_decade=20)
-    assert float(cell.fe_sigma_r) == alone["fe_sigma_r"]
+    assert float(cell.fe_sigma_r) == alone["fe_sigma_r_Pa"]
     assert case["target"][2] == {"name": "soil", "E": 0.12e9, "nu": 0.4999, "rho": 1600.0,
                                  "lam": 0.5, "sigma_c": 7e6}
 

@@ -43,12 +43,12 @@ SWEEP = {"grid": {"velocities": [300.0, 800.0], "depths": [0.3]},
 
 def _result(case):
     both = {"dynamic": 1e8, "quasi-static": 1.1e8}
-    return {"id": case["id"], "status": "ok", "fe_sigma_r": 1e8, "S": 4.0,
-            "error_estimate": None, "analytic_sigma_r": both,
+    return {"id": case["id"], "status": "ok", "fe_sigma_r_Pa": 1e8, "S": 4.0,
+            "error_estimate": None, "analytic_sigma_r_Pa": both,
             "relative_difference": {"dynamic": 0.0, "quasi-static": -0.09},
-            "fe_plastic_radius": 0.1, "analytic_plastic_radius": {"dynamic": 0.1,
-                                                                  "quasi-static": 0.11},
-            "seconds": 1.0}
+            "fe_plastic_radius_m": 0.1, "analytic_plastic_radius_m": {"dynamic": 0.1,
+                                                                      "quasi-static": 0.11},
+            "wall_time_s": 1.0}
 
 
 @pytest.fixture(scope="module")

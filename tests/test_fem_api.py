@@ -132,14 +132,14 @@ def test_compare_at_depth_is_json_and_side_by_side():
     out = compare_at_depth(target, projectile, 0.5, 500.0, error_estimate=False)
     json.dumps(out)
     assert out["layers"] == ["concrete", "macadam", "soil"]
-    assert out["interfaces"] == pytest.approx([0.21, 0.66])
-    assert set(out["analytic_sigma_r"]) == {"dynamic", "quasi-static"}
+    assert out["interface_radii_m"] == pytest.approx([0.21, 0.66])
+    assert set(out["analytic_sigma_r_Pa"]) == {"dynamic", "quasi-static"}
     diff = out["relative_difference"]["dynamic"]
-    assert diff == pytest.approx(out["fe_sigma_r"] / out["analytic_sigma_r"]["dynamic"] - 1)
+    assert diff == pytest.approx(out["fe_sigma_r_Pa"] / out["analytic_sigma_r_Pa"]["dynamic"] - 1)
     # layered, nu = 0.4999: FE 1.4 % below the incompressible closed form (compressibility)
     assert -0.03 < diff < 0
     assert compare_at_depth(target, projectile, 0.5, 500.0, nu=0.49,
-                            error_estimate=False)["fe_sigma_r"] < out["fe_sigma_r"]
+                            error_estimate=False)["fe_sigma_r_Pa"] < out["fe_sigma_r_Pa"]
 
 
 def test_error_estimate_falls_back_to_a_finer_run_where_the_coarse_one_fails(monkeypatch):

@@ -59,7 +59,7 @@ def test_layered_wall_stress_converges(default_target, depth):
     target, projectile = default_target
     levels = [(15.0, 0.06), (30.0, 0.03), (60.0, 0.015)]
     S = [compare_at_depth(target, projectile, depth, 500.0, elements_per_decade=e,
-                          growth_per_step=g, error_estimate=False)["fe_sigma_r"]
+                          growth_per_step=g, error_estimate=False)["fe_sigma_r_Pa"]
          for e, g in levels]
     # consecutive refinements within 1 % (25-depth study in benchmarks/fem_layered.py:
     # max 0.95 % coarse->mid, 0.77 % mid->fine)
@@ -70,7 +70,7 @@ def test_layered_S_of_L_is_smooth_in_the_incompressible_limit(default_target):
     target, projectile = default_target
     depths = np.linspace(0.10, 0.50, 9)
     S = np.array([compare_at_depth(target, projectile, L, 500.0, nu=0.49999, outer_ratio=3000.0,
-                                   error_estimate=False)["fe_sigma_r"] for L in depths])
+                                   error_estimate=False)["fe_sigma_r_Pa"] for L in depths])
     # at nu = 0.4999 S(L) wiggles by ~0.5 %: P-wave reverberation between the cavity and the
     # concrete/macadam interface in the compressible solid (amplitude ~ V/c_p). At nu = 0.49999
     # S(L) decreases monotonically, as the incompressible model does, without chatter:

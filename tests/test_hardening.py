@@ -356,7 +356,241 @@ def test_version_bare_usage_and_help_with_defaults(capsys):
      "'workers'"),
     (["validate", "--shots", "{shots}", "--out", "/proc/cavex-test"], "'out'"),
     (["calibrate", "--shots", "{shots}", "--out", "{tmp}"], "'out'"),
+    (["validate", "--shots", "{shots}", "--out", ""], "'out'"),  # was: results/validation
 ])
 def test_validation_commands_check_before_work(capsys, tmp_path, argv, name):
     shots = Path(__file__).resolve().parents[1] / "examples" / "shots_forrestal1994.csv"
     refused(capsys, tmp_path, [a.format(shots=shots, tmp=tmp_path) for a in argv], name)
+
+
+# --- the adversarial pass over every command (issue 12) ------------------------------------
+
+LAW = ["--resistance", "law", "--law-A", "2e8", "--law-B", "2500"]
+PROJECTILE_LINE = "V0 = 1000.0"
+
+
+def _config(tmp_path, name, old, new):
+    text = default_config_text()
+    assert old in text
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text.replace(old, new, 1))
+    return path
+
+
+@pytest.mark.parametrize(("extra", "name"), [
+    (["--velocity", "1e5"], "'velocity'"), (["--velocity", "0"], "'velocity'"),
+    (["--velocity", "nan"], "'velocity'"), (["--velocity", "-1e3"], "'velocity'"),
+    (["--velocity", "inf"], "'velocity'"),
+    (["--spin", "1e12"], "'spin'"), (["--spin", "-1e12"], "'spin'"), (["--spin", "nan"], "'spin'"),
+    (["--obliquity", "90"], "'obliquity'"), (["--obliquity", "-90"], "'obliquity'"),
+    (["--obliquity", "nan"], "'obliquity'"), (["--obliquity", "-inf"], "'obliquity'"),
+    (["--obliquity", "1e308"], "'obliquity'"),
+    (["--attack", "-5"], "'attack'"), (["--attack", "90"], "'attack'"),
+    (["--attack", "nan"], "'attack'"), (["--attack-plane", "nan"], "'attack_plane'"),
+    (["--contact-ramp", "nan"], "'contact_ramp'"), (["--contact-ramp", "-1"], "'contact_ramp'"),
+])
+def test_trajectory_shot_out_of_range(capsys, tmp_path, extra, name):
+    refused(capsys, tmp_path, ["trajectory", *LAW, "--out", tmp_path / "o", *extra], name)
+
+
+@pytest.mark.parametrize(("law", "name"), [
+    (["--resistance", "law", "--law-A", "1e100", "--law-B", "0"], "'law_A'"),  # ricochet at t=0
+    (["--resistance", "law", "--law-A", "1e40", "--law-B", "0"], "'law_A'"),  # stalled
+    (["--resistance", "law", "--law-A", "2e8", "--law-B", "1e300"], "'law_B'"),  # overflow
+    (["--resistance", "law", "--law-A", "nan", "--law-B", "0"], "'law_A'"),
+    (["--resistance", "law", "--law-A", "2e8", "--law-B", "-1"], "'law_B'"),
+    (["--resistance", "law", "--law-B", "2500"], "--law-A"),
+    (["--law-A", "2e8"], "--law-A"),  # was silently ignored by the derived law
+    (["--resistance", "derived", "--law-B", "2500"], "--law-A"),
+    (["--resistance", "table"], "--table"),
+])
+def test_trajectory_law_options(capsys, tmp_path, law, name):
+    refused(capsys, tmp_path, ["trajectory", *law, "--out", tmp_path / "o"], name)
+
+
+@pytest.mark.parametrize(("name", "old", "new", "parameter"), [
+    ("short", PROJECTILE_LINE, PROJECTILE_LINE + "\nlength = 0.03", "'projectile.length'"),
+    ("long", PROJECTILE_LINE, PROJECTILE_LINE + "\nlength = 1e300", "'projectile.length'"),
+    ("heavy", "m = 0.505", "m = 1e300", "'length'"),  # a 1e299 m steel rod: y0 not finite
+    ("light", "m = 0.505", "m = 0.01", "'length'"),  # the steel body is shorter than its nose
+    ("cg", PROJECTILE_LINE, PROJECTILE_LINE + "\nlength = 0.15\ncg = 0.2", "'projectile.cg'"),
+    ("inertia", PROJECTILE_LINE, PROJECTILE_LINE + "\ninertia = 0", "'projectile.inertia'"),
+    ("inertia_nan", PROJECTILE_LINE, PROJECTILE_LINE + "\ninertia = nan",
+     "'projectile.inertia'"),
+    ("mu", PROJECTILE_LINE, PROJECTILE_LINE + "\nmu = 1e300", "'projectile.mu'"),
+    ("mu_neg", PROJECTILE_LINE, PROJECTILE_LINE + "\nmu = -0.1", "'projectile.mu'"),
+])
+def test_trajectory_projectile_out_of_range(capsys, tmp_path, name, old, new, parameter):
+    config = _config(tmp_path, name, old, new)
+    refused(capsys, tmp_path, ["trajectory", "--config", config, *LAW, "--out", tmp_path / "o"],
+            parameter)
+
+
+@pytest.mark.parametrize(("old", "new", "extra"), [
+    ("m = 0.505", "m = 1e-300\nlength = 0.15", []),
+    (PROJECTILE_LINE, PROJECTILE_LINE + "\ninertia = 1e-300", ["--obliquity", "30"]),
+    (None, None, ["--velocity", "1e-9", "--obliquity", "89.9"]),  # ended at t = 0
+])
+def test_trajectory_that_cannot_advance_is_a_numerical_failure(capsys, tmp_path, old, new,
+                                                               extra):
+    """Forces far beyond the body's mass or inertia overflowed (RuntimeWarnings, then a
+    'ricochet' at t = 0 and 1000 m/s printed as a result); now exit 1, one line, no files."""
+    if old is not None:
+        extra = [*extra, "--config", _config(tmp_path, "body", old, new)]
+    code, out, err = run(capsys, "trajectory", *LAW, "--out", tmp_path / "o", *extra)
+    assert (code, out) == (1, "") and len(err.splitlines()) == 1, err
+    assert err.startswith("cavex: numerical failure: ") and not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("damage", ["not_a_table", "garbage", "other_target", "too_slow"])
+def test_trajectory_table_refused(capsys, tmp_path, good_table, damage):
+    path = tmp_path / "t.nc"
+    argv = ["trajectory", "--resistance", "table", "--table", path, "--out", tmp_path / "o"]
+    if damage == "not_a_table":
+        xr.Dataset({"x": ("a", np.arange(3.0))}).to_netcdf(path, engine="scipy")
+    elif damage == "garbage":
+        path.write_text("hello")
+    elif damage == "other_target":
+        write_table(good_table, path, reproducible=False)
+        argv += ["--config", _config(tmp_path, "other", "tau = 25e6", "tau = 30e6")]
+    else:  # the elements' normal velocities (543 m/s) exceed the table's (300 m/s)
+        target, projectile = load_config()
+        write_table(analytic_table(target, projectile, [0.0, 300.0], [0.1, 0.5, 1.0, 1.3]), path,
+                    reproducible=False)
+    refused(capsys, tmp_path, argv, "table")
+
+
+@pytest.mark.parametrize("command", [
+    ["trajectory", *LAW, "--out", "{afile}"], ["trajectory", *LAW, "--out", "{afile}/x"],
+    ["trajectory", *LAW, "--out", ""], ["trajectory", *LAW, "--out", "/proc/cavex-test"],
+    ["fem", "--velocity", "300", "--depth", "0.3", "--fields", "{afile}"],
+    ["fem", "--velocity", "300", "--depth", "0.3", "--fields", ""],
+    ["fem", "--velocity", "300", "--depth", "0.3", "--fields", "/proc/cavex-test"],
+    ["verify", "--quick", "--out", ""], ["batch", "{sweep}", "--out", ""],
+])
+def test_unwritable_output_of_the_other_commands(capsys, tmp_path, files, command):
+    argv = [a.format(afile=files["afile"], sweep=files["sweep"]) for a in command]
+    refused(capsys, tmp_path, argv, "'out'" if "--out" in argv else "'fields'")
+
+
+@pytest.fixture
+def read_only(tmp_path):
+    """A folder nobody may write into: mode 555, or, for root (whom modes do not stop), the
+    immutable attribute (chattr +i); skipped where neither holds."""
+    import shutil
+    import subprocess
+
+    folder = tmp_path / "read-only"
+    folder.mkdir()
+    immutable = os.geteuid() == 0
+    if immutable:
+        if shutil.which("chattr") is None or subprocess.run(
+                ["chattr", "+i", folder], capture_output=True).returncode != 0:
+            pytest.skip("root without chattr +i: no folder is read-only here")
+    else:
+        folder.chmod(0o555)
+    try:
+        (folder / "probe").touch()
+    except OSError:
+        pass
+    else:
+        pytest.skip("the read-only folder is writable here")
+    yield folder
+    if immutable:
+        subprocess.run(["chattr", "-i", folder], check=True)
+    else:
+        folder.chmod(0o755)
+
+
+@pytest.mark.parametrize("command", [
+    ["penetrate", "--out", "{ro}"], ["penetrate", "--out", "{ro}/sub"],
+    ["trajectory", *LAW, "--out", "{ro}"], ["trajectory", *LAW, "--out", "{ro}/sub"],
+    ["table", "-o", "{ro}/t.nc", "--velocities", "0", "100", "--depths", "0.3", "0.4"],
+    ["batch", "{sweep}", "--out", "{ro}/b"], ["verify", "--quick", "--out", "{ro}/v"],
+    ["fem", "--velocity", "300", "--depth", "0.3", "--fields", "{ro}/f"],
+    ["validate", "--shots", "{shots}", "--out", "{ro}"],
+    ["calibrate", "--shots", "{shots}", "--out", "{ro}/c.toml"],
+])
+def test_read_only_or_immutable_output_folder(capsys, tmp_path, files, read_only, command):
+    shots = Path(__file__).resolve().parents[1] / "examples" / "shots_forrestal1994.csv"
+    argv = [a.format(ro=read_only, sweep=files["sweep"], shots=shots) for a in command]
+    line = refused(capsys, tmp_path, argv, "'fields'" if "--fields" in argv else "'out'")
+    assert "writable" in line
+
+
+@pytest.mark.parametrize(("argv", "name"), [
+    (["stress", "--velocity", "-1e2", "--depth", "0.3"], "'velocity'"),  # was "expected one
+    (["stress", "--velocity", "100", "--depth", "-inf"], "'depth'"),  # argument"
+    (["table", "-o", "{tmp}/t.nc", "--velocities", "0", "100", "--depths", "0.3", "1e308"],
+     "'depths'"),  # np.round overflowed: RuntimeWarning lines, then 'depths[13]' = inf
+    (["stress", "--velocity", "300", "--depth", "0.3", "--config", "{thick}"],
+     "'layers[1].thickness'"),  # lost to round-off below 1e300 m: was 'interfaces[1]'
+    (["batch", "{fast}", "--out", "{tmp}/b"], "'grid.velocities[0]'"),  # ran, exit 0, failed
+])
+def test_other_commands_out_of_range(capsys, tmp_path, argv, name):
+    thick = _config(tmp_path, "thick", "thickness = 0.65", "thickness = 1e300")
+    fast = tmp_path / "fast.toml"
+    fast.write_text(SMALL_SWEEP.replace("velocities = [300.0]", "velocities = [1e5]"))
+    refused(capsys, tmp_path, [a.format(tmp=tmp_path, thick=thick, fast=fast) for a in argv],
+            name)
+
+
+def test_an_interrupt_while_writing_leaves_no_files(tmp_path):
+    """SIGINT or SIGTERM inside the staged writing removes what was written (and the folder it
+    created); the files move into the folder only all together."""
+    import signal
+
+    from cavex.paths import staged_output
+
+    handlers = [signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)]
+    for signum in (signal.SIGINT, signal.SIGTERM):
+        out = tmp_path / f"out{signum}"
+        with pytest.raises(KeyboardInterrupt), staged_output(out) as stage:
+            (stage / "history.csv").write_text("t\n0\n")
+            os.kill(os.getpid(), signum)
+        assert not out.exists()
+    assert [signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)] == handlers
+    kept = tmp_path / "kept"
+    kept.mkdir()
+    (kept / "old.txt").write_text("old")
+    with pytest.raises(RuntimeError), staged_output(kept) as stage:
+        (stage / "new.txt").write_text("new")
+        raise RuntimeError("failed while writing")
+    assert sorted(p.name for p in kept.iterdir()) == ["old.txt"]
+    with staged_output(kept) as stage:
+        (stage / "new.txt").write_text("new")
+    assert sorted(p.name for p in kept.iterdir()) == ["new.txt", "old.txt"]
+
+
+def test_ctrl_c_during_a_trajectory_run(tmp_path):
+    """Ctrl-C while the files are being written: one line, exit 130, and no --out folder (it
+    was a traceback, or a SystemError out of the compiled kernel, and a partial set of files)."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "o"
+    process = subprocess.Popen([sys.executable, "-m", "cavex.cli", "trajectory", *LAW, "--out",
+                                str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True)
+    deadline = time.monotonic() + 60.0
+    while time.monotonic() < deadline and process.poll() is None:
+        if out.exists() and any(out.glob(".cavex-partial-*/*")):
+            break  # writing has begun
+        time.sleep(0.005)
+    process.send_signal(signal.SIGINT)
+    stdout, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, (stdout, stderr)
+    assert stderr.splitlines() == ["cavex: interrupted"] and stdout == ""
+    assert not out.exists()
+
+
+def test_a_run_that_reaches_the_time_limit_ends_there():
+    from cavex.analytic.oblique import MAX_TIME, Shot, fly
+
+    target, projectile = load_config()
+    result = fly(target.single(0), projectile, Shot(1000.0), "law", law_A=0.0, law_B=0.0)
+    assert result.phases[-1]["end_reason"] == "time limit"
+    assert result.end["state"] == "time limit" and result.end["time_s"] == MAX_TIME
+    assert result.end["nose_tip_m"] == result.phases[-1]["end_nose_tip_m"]

@@ -75,7 +75,7 @@ def single(default):
     """Concrete alone with the derived quasi-static resistance: constant C_A, C_B."""
     target, projectile = default
     tgt = target.single(0)
-    resistance = ClosedFormResistance(tgt, projectile)
+    resistance = ClosedFormResistance(tgt, projectile, boundary="quasi-static")
     c_a = resistance.force(0.0, 0.0)
     c_b = (resistance.force(0.0, 1000.0) - c_a) / 1000.0 ** 2
     return tgt, projectile, resistance, c_a, c_b
@@ -131,7 +131,8 @@ def test_crater_stage_matches_eqs_33_34(single, default, crater):
     assert stiffness * lc == pytest.approx(c_a + c_b * vc ** 2, rel=1e-13)  # Eq. 34 continuity
     omega = math.sqrt(stiffness / m)
     tc = math.acos(vc / v0) / omega
-    resistance = ClosedFormResistance(target, projectile)  # layered: crater uses layer 1 alone
+    # layered: crater uses layer 1 alone
+    resistance = ClosedFormResistance(target, projectile, boundary="quasi-static")
     got_vc, got_k = crater_exit(projectile, resistance.crater_force, lc)
     # brentq xtol 1e-13 on V and rtol 1e-15: round-off level
     assert got_vc == pytest.approx(vc, rel=1e-12)
@@ -233,7 +234,7 @@ def _assert_monotone(trajectory):
 @pytest.fixture(scope="module")
 def quasi_static_run(default):
     target, projectile = default
-    resistance = ClosedFormResistance(target, projectile)
+    resistance = ClosedFormResistance(target, projectile, boundary="quasi-static")
     return resistance, penetrate(target, projectile, resistance)
 
 

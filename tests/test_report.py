@@ -50,8 +50,8 @@ def test_quick_report_writes_every_file(quick_report):
     assert summary["cells"] == grid.sizes["velocity"] * grid.sizes["depth"] >= 3 * 3
     assert grid.sizes["velocity"] == 3 and set(np.unique(grid["wall_layer"])) == {0, 1, 2}
     # nothing that differs from run to run: wall times and the creation time only in the summary
-    assert summary["seconds"] > 0 and summary["created"]
-    assert "created" not in grid.attrs and "seconds" not in grid.attrs["report"]
+    assert summary["wall_time_s"] > 0 and summary["created"]
+    assert "created" not in grid.attrs and "wall_time_s" not in grid.attrs["report"]
     for name in ("report.md", "report.html"):
         text = (out / name).read_text()
         assert "wall time" not in text and summary["created"] not in text

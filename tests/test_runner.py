@@ -44,7 +44,7 @@ def grid_cases():
 
 def without_seconds(results):
     """FE results without the wall-clock time (the only non-deterministic entry)."""
-    return [{k: v for k, v in r.items() if k != "seconds"} for r in results]
+    return [{k: v for k, v in r.items() if k != "wall_time_s"} for r in results]
 
 
 def test_probe_results_identical_serial_pool_and_dask(cluster):
@@ -73,12 +73,12 @@ def test_fe_results_bitwise_identical_serial_pool_and_dask(cluster):
     with Client(cluster) as client:
         dask = without_seconds(run_cases(fe_cases, cases, scheduler=client))
     assert serial == pool == dask
-    hexes = [[r["fe_sigma_r"].hex(), r["S"].hex()] for r in serial]
-    assert hexes == [[r["fe_sigma_r"].hex(), r["S"].hex()] for r in dask]
+    hexes = [[r["fe_sigma_r_Pa"].hex(), r["S"].hex()] for r in serial]
+    assert hexes == [[r["fe_sigma_r_Pa"].hex(), r["S"].hex()] for r in dask]
     first = serial[0]
     assert first["status"] == "ok" and first["layers"] == ["concrete", "macadam", "soil"]
-    assert first["fe_sigma_r"] == pytest.approx(612.485e6, rel=1e-4)  # coarse, measured
-    assert first["S"] == pytest.approx(first["fe_sigma_r"] / 25e6, rel=1e-15)
+    assert first["fe_sigma_r_Pa"] == pytest.approx(612.485e6, rel=1e-4)  # coarse, measured
+    assert first["S"] == pytest.approx(first["fe_sigma_r_Pa"] / 25e6, rel=1e-15)
     for r in serial:  # coarse mesh, nu = 0.4999: within a few % of the closed form
         assert abs(r["relative_difference"]["dynamic"]) < 0.08
 

@@ -55,7 +55,7 @@ def runway():
 @pytest.fixture(scope="module")
 def synthetic(runway):
     """Quasi-static closed-form table on the default grid (13 x 31 depths + switch nodes)."""
-    return analytic_table(*runway, DEFAULT_VELOCITIES, DEFAULT_DEPTHS)
+    return analytic_table(*runway, DEFAULT_VELOCITIES, DEFAULT_DEPTHS, boundary="quasi-static")
 
 
 @pytest.fixture(scope="module")
@@ -184,7 +184,7 @@ def test_force_reproduces_the_closed_form(synthetic, runway):
     the PCHIP-in-L error, measured on 600 random points: median 3.6e-5, max 1.4e-2 (at the kink
     where the plastic zone leaves the macadam, L = 1.128 m)."""
     target, projectile = runway
-    closed = ClosedFormResistance(target, projectile)
+    closed = ClosedFormResistance(target, projectile, boundary="quasi-static")
     table = TabulatedResistance(synthetic, target, projectile)
     for depth in synthetic["depth"].values[::5]:
         for v in (0.0, 137.0, 650.0, 1200.0):
@@ -211,7 +211,8 @@ def test_labels_change_at_the_wall_layer_switches(synthetic, runway):
 
 def _trajectory_errors(runway, reference, n, method):
     target, projectile = runway
-    table = analytic_table(target, projectile, VELOCITIES, np.linspace(0.1, 1.3, n))
+    table = analytic_table(target, projectile, VELOCITIES, np.linspace(0.1, 1.3, n),
+                           boundary="quasi-static")
     run = trajectory_summary(penetrate(target, projectile, TabulatedResistance(
         table, target, projectile, depth_method=method)), target)
     return (run["final_depth_m"] - reference["final_depth_m"],
@@ -227,7 +228,8 @@ def test_trajectory_converges_with_the_table_spacing(runway):
     636.17 m/s at H1) within 2e-4 m and 1e-2 m/s."""
     target, projectile = runway
     reference = trajectory_summary(
-        penetrate(target, projectile, ClosedFormResistance(target, projectile)), target)
+        penetrate(target, projectile, ClosedFormResistance(target, projectile,
+                                                           boundary="quasi-static")), target)
     assert reference["final_depth_m"] == pytest.approx(3.0916, abs=1e-4)
     counts = np.array([16, 31, 61])
     spacing = 1.2 / (counts - 1)
@@ -261,7 +263,7 @@ def test_fe_interpolation_error_against_extra_fe_points(runway):
                                                  boundary="dynamic"), target, projectile)
     fe_error, closed_error = [], []
     for (v, L), result in zip(points, results, strict=True):
-        fe_error.append(fe_resistance.wall_stress(L, [v])[0] / result["fe_sigma_r"] - 1.0)
+        fe_error.append(fe_resistance.wall_stress(L, [v])[0] / result["fe_sigma_r_Pa"] - 1.0)
         layers, interfaces = spherical_problem(target, projectile, L)
         exact = cavity_stress(layers, interfaces, v, projectile.r, boundary="dynamic")
         closed_error.append(dynamic.wall_stress(L, [v])[0] / exact - 1.0)
@@ -295,7 +297,7 @@ def test_small_fe_table_builds_and_drives_the_integrator(fe_table, runway, tmp_p
 
 
 def test_table_plastic_radius_is_the_case_results(fe_table, fe_store, runway):
-    """``plastic_radius`` of every cell is its case result's ``fe_plastic_radius`` (NaN where
+    """``plastic_radius`` of every cell is its case result's ``fe_plastic_radius_m`` (NaN where
     the cell failed); the first-layer cases are not in the grid."""
     b = fe_table["plastic_radius"]
     assert b.dims == ("velocity", "depth") and b.attrs["units"] == "m"
@@ -306,7 +308,7 @@ def test_table_plastic_radius_is_the_case_results(fe_table, fe_store, runway):
         case, result = entry["case"], entry["result"]
         value = float(b.sel(velocity=case["velocity"], depth=case["depth"]))
         if result["status"] == "ok":
-            assert value == result["fe_plastic_radius"]
+            assert value == result["fe_plastic_radius_m"]
         else:
             assert np.isnan(value)
     # no failed cell; b >= the cavity radius (b = a where the soil is elastic, FE to 0.1 %)

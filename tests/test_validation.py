@@ -196,7 +196,7 @@ def test_bad_calibration_files_are_refused(capsys, tmp_path):
                "--params", "strength_factor")[0] == 0
     text = good.read_text()
     cases = [(text.replace("lam = ", "lamb = ", 1), "unknown key 'calibration.lamb'"),
-             (text.replace('model = "derived-quasi-static"', 'model = "quick"'),
+             (text.replace('model = "derived-dynamic"', 'model = "quick"'),
               "parameter 'model' must be one of"),
              (text.replace('params = ["strength_factor"]', 'params = ["tau"]'),
               "unknown calibration parameter 'tau'"),
@@ -283,7 +283,8 @@ def test_synthetic_shots_calibrate_back_to_their_parameters(capsys, tmp_path):
     shots_path = tmp_path / "synthetic.csv"
     synthetic_file(shots_path, truth)
     cal = tmp_path / "cal.toml"
-    code, out, err = run(capsys, "calibrate", "--shots", str(shots_path), "--out", str(cal))
+    code, out, err = run(capsys, "calibrate", "--shots", str(shots_path), "--out", str(cal),
+                         "--model", "derived-quasi-static")
     assert (code, err) == (0, "")
     fitted = read_calibration(cal)
     assert fitted.params == ("lam", "strength_factor")
@@ -309,13 +310,13 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     small.write_text("\n".join(lines) + "\n")
     cal = tmp_path / "cal.toml"
     assert run(capsys, "calibrate", "--shots", str(small), "--out", str(cal), "--ids",
-               "F94-52", "--params", "strength_factor")[0] == 0
+               "F94-52", "--params", "strength_factor", "--model", "derived-quasi-static")[0] == 0
     data = tomllib.loads(cal.read_text())
     assert data["calibration"]["shots"] == ["F94-52"]
     assert abs(math.log(data["calibration"]["strength_factor"])) > 0.1  # it moved
     assert data["calibration"]["reference_shot"] == "F94-52"
-    code, out, err = run(capsys, "penetrate", "--config", str(cal), "--json", "--out",
-                         str(tmp_path / "pen"))
+    code, out, err = run(capsys, "penetrate", "--config", str(cal), "--boundary", "quasi-static",
+                         "--json", "--out", str(tmp_path / "pen"))
     assert (code, err) == (0, "")
     final = json.loads(out)["phases"][-1]["end_depth_m"]
     out_dir = tmp_path / "val"
@@ -324,14 +325,14 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     assert (code, err) == (0, "")
     result = json.loads(out)
     rows = {row["id"]: row for row in result["shots"]}
-    assert rows["F94-52"]["predicted"]["derived quasi-static calibrated"] == pytest.approx(
+    assert rows["F94-52"]["predicted_m"]["derived quasi-static calibrated"] == pytest.approx(
         final, rel=DIGITS_6)
     # the JSON of the issue, and the statistics recomputed from it
     assert set(result["summary"]) == {"derived quasi-static", "derived dynamic", "paper",
                                       "FE table", "Forrestal 1994",
                                       "derived quasi-static calibrated"}
     for model, stats in result["summary"].items():
-        ratios = [row["predicted"][model] / row["measured"] for row in result["shots"]]
+        ratios = [row["predicted_m"][model] / row["measured_m"] for row in result["shots"]]
         assert stats["n"] == 2
         assert stats["mean_ratio"] == pytest.approx(np.mean(ratios), rel=DIGITS_6)
         assert stats["std_ratio"] == pytest.approx(np.std(ratios, ddof=1), rel=DIGITS_6)
@@ -343,7 +344,7 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     assert rows["F94-52"]["ratio"]["derived quasi-static calibrated"] == pytest.approx(1.0,
                                                                                       abs=1e-5)
     empirical_depth = empirical.shot_depth(read_shots(small).by_id(["F94-50"])[0])
-    assert rows["F94-50"]["predicted"]["Forrestal 1994"] == pytest.approx(empirical_depth,
+    assert rows["F94-50"]["predicted_m"]["Forrestal 1994"] == pytest.approx(empirical_depth,
                                                                           rel=DIGITS_6)
     # files; one FE table per distinct target (two here), reused by a rerun
     names = {p.name for p in out_dir.iterdir()}
@@ -390,15 +391,15 @@ def test_committed_validation_report_is_consistent():
     for name, rows in (("summary", result["shots"]), ("held_out_summary",
                        [r for r in result["shots"] if r["id"] in result["held_out"]])):
         for model, stats in result[name].items():
-            ratios = [r["predicted"][model] / r["measured"] for r in rows
-                      if r["predicted"][model] is not None]
+            ratios = [r["predicted_m"][model] / r["measured_m"] for r in rows
+                      if r["predicted_m"][model] is not None]
             assert stats["n"] == len(ratios)
             assert stats["mean_ratio"] == pytest.approx(np.mean(ratios), rel=DIGITS_6)
             assert stats["std_ratio"] == pytest.approx(np.std(ratios, ddof=1), rel=DIGITS_6)
             assert stats["mean_abs_log_ratio"] == pytest.approx(
                 np.mean(np.abs(np.log(ratios))), rel=DIGITS_6)
     for row, shot in zip(result["shots"], data.shots, strict=True):
-        assert row["predicted"]["Forrestal 1994"] == pytest.approx(empirical.shot_depth(shot),
-                                                                   rel=DIGITS_6)
+        assert row["predicted_m"]["Forrestal 1994"] == pytest.approx(
+            empirical.shot_depth(shot), rel=DIGITS_6)
     sentence = verdict(result["held_out_summary"], result["calibrations"])
     assert sentence in (folder / "report.md").read_text()

@@ -23,6 +23,7 @@ import numpy as np
 from cavex.config import parse_projectile, parse_target
 from cavex.errors import CavexInputError, check_keys, is_finite_number, prefixed, require
 from cavex.fem.settings import make_numerics
+from cavex.materials import MAX_VELOCITY
 from cavex.paths import check_output_dir
 from cavex.verification.cases import (
     check_run_size,
@@ -39,7 +40,7 @@ from cavex.verification.runner import (
     run_cases,
     write_text_atomic,
 )
-from cavex.verification.table import write_table
+from cavex.verification.table import MAX_DEPTH, write_table
 
 SECTIONS = ("sweep", "target", "grid", "numerics", "materials")
 SWEEP_KEYS = ("name", "scheduler", "workers")
@@ -52,24 +53,24 @@ NUMERICS_UNITS = {"seed_radius": "m", "tension_cutoff": "Pa", "dilatancy_deg": "
 SWEEP_FILE, STORE_DIR, RESULTS_FILE = "sweep.json", "cases", "results.nc"
 
 VARIABLES = {  # name: (path in the fe_cases result, units, long name)
-    "fe_sigma_r": (("fe_sigma_r",), "Pa", "FE radial stress at the cavity wall"),
+    "fe_sigma_r": (("fe_sigma_r_Pa",), "Pa", "FE radial stress at the cavity wall"),
     "S": (("S",), "1", "FE wall stress over the wall layer's tau"),
     "error_estimate": (("error_estimate",), "1",
                        "FE relative discretisation error estimate (NaN: not estimated)"),
-    "analytic_sigma_r_dynamic": (("analytic_sigma_r", "dynamic"), "Pa",
+    "analytic_sigma_r_dynamic": (("analytic_sigma_r_Pa", "dynamic"), "Pa",
                                  "closed-form wall stress, dynamic boundary convention"),
-    "analytic_sigma_r_quasi_static": (("analytic_sigma_r", "quasi-static"), "Pa",
+    "analytic_sigma_r_quasi_static": (("analytic_sigma_r_Pa", "quasi-static"), "Pa",
                                       "closed-form wall stress, quasi-static convention"),
     "relative_difference_dynamic": (("relative_difference", "dynamic"), "1",
                                     "fe_sigma_r / analytic_sigma_r_dynamic - 1"),
     "relative_difference_quasi_static": (("relative_difference", "quasi-static"), "1",
                                          "fe_sigma_r / analytic_sigma_r_quasi_static - 1"),
-    "fe_plastic_radius": (("fe_plastic_radius",), "m", "FE elastic-plastic boundary radius"),
-    "analytic_plastic_radius_dynamic": (("analytic_plastic_radius", "dynamic"), "m",
+    "fe_plastic_radius": (("fe_plastic_radius_m",), "m", "FE elastic-plastic boundary radius"),
+    "analytic_plastic_radius_dynamic": (("analytic_plastic_radius_m", "dynamic"), "m",
                                         "closed-form plastic radius, dynamic convention"),
-    "analytic_plastic_radius_quasi_static": (("analytic_plastic_radius", "quasi-static"), "m",
+    "analytic_plastic_radius_quasi_static": (("analytic_plastic_radius_m", "quasi-static"), "m",
                                              "closed-form plastic radius, quasi-static"),
-    "wall_time": (("seconds",), "s", "FE run time (not reproducible)"),
+    "wall_time": (("wall_time_s",), "s", "FE run time (not reproducible)"),
 }
 
 
@@ -190,6 +191,10 @@ def _grid_section(table):
     _check_table(table, "grid.", GRID_KEYS, required=("velocities", "depths"))
     velocities = _number_list(table["velocities"], "grid.velocities", lambda v: v > 0, "> 0")
     depths = _number_list(table["depths"], "grid.depths", lambda v: v >= 0, ">= 0")
+    for where, values, top, unit in (("grid.velocities", velocities, MAX_VELOCITY, "m/s"),
+                                     ("grid.depths", depths, MAX_DEPTH, "m")):
+        for i, value in enumerate(values):  # as `cavex table`; the case ids stay file names
+            require(value <= top, f"{where}[{i}]", f"<= {top:g} {unit}", value)
     axes = [Axis("velocity", "grid", ("velocity",), velocities, "m s-1",
                  "cavity expansion velocity V"),
             Axis("depth", "grid", ("depth",), depths, "m", "nose-tip depth L")]
@@ -236,9 +241,12 @@ def _materials_section(entries, layers, grid_sets_nu):
             if prop == "nu" and grid_sets_nu:
                 raise CavexInputError(f"key '{where}nu' conflicts with 'grid.nu' (which sets "
                                       "every layer's nu)")
-            if (index, prop) in seen:
-                raise CavexInputError(f"key '{where}{prop}' varies a property already given")
-            seen.add((index, prop))
+            strength = "tau" if prop == "sigma_c" else prop  # each replaces the other
+            if (index, strength) in seen:
+                raise CavexInputError(f"key '{where}{prop}' varies a property already given"
+                                      + (" (tau and sigma_c replace each other: give one)"
+                                         if strength == "tau" else ""))
+            seen.add((index, strength))
             if isinstance(value, list):
                 values = _value_list(value, where + prop)
                 for j, item in enumerate(values):
@@ -506,8 +514,9 @@ def _values(results, path):
 # --- the command --------------------------------------------------------------------------------
 
 def batch_main(path, out_dir=None, scheduler=None, workers=None, progress=None,
-               allow_large=False):
-    """Run a sweep for ``cavex batch`` and return the printable summary.
+               allow_large=False, as_json=False):
+    """Run a sweep for ``cavex batch`` and return the printable summary (``as_json``:
+    :func:`summary_dict` as JSON).
 
     ``out_dir`` defaults to ``results/batch/<sweep name>``. The size and an estimate of the
     run time go to stderr first; more than :data:`cavex.verification.cases.LARGE_RUN` cases
@@ -528,19 +537,34 @@ def batch_main(path, out_dir=None, scheduler=None, workers=None, progress=None,
     before = len(ids & set(read_store(os.path.join(out_dir, STORE_DIR))))
     start = time.perf_counter()
     dataset = run_sweep(path, out_dir, scheduler=scheduler, workers=workers, progress=progress)
-    return _summary(dataset, out_dir, before, time.perf_counter() - start)
+    summary = summary_dict(dataset, out_dir, before, time.perf_counter() - start)
+    if as_json:
+        return json.dumps(summary, indent=2)
+    return _summary(summary)
 
 
-def _summary(dataset, out_dir, loaded, seconds):
-    sizes = ", ".join(f"{name}={size}" for name, size in dataset.sizes.items())
+def summary_dict(dataset, out_dir, loaded, seconds):
+    """What ``cavex batch --json`` prints: the sweep's name, its cases (run now, loaded from
+    the store, failed, with the reasons), the Dataset's dimensions, the wall time and the
+    files written."""
+    cases = int(dataset.attrs["cases"])
     reasons = json.loads(dataset.attrs["failure_reasons"])
-    lines = [f"sweep '{dataset.attrs['sweep']}': {dataset.attrs['cases']} cases "
-             f"({dataset.attrs['cases'] - loaded} run, "
-             f"{loaded} loaded from the store), {len(reasons)} failed, {seconds:.1f} s",
+    return {"sweep": dataset.attrs["sweep"], "cases": cases, "run": cases - loaded,
+            "loaded": loaded, "failed": len(reasons), "failure_reasons": reasons,
+            "dimension_sizes": dict(dataset.sizes), "wall_time_s": float(seconds),
+            "output": os.path.join(out_dir, RESULTS_FILE),
+            "store": os.path.join(out_dir, STORE_DIR)}
+
+
+def _summary(s):
+    sizes = ", ".join(f"{name}={size}" for name, size in s["dimension_sizes"].items())
+    reasons = s["failure_reasons"]
+    lines = [f"sweep '{s['sweep']}': {s['cases']} cases ({s['run']} run, "
+             f"{s['loaded']} loaded from the store), {s['failed']} failed, "
+             f"{s['wall_time_s']:.1f} s",
              f"dimensions: {sizes}"]
     lines += [f"  failed {case_id}: {reason}" for case_id, reason in list(reasons.items())[:10]]
     if len(reasons) > 10:
         lines.append(f"  ... and {len(reasons) - 10} more (attribute failure_reasons)")
-    lines.append(f"wrote {os.path.join(out_dir, RESULTS_FILE)} (cases in "
-                 f"{os.path.join(out_dir, STORE_DIR)}/)")
+    lines.append(f"wrote {s['output']} (cases in {s['store']}/)")
     return "\n".join(lines)

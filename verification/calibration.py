@@ -110,7 +110,7 @@ def log_ratios(shots, model, mapping, tables=None):
     return np.array([math.log(predict(s, model, mapping, tables) / s.depth) for s in shots])
 
 
-def fit(shots, option="derived-quasi-static", params=None, start=None, tables=None,
+def fit(shots, option="derived-dynamic", params=None, start=None, tables=None,
         progress=False):
     """Least-squares fit of ``params`` of the mapping for model ``option`` to ``shots``.
 
@@ -220,8 +220,8 @@ def calibration_text(calibration, shots_file, reference, command=None):
     lines = ["# cavex calibration, written by `cavex calibrate`.",
              *([f"# command: {command}"] if command else []),
              f"# [projectile] and [[layers]]: the calibrated target of shot '{reference.id}', so",
-             "# `cavex penetrate --config THIS_FILE` runs it (derived-dynamic: add",
-             "# --boundary dynamic; paper: --model paper). `cavex validate --calibration",
+             "# `cavex penetrate --config THIS_FILE` runs it (derived-quasi-static: add",
+             "# --boundary quasi-static; paper: --model paper). `cavex validate --calibration",
              "# THIS_FILE` reads [calibration] and applies its mapping to every shot.",
              "", "[calibration]",
              f"model = {_toml_string(calibration.option)}",
@@ -280,11 +280,12 @@ def read_calibration(path):
 
 # --- command-line job -------------------------------------------------------------------------
 
-def calibrate_main(shots_path, out_path, params=None, option="derived-quasi-static", ids=None,
-                   workers=None, scheduler=None, progress=None, command=None):
+def calibrate_main(shots_path, out_path, params=None, option="derived-dynamic", ids=None,
+                   workers=None, scheduler=None, progress=None, command=None, as_json=False):
     """The ``cavex calibrate`` job: read and check everything, fit, write ``out_path``.
 
-    Returns the summary text. Nothing is written when an input is refused or the fit fails.
+    Returns the summary text (``as_json``: :func:`summary_dict` as JSON). Nothing is written
+    when an input is refused or the fit fails.
     """
     from cavex.paths import check_output_file
     from cavex.verification.runner import check_execution, show_progress, write_text_atomic
@@ -308,13 +309,29 @@ def calibrate_main(shots_path, out_path, params=None, option="derived-quasi-stat
     if out.parent != Path(""):
         out.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(out, text)
-    stats = dict(calibration.statistics)
-    values = ", ".join(f"{p} = {getattr(calibration.mapping, p):.6g}" for p in params)
+    summary = summary_dict(calibration, seconds, out)
+    if as_json:
+        import json
+
+        return json.dumps(summary, indent=2)
+    values = ", ".join(f"{p} = {v:.6g}" for p, v in summary["fitted"].items())
     return "\n".join([
         f"model   {option} ({calibration.model}), {len(shots)} shots: "
         f"{', '.join(calibration.shots)}",
         f"fitted  {values}",
-        f"fit     mean |ln(predicted/measured)| {stats['mean_abs_log_ratio']:.4f}, rms "
-        f"{stats['rms_log_ratio']:.4f}, {stats['evaluations']} evaluations, {seconds:.1f} s",
+        f"fit     mean |ln(predicted/measured)| {summary['mean_abs_log_ratio']:.4f}, rms "
+        f"{summary['rms_log_ratio']:.4f}, {summary['evaluations']} evaluations, "
+        f"{seconds:.1f} s",
         f"wrote   {out}",
     ])
+
+
+def summary_dict(calibration, seconds, out):
+    """What ``cavex calibrate --json`` prints: the model, the fitted parameters (all
+    dimensionless), the mapping, the shots fitted, the fit statistics, the wall time and the
+    file written."""
+    return {"model": calibration.option, "params": list(calibration.params),
+            "fitted": {p: getattr(calibration.mapping, p) for p in calibration.params},
+            "mapping": calibration.mapping.as_dict(), "shots": list(calibration.shots),
+            **dict(calibration.statistics), "wall_time_s": float(seconds),
+            "output": str(out)}

@@ -15,6 +15,8 @@ from cavex.fem.output import write_result
 from cavex.paths import check_output_dir
 
 BOUNDARIES = ("dynamic", "quasi-static")
+#: Numerics settings renamed in JSON output (their unit appended)
+NUMERICS_JSON_KEYS = {"seed_radius": "seed_radius_m", "tension_cutoff": "tension_cutoff_Pa"}
 
 
 def fe_problem(target, projectile, depth, velocity, nu=None):
@@ -51,21 +53,29 @@ def comparison(depth, problem, result):
                 for b in BOUNDARIES}
     fe = result.cavity_stress
     return {
-        "depth": float(depth), "velocity": float(velocity), "radius": float(radius),
+        "depth_m": float(depth), "velocity_m_s": float(velocity),
+        "cavity_radius_m": float(radius),
         "layers": [m.name or f"layer {i}" for i, m in enumerate(layers)],
-        "interfaces": [float(h) for h in interfaces],
-        "interfaces_final": [float(h) for h in result.interfaces_final],
-        "fe_sigma_r": float(fe),
+        "interface_radii_m": [float(h) for h in interfaces],
+        "interface_radii_final_m": [float(h) for h in result.interfaces_final],
+        "fe_sigma_r_Pa": float(fe),
         "S": float(fe / layers[0].tau),
-        "analytic_sigma_r": {b: float(s.stress) for b, s in analytic.items()},
+        "analytic_sigma_r_Pa": {b: float(s.stress) for b, s in analytic.items()},
         "relative_difference": {b: float(fe / s.stress - 1.0) for b, s in analytic.items()},
         "error_estimate": None if result.error_estimate is None else float(result.error_estimate),
         "refinements": int(result.stats["refinements"]),
-        "fe_plastic_radius": float(result.plastic_radius),
-        "analytic_plastic_radius": {b: float(s.plastic_radius) for b, s in analytic.items()},
-        "settings": result.numerics,
-        "seconds": float(result.stats["seconds"]),
+        "fe_plastic_radius_m": float(result.plastic_radius),
+        "analytic_plastic_radius_m": {b: float(s.plastic_radius) for b, s in analytic.items()},
+        "numerics": numerics_json(result.numerics),
+        "wall_time_s": float(result.stats["seconds"]),
     }
+
+
+def numerics_json(numerics):
+    """:class:`cavex.fem.Numerics` settings (a dict) with the JSON key convention: the
+    dimensional ones carry their unit (``seed_radius_m``, ``tension_cutoff_Pa``; README
+    "Commands"), the others are dimensionless (``dilatancy_deg`` already names its unit)."""
+    return {NUMERICS_JSON_KEYS.get(k, k): v for k, v in numerics.items()}
 
 
 def compare_at_depth(target, projectile, depth, velocity, nu=None,
@@ -93,12 +103,14 @@ def compare_at_depth(target, projectile, depth, velocity, nu=None,
     Returns
     -------
     dict
-        ``fe_sigma_r``; ``analytic_sigma_r`` and ``relative_difference`` (``fe/analytic - 1``),
-        each a dict keyed ``"dynamic"`` and ``"quasi-static"``; ``error_estimate``,
-        ``refinements``; ``fe_plastic_radius`` and ``analytic_plastic_radius`` (dict); ``S``
-        (FE wall stress over the wall layer's tau); the problem (``depth``, ``velocity``,
-        ``radius``, ``layers``, ``interfaces``, ``interfaces_final``) and ``settings`` (the
-        numerics of the run reported).
+        ``fe_sigma_r_Pa``; ``analytic_sigma_r_Pa`` and ``relative_difference``
+        (``fe/analytic - 1``), each a dict keyed ``"dynamic"`` and ``"quasi-static"``;
+        ``error_estimate``, ``refinements``; ``fe_plastic_radius_m`` and
+        ``analytic_plastic_radius_m`` (dict); ``S`` (FE wall stress over the wall layer's
+        tau); the problem (``depth_m``, ``velocity_m_s``, ``cavity_radius_m``, ``layers``,
+        ``interface_radii_m``, ``interface_radii_final_m``), ``numerics`` (the settings of
+        the run reported, :func:`numerics_json`) and ``wall_time_s``. Keys follow the JSON
+        convention of README "Commands" (SI unit suffix on every dimensional quantity).
 
     Raises
     ------

@@ -10,20 +10,25 @@ import io
 from pathlib import Path
 
 from cavex.analytic.penetration import crater_depth, penetrate
-from cavex.analytic.resistance import ClosedFormResistance
+from cavex.analytic.resistance import ClosedFormResistance, check_model, model_boundary
 from cavex.config import load_config
 from cavex.verification.number_format import format_number
 from cavex.verification.runner import save_figure, write_text_atomic
 from cavex.verification.table2 import table2_comparison
 
 
-def penetration_job(target, projectile, *, model="derived", boundary="quasi-static",
+def penetration_job(target, projectile, *, model="derived", boundary=None,
                     epsilon="quasi-static", crater="nose-base", table_path=None):
     """Run the target and its first layer alone (the paper's Fig. 4 pair); nothing is written.
+
+    ``boundary`` None is the model's default: dynamic for the derived model, the paper's own
+    quasi-static for the paper model (:func:`cavex.analytic.resistance.model_boundary`).
 
     With ``table_path`` the runway uses the FE-tabulated resistance of that table (which must
     have been built for this target); the first layer alone keeps the closed form ``model``.
     """
+    check_model(model, boundary)
+    boundary = model_boundary(model, boundary)
     single = target.single(0)
     runs = {"runway": _runway(target, projectile, model, boundary, epsilon, crater, table_path),
             "first_layer_only": penetrate(single, projectile, ClosedFormResistance(

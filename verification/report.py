@@ -199,10 +199,10 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     Returns
     -------
     dict
-        ``out_dir``, ``files``, ``cells``, ``failed``, ``seconds`` (wall time), ``table_seconds``,
-        ``created`` (the FE table's creation time), ``conclusions`` (list of str), ``picture``
-        (message), ``stats``. The wall times and the creation time are not written into any
-        file (they would differ on every run).
+        ``out_dir``, ``files``, ``quick``, ``cells``, ``failed``, ``wall_time_s``,
+        ``table_wall_time_s``, ``created`` (the FE table's creation time), ``conclusions``
+        (list of str), ``picture`` (message), ``stats``. The wall times and the creation time
+        are not written into any file (they would differ on every run).
     """
     started = time.perf_counter()
     out = Path(out_dir)
@@ -241,7 +241,7 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
         markdown_to_html(markdown, "cavex verification report", base_dir=out), encoding="utf-8")
     files.update(report=str(out / "report.md"), html=str(out / "report.html"))
     return {"out_dir": str(out), "files": files, "conclusions": lines, "stats": stats, **info,
-            "seconds": time.perf_counter() - started, "table_seconds": table_seconds,
+            "wall_time_s": time.perf_counter() - started, "table_wall_time_s": table_seconds,
             "created": created}
 
 
@@ -325,11 +325,19 @@ def report_markdown(grid, target, stats, lines, trajectory, pic, paths, info):
     return "\n".join(md)
 
 
+def summary_dict(summary):
+    """What ``cavex verify --json`` prints: :func:`verify`'s result without ``stats`` (the
+    report and ``grid.nc`` hold the statistics)."""
+    return {k: summary[k] for k in ("out_dir", "files", "quick", "cells", "failed", "picture",
+                                    "conclusions", "wall_time_s", "table_wall_time_s",
+                                    "created")}
+
+
 def summary_text(summary):
     """Printable summary of :func:`verify`'s result."""
     return "\n".join([
         f"cells   {summary['cells']} ({summary['failed']} failed)",
-        f"time    {summary['seconds']:.1f} s (FE table {summary['table_seconds']:.1f} s, "
+        f"time    {summary['wall_time_s']:.1f} s (FE table {summary['table_wall_time_s']:.1f} s, "
         f"created {summary.get('created') or '?'})",
         f"figure  {summary['picture']}",
         *(f"- {line}" for line in summary["conclusions"]),
@@ -338,8 +346,9 @@ def summary_text(summary):
 
 
 def verify_main(config_path=None, quick=False, out_dir=None, scheduler=None, workers=None,
-                progress=None):
-    """The ``cavex verify`` job: load the config, write the report, return a printable summary."""
+                progress=None, as_json=False):
+    """The ``cavex verify`` job: load the config, write the report, return a printable summary
+    (``as_json``: :func:`summary_dict` as JSON)."""
     from cavex.config import default_config_text, load_config
 
     target, projectile = load_config(config_path)
@@ -349,6 +358,8 @@ def verify_main(config_path=None, quick=False, out_dir=None, scheduler=None, wor
     check_execution(workers, scheduler)
     summary = verify(target, projectile, quick=quick, out_dir=out_dir, scheduler=scheduler,
                      workers=workers, config_text=config, progress=progress)
+    if as_json:
+        return json.dumps(summary_dict(summary), indent=2)
     return summary_text(summary)
 
 

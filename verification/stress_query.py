@@ -5,17 +5,20 @@ import math
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.analytic.paper_model import paper_coefficients
-from cavex.analytic.resistance import check_model
+from cavex.analytic.resistance import check_model, model_boundary
 from cavex.errors import CavexNumericalError, require
 from cavex.materials import MAX_VELOCITY
 
 
-def stress_at_depth(target, projectile, depth, velocity, *, model="derived",
-                    boundary="quasi-static", epsilon="quasi-static"):
-    """JSON-able description of the cavity-wall stress at nose depth ``depth`` (m)."""
+def stress_at_depth(target, projectile, depth, velocity, *, model="derived", boundary=None,
+                    epsilon="quasi-static"):
+    """JSON-able description of the cavity-wall stress at nose depth ``depth`` (m); ``boundary``
+    None is the model's default (dynamic for the derived model, see
+    :func:`cavex.analytic.resistance.model_boundary`)."""
     require(math.isfinite(velocity) and 0.0 <= velocity <= MAX_VELOCITY, "velocity",
             f"in [0, {MAX_VELOCITY:g}] m/s", velocity)
     check_model(model, boundary)
+    boundary = model_boundary(model, boundary)
     if model == "paper":
         return _finite(_paper(target, projectile, depth, velocity, epsilon))
     layers, interfaces = spherical_problem(target, projectile, depth)

@@ -56,6 +56,10 @@ SWITCH_REFINEMENT = (2.0, 1.0, 0.5, 0.25, 0.125)  # depths L_s - f r added above
 SWITCH_OFFSET = 1e-9  # m: the switch node sits this far below the switch depth
 FIRST_LAYER_DEPTH = 0.0  # the single first-layer problem has no interfaces; any depth will do
 
+#: Deepest nose depth of a table (m): far below any rigid penetration; the grid's depths are
+#: rounded to 1e-12 m, which overflows beyond ~1e296 m.
+MAX_DEPTH = 1e3
+
 
 # --- target and projectile as TOML-schema data ------------------------------------------------
 
@@ -132,8 +136,8 @@ def check_grid(velocities, depths):
     require(np.unique(v).size >= 2, "velocities", "at least two different values", shown_v)
     require(v.min() == 0.0, "velocities",
             "a grid that includes V = 0 (the nose tip sees V cos(phi) -> 0)", shown_v)
-    require(d.ndim == 1 and np.all(np.isfinite(d)) and np.all(d >= 0.0), "depths",
-            "finite values >= 0 (m)", shown_d)
+    require(d.ndim == 1 and np.all(np.isfinite(d)) and np.all(d >= 0.0)
+            and np.all(d <= MAX_DEPTH), "depths", f"values in [0, {MAX_DEPTH:g}] m", shown_d)
     require(np.unique(d).size >= 2, "depths", "at least two different values", shown_d)
 
 
@@ -207,9 +211,9 @@ def _cells(results, cases, velocities, depths):
             failures.append({"velocity": float(case["velocity"]), "depth": float(case["depth"]),
                              "reason": str(result.get("reason", ""))})
             continue
-        out["sigma_r"][i, j] = result["fe_sigma_r"]
+        out["sigma_r"][i, j] = result["fe_sigma_r_Pa"]
         out["S"][i, j] = result["S"]
-        out["plastic_radius"][i, j] = result["fe_plastic_radius"]
+        out["plastic_radius"][i, j] = result["fe_plastic_radius_m"]
         estimate = result.get("error_estimate")
         out["error_estimate"][i, j] = np.nan if estimate is None else estimate
     return {**out, "failed": failed, "failures": failures}
@@ -224,7 +228,7 @@ def settings_json(nu, numerics, error_target=DEFAULT_ERROR_TARGET):
                        "error_target": error_target, "switch": "cavity"}, sort_keys=True)
 
 
-def analytic_table(target, projectile, velocities, depths, boundary="quasi-static",
+def analytic_table(target, projectile, velocities, depths, boundary="dynamic",
                    refine=SWITCH_REFINEMENT):
     """A table filled from the closed form instead of the FE (for tests and comparisons).
 
@@ -382,8 +386,10 @@ STORE_SUFFIX = ".cases"  # cavex table's resumable case store: <out>.cases/ unti
 
 
 def table_main(config_path=None, velocities=None, depths=None, out_path="results/table.nc",
-               nu=None, workers=None, scheduler=None, numerics=None, progress=None):
-    """The ``cavex table`` job: build, write and summarise a table; returns the summary text.
+               nu=None, workers=None, scheduler=None, numerics=None, progress=None,
+               as_json=False):
+    """The ``cavex table`` job: build, write and summarise a table; returns the summary text
+    (``as_json``: :func:`summary_dict` as JSON).
 
     The output location, the grid, ``workers`` and ``scheduler`` are checked before any FE
     work; finished cells are kept in ``<out>.cases/`` while the table is built, so that a killed
@@ -407,20 +413,34 @@ def table_main(config_path=None, velocities=None, depths=None, out_path="results
     seconds = time.perf_counter() - start
     written = write_table(ds, out_path)
     shutil.rmtree(store, ignore_errors=True)  # the table holds every cell now
+    if as_json:
+        return json.dumps(summary_dict(ds, seconds, written), indent=2)
     return summary_text(ds, seconds, written)
+
+
+def summary_dict(ds, seconds, path):
+    """What ``cavex table --json`` prints: FE cases (the grid plus the first layer alone),
+    the grid's axes, failed cells, the largest error estimate (None: none estimated), the wall
+    time and the file written."""
+    estimate = float(np.nanmax(ds["error_estimate"])) if np.any(
+        np.isfinite(ds["error_estimate"])) else None
+    return {"cases": ds.sizes["velocity"] * (ds.sizes["depth"] + 1),
+            "velocities_m_s": [float(x) for x in ds["velocity"].values],
+            "depths_m": [float(x) for x in ds["depth"].values],
+            "failed": int(ds["failed"].sum()) + int(ds["failed_first_layer"].sum()),
+            "max_error_estimate": estimate, "wall_time_s": float(seconds),
+            "output": str(path)}
 
 
 def summary_text(ds, seconds, path):
     """Cases, failed cells, time and path of a built table, one item per line."""
-    cells = ds.sizes["velocity"] * (ds.sizes["depth"] + 1)
-    failed = int(ds["failed"].sum()) + int(ds["failed_first_layer"].sum())
-    estimate = float(np.nanmax(ds["error_estimate"])) if np.any(
-        np.isfinite(ds["error_estimate"])) else math.nan
-    v, d = ds["velocity"].values, ds["depth"].values
+    s = summary_dict(ds, seconds, path)
+    v, d = s["velocities_m_s"], s["depths_m"]
+    estimate = math.nan if s["max_error_estimate"] is None else s["max_error_estimate"]
     return "\n".join([
-        f"cases   {cells} ({ds.sizes['velocity']} velocities {v[0]:g}..{v[-1]:g} m/s x "
-        f"{ds.sizes['depth']} depths {d[0]:g}..{d[-1]:g} m, + first layer alone)",
-        f"failed  {failed}",
+        f"cases   {s['cases']} ({len(v)} velocities {v[0]:g}..{v[-1]:g} m/s x "
+        f"{len(d)} depths {d[0]:g}..{d[-1]:g} m, + first layer alone)",
+        f"failed  {s['failed']}",
         f"largest FE error estimate {estimate:.3%}",
         f"time    {seconds:.1f} s",
         f"wrote   {path}",

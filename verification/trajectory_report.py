@@ -8,25 +8,33 @@ interfaces marked, a 3-D view of the path in the layered block (pyvista, off-scr
 """
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.oblique import Shot, fly
+from cavex.analytic.oblique import CONTACT_RAMP, Shot, fly
 from cavex.analytic.surface_force import rotation_matrix as rotation
+from cavex.errors import require
 from cavex.paths import check_output_dir
 from cavex.verification.number_format import format_number
 from cavex.verification.runner import save_figure, write_text_atomic
 
 DEFAULT_DIR = "results/trajectory"
+MIN_CONTACT_RAMP = 0.01  # m/s: ~10x the default's run time
 
 
-def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="quasi-static",
+def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="dynamic",
                    free_surface=True, table=None, law_A=None, law_B=None,
-                   compare_homogeneous=False):
+                   compare_homogeneous=False, contact_ramp=None):
     """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``."""
+    contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
+    # the command keeps the regularisation on: without it (or far below the default) an
+    # oblique shot's sliding shank needs millions of steps (docs/oblique.md)
+    require(math.isfinite(contact_ramp) and MIN_CONTACT_RAMP <= contact_ramp <= 100.0,
+            "contact_ramp", f"in [{MIN_CONTACT_RAMP:g}, 100] m/s", contact_ramp)
     options = {"boundary": boundary, "free_surface": free_surface, "table": table,
-               "law_A": law_A, "law_B": law_B}
+               "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp}
     if table is not None:
         from cavex.verification.table import load_table
         options["table"] = load_table(table)
@@ -42,7 +50,7 @@ def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="
     settings = {"speed_m_s": shot.speed, "obliquity_deg": shot.obliquity,
                 "attack_deg": shot.attack, "attack_plane_deg": shot.attack_plane,
                 "spin_rad_s": shot.spin, "resistance": resistance, "boundary": boundary,
-                "free_surface": free_surface}
+                "free_surface": free_surface, "contact_ramp_m_s": contact_ramp}
     return {"runs": runs, "settings": settings, "target": target}
 
 
@@ -95,12 +103,23 @@ def figures(job, folder):
     picture = view_3d(job, folder / "path_3d.png")
     if picture:
         written.append(picture)
-    return written
+    return [str(path) for path in written]
 
 
 def _interfaces(ax, target, vertical=True):
     for H in target.interface_depths:
         (ax.axhline if vertical else ax.axvline)(H, color="0.5", lw=0.8, ls="--")
+
+
+def _layer_names(ax, target):
+    """Each layer's name at the right edge of a side view, at the middle of its depth range
+    (the last one just below the last interface)."""
+    tops = [0.0, *target.interface_depths]
+    bottom = ax.get_ylim()[0]  # the axis is inverted: ylim = (deepest, shallowest)
+    for k, layer in enumerate(target.layers):
+        low = tops[k + 1] if k + 1 < len(tops) else max(bottom, tops[k] + 0.1)
+        ax.text(1.01, 0.5 * (tops[k] + low), layer.name or f"layer {k + 1}",
+                transform=ax.get_yaxis_transform(), va="center", fontsize=8, color="0.3")
 
 
 def outline_points(result, y):
@@ -134,17 +153,20 @@ def side_view(job, path):
     ax.axhline(0.0, color="k", lw=1)
     ax.set_aspect("equal")
     ax.invert_yaxis()
+    _layer_names(ax, target)
     ax.set_xlabel("x (m, horizontal, plane of obliquity)")
     ax.set_ylabel("z (m, depth)")
     ax.set_title(_title(job) + "\nprojectile outline at 9 equal time intervals")
-    ax.legend(fontsize=8, loc="lower left")
+    ax.legend(fontsize=8, loc="upper right")
     return save_figure(fig, path, dpi=120, bbox_inches="tight")
 
 
 def _title(job):
     s = job["settings"]
+    law = s["resistance"] + (f" {s['boundary']}" if s["resistance"] == "derived" else "")
     return (f"V0 = {s['speed_m_s']:g} m/s, obliquity {s['obliquity_deg']:g} deg, attack "
-            f"{s['attack_deg']:g} deg, resistance {s['resistance']}")
+            f"{s['attack_deg']:g} deg; resistance {law}, contact ramp "
+            f"{s['contact_ramp_m_s']:g} m/s")
 
 
 def pitch_time(job, path):
@@ -175,7 +197,7 @@ def overloads(job, path):
             axes[row, 0].plot(h["t_s"] * 1e3, h[key] / 1e3, color=f"C{k}", label=name)
             axes[row, 1].plot(h["tip_z_m"], h[key] / 1e3, color=f"C{k}", label=name)
     for row, key in enumerate(("axial", "lateral")):
-        axes[row, 0].set_ylabel(f"{key} overload (10^3 g)")
+        axes[row, 0].set_ylabel(f"{key} overload (thousands of g)")
         axes[row, 0].set_xlabel("t (ms)")
         axes[row, 1].set_xlabel("nose-tip depth (m); dashed: interfaces")
         _interfaces(axes[row, 1], job["target"], vertical=False)
@@ -191,8 +213,12 @@ def view_3d(job, path):
     cannot render here (no OpenGL)."""
     try:
         import pyvista as pv
+        from vtkmodules.vtkCommonCore import vtkLogger
     except ImportError:  # pragma: no cover
         return None
+    # no display here: VTK falls back to off-screen rendering but first logs a coloured
+    # "bad X server connection" warning on stderr; the picture is the same
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
     target = job["target"]
     result = job["runs"]["runway"]
     h = result.history
@@ -236,24 +262,54 @@ def view_3d(job, path):
 
 def trajectory_main(args, target, projectile):
     """``cavex trajectory``: checks, runs, writes, returns the text to print."""
-    from cavex.errors import CavexInputError
+    import math
+
+    from cavex.errors import CavexInputError, CavexNumericalError, require
+    from cavex.materials import MAX_VELOCITY
+    from cavex.paths import staged_output
 
     if (args.resistance == "table") != (args.table is not None):
         raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
                               "neither)")
-    if (args.resistance == "law") != (args.law_A is not None and args.law_B is not None):
+    law = [args.law_A is not None, args.law_B is not None]
+    if not all(law) if args.resistance == "law" else any(law):
         raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
                               "'--resistance law' (all or none)")
     folder = check_output_dir(args.out, "out")
-    shot = Shot(projectile.V0 if args.velocity is None else args.velocity, args.obliquity,
-                args.attack, args.attack_plane, args.spin)
+    speed = projectile.V0 if args.velocity is None else args.velocity
+    require(math.isfinite(speed) and 0.0 < speed <= MAX_VELOCITY, "velocity",
+            f"in (0, {MAX_VELOCITY:g}] m/s", speed)
+    top = MAX_VELOCITY / projectile.r  # the shank's surface speed <= MAX_VELOCITY
+    require(math.isfinite(args.spin) and abs(args.spin) <= top, "spin",
+            f"in [-{top:g}, {top:g}] rad/s (shank surface speed <= {MAX_VELOCITY:g} m/s)",
+            args.spin)
+    shot = Shot(speed, args.obliquity, args.attack, args.attack_plane, args.spin)
     projectile.body_length  # noqa: B018 (a projectile without a length refuses here)
-    job = trajectory_job(target, projectile, shot, args.resistance, boundary=args.boundary,
-                         free_surface=not args.no_free_surface, table=args.table,
-                         law_A=args.law_A, law_B=args.law_B,
-                         compare_homogeneous=args.compare_homogeneous)
-    written = write_outputs(job, folder)
+    try:  # forces beyond the body's mass and inertia overflow (warnings, then a bogus end)
+        with np.errstate(over="raise", invalid="raise"):
+            job = trajectory_job(target, projectile, shot, args.resistance,
+                                 boundary=args.boundary, free_surface=not args.no_free_surface,
+                                 table=args.table, law_A=args.law_A, law_B=args.law_B,
+                                 compare_homogeneous=args.compare_homogeneous,
+                                 contact_ramp=args.contact_ramp)
+    except FloatingPointError as exc:
+        raise CavexNumericalError(f"the trajectory overflowed ({exc}): forces far beyond the "
+                                  "projectile's mass and inertia") from None
+    for name, result in job["runs"].items():  # nothing but finite numbers is written
+        finite = all(np.all(np.isfinite(v)) for v in result.history.values())
+        if not finite or result.phases[-1]["end_time_s"] <= 0.0:
+            raise CavexNumericalError(
+                f"the {name} trajectory " + ("is not finite" if not finite else
+                "ended at t = 0 s: the integrator could not advance (a shot too slow, or "
+                "forces far beyond the projectile's mass and inertia)"))
     runs = {k: summary(v) for k, v in job["runs"].items()}
+    try:  # the peaks and rates too (a repeated time sample gives an infinite rate)
+        json.dumps(runs, allow_nan=False)
+    except ValueError:
+        raise CavexNumericalError("the trajectory summary is not finite (peaks, pitch "
+                                  "rate)") from None
+    with staged_output(folder) as stage:  # every file or none, also on Ctrl-C or kill
+        written = [str(folder / Path(path).name) for path in write_outputs(job, stage)]
     if args.json:
         main = runs["runway"]
         return json.dumps({"end": main["end"], "phases": main["phases"],

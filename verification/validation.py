@@ -236,10 +236,10 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     Returns
     -------
     dict
-        ``shots`` (``id``, ``V0``, ``fc``, ``rho``, ``measured``, ``predicted`` and ``ratio``
-        per model), ``summary`` (per model, all shots), ``held_out`` (ids in no calibration's
-        fit) and ``held_out_summary`` (with calibrations), ``failures``, ``models``,
-        ``calibrations``.
+        ``shots`` (``id``, ``V0_m_s``, ``fc_Pa``, ``rho_kg_m3``, ``measured_m``,
+        ``predicted_m`` and ``ratio`` per model), ``summary`` (per model, all shots),
+        ``held_out`` (ids in no calibration's fit) and ``held_out_summary`` (with
+        calibrations), ``failures``, ``models``, ``calibrations``.
     """
     mapping = mapping or Mapping()
     columns = {name: (name, mapping) for name in MODELS}
@@ -252,8 +252,9 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     for i, shot in enumerate(shots):
         predicted = {name: depths[name][i] for name in columns}
         ratio = {name: None if d is None else d / shot.depth for name, d in predicted.items()}
-        rows.append({"id": shot.id, "V0": shot.V0, "fc": shot.fc, "rho": shot.rho,
-                     "measured": shot.depth, "predicted": predicted, "ratio": ratio})
+        rows.append({"id": shot.id, "V0_m_s": shot.V0, "fc_Pa": shot.fc,
+                     "rho_kg_m3": shot.rho, "measured_m": shot.depth, "predicted_m": predicted,
+                     "ratio": ratio})
     fitted = {i for c in calibrations for i in c.shots}
     held_out = [row["id"] for row in rows if row["id"] not in fitted]
     result = {"models": list(columns), "mapping": mapping.as_dict(),

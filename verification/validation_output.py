@@ -50,7 +50,7 @@ def validate_main(shots_path, calibration_paths=(), out_dir=None, as_json=False,
     if repeated:
         raise CavexInputError(f"two calibrations of the same model ({', '.join(repeated)}); "
                               "give one per model")
-    out = check_output_dir(out_dir or DEFAULT_OUT, "out")
+    out = check_output_dir(DEFAULT_OUT if out_dir is None else out_dir, "out")
     check_execution(workers, scheduler)
     began = time.monotonic()
     result = run(shot_file, calibrations, tables_dir=out / "tables", workers=workers,
@@ -78,9 +78,9 @@ def run(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
         columns = {COMPRESSIBILITY_COLUMN: (FE_MODEL, dynamic[0].mapping)}
         depths, failures = predictions(shot_file.shots, columns, tables, progress)
         for row, depth in zip(result["shots"], depths[COMPRESSIBILITY_COLUMN], strict=True):
-            row["predicted"][COMPRESSIBILITY_COLUMN] = depth
+            row["predicted_m"][COMPRESSIBILITY_COLUMN] = depth
             row["ratio"][COMPRESSIBILITY_COLUMN] = None if depth is None else \
-                depth / row["measured"]
+                depth / row["measured_m"]
         result["failures"].update(failures)
         result["compressibility_column"] = COMPRESSIBILITY_COLUMN
         result["summary"] = summaries(result["shots"], list(result["summary"]) +
@@ -126,9 +126,9 @@ def predictions_csv(result):
     writer.writerow(["id", "V0_m_s", "fc_Pa", "rho_kg_m3", "measured_m"]
                     + [f"{slug(m)}_m" for m in models] + [f"{slug(m)}_ratio" for m in models])
     for row in result["shots"]:
-        writer.writerow([row["id"], _g(row["V0"]), _g(row["fc"]), _g(row["rho"]),
-                         _g(row["measured"])]
-                        + [_g(row["predicted"][m]) for m in models]
+        writer.writerow([row["id"], _g(row["V0_m_s"]), _g(row["fc_Pa"]), _g(row["rho_kg_m3"]),
+                         _g(row["measured_m"])]
+                        + [_g(row["predicted_m"][m]) for m in models]
                         + [_g(row["ratio"][m]) for m in models])
     return text.getvalue()
 
@@ -177,8 +177,9 @@ def compressibility(result, column):
     ``column`` is the FE column; its closed-form partner is ``derived dynamic`` (uncalibrated
     mapping) or ``derived dynamic calibrated`` (the compressibility column)."""
     partner = "derived dynamic" if column == FE_MODEL else "derived dynamic calibrated"
-    ratios = [row["predicted"][column] / row["predicted"][partner] for row in result["shots"]
-              if row["predicted"].get(column) and row["predicted"].get(partner)]
+    ratios = [row["predicted_m"][column] / row["predicted_m"][partner]
+              for row in result["shots"]
+              if row["predicted_m"].get(column) and row["predicted_m"].get(partner)]
     if not ratios:
         return None
     return float(np.min(ratios)), float(np.median(ratios)), float(np.max(ratios))
@@ -244,10 +245,10 @@ def report_markdown(result):
               + " | ".join(models) + " |",
               "|---|---:|---:|---:|" + "---:|" * len(models)]
     for row in shots:
-        cells = [f"{row['predicted'][m] * 1e3:.1f} ({row['ratio'][m]:.3f})"
-                 if row["predicted"][m] is not None else "failed" for m in models]
-        lines.append(f"| {row['id']} | {row['V0']:g} | {row['fc'] / 1e6:g} | "
-                     f"{row['measured'] * 1e3:g} | " + " | ".join(cells) + " |")
+        cells = [f"{row['predicted_m'][m] * 1e3:.1f} ({row['ratio'][m]:.3f})"
+                 if row["predicted_m"][m] is not None else "failed" for m in models]
+        lines.append(f"| {row['id']} | {row['V0_m_s']:g} | {row['fc_Pa'] / 1e6:g} | "
+                     f"{row['measured_m'] * 1e3:g} | " + " | ".join(cells) + " |")
     lines += ["", "![predicted against measured](predicted_vs_measured.png)", "",
               "![ratio against striking velocity](ratio_vs_velocity.png)", ""]
     if result["failures"]:
@@ -269,8 +270,8 @@ def write_figures(result, out):
                FE_MODEL: "D", EMPIRICAL: "*"}
     colours = dict(zip([*CLOSED_FORMS, FE_MODEL, EMPIRICAL],
                        ["tab:blue", "tab:orange", "tab:green", "tab:red", "black"], strict=True))
-    measured = np.array([row["measured"] for row in result["shots"]])
-    velocity = np.array([row["V0"] for row in result["shots"]])
+    measured = np.array([row["measured_m"] for row in result["shots"]])
+    velocity = np.array([row["V0_m_s"] for row in result["shots"]])
     held = set(result.get("held_out", []))
     written = []
     for name, x_of in (("predicted_vs_measured.png", None), ("ratio_vs_velocity.png", velocity)):
@@ -278,8 +279,8 @@ def write_figures(result, out):
         for model in result["models"]:
             base = next(b for b in MODELS if model.startswith(b))
             calibrated = model != base
-            y = np.array([np.nan if row["predicted"][model] is None else row["predicted"][model]
-                          for row in result["shots"]])
+            y = np.array([np.nan if row["predicted_m"][model] is None
+                          else row["predicted_m"][model] for row in result["shots"]])
             style = {"marker": markers[base], "color": colours[base], "linestyle": "none",
                      "markersize": 7 if base != EMPIRICAL else 10, "label": model,
                      "markerfacecolor": colours[base] if calibrated or base == EMPIRICAL
