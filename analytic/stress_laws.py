@@ -39,7 +39,7 @@ from cavex.errors import CavexInputError, CavexNumericalError, require
 HORIZONTAL = 1e-12  # |n_z| below which a normal counts as horizontal
 FAR = 1e6  # m: interface radius standing for "never met"
 DEPTH_QUADRATIC, TABLE, DERIVED = range(3)
-OK, WALK_FAILED, BEYOND_TABLE = range(3)
+OK, WALK_FAILED, BEYOND_TABLE, NOT_FINITE = range(4)
 BOUNDARIES = ("dynamic", "quasi-static")
 RESISTANCES = ("derived", "paper", "table", "law")
 _EMPTY1 = np.empty(0)
@@ -139,6 +139,9 @@ def raise_for(status, vn):
     if status == WALK_FAILED:
         raise CavexNumericalError("dynamic elastic-plastic boundary did not converge on a "
                                   f"surface element (V_n = {vn:.6g} m/s)")
+    if status == NOT_FINITE:
+        raise CavexNumericalError("the equations of motion are not finite (forces far beyond "
+                                  "the projectile's mass and inertia)")
     raise CavexInputError(f"parameter 'table' must reach the normal velocity {vn:.6g} m/s of "
                           "a surface element (its velocities stop below it: build it to a "
                           "higher velocity, `cavex table --velocities`)")

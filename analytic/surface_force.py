@@ -35,7 +35,7 @@ import math
 import numpy as np
 from numba import njit
 
-from cavex.analytic.stress_laws import OK, element_stress
+from cavex.analytic.stress_laws import NOT_FINITE, OK, element_stress
 
 ROUND_OFF = 1e-9  # normal velocities below this x the body's velocity scale count as zero
 
@@ -191,4 +191,8 @@ def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length
     dy[11] = (moment[1] - (w2 * i0 * w0 - w0 * i2 * w2)) / i1
     dy[12] = (moment[2] - (w0 * i1 * w1 - w1 * i0 * w0)) / i2
     dy[13] = power
+    if status == OK:
+        for k in range(14):
+            if not math.isfinite(dy[k]):
+                return dy, NOT_FINITE, vn
     return dy, status, vn

@@ -5,12 +5,13 @@ import json
 import os
 import re
 import sys
+from pathlib import Path
 
 from cavex import __version__
 from cavex.analytic.paper_model import EPSILON_READINGS
 from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
-from cavex.paths import check_output_dir
+from cavex.paths import check_output_dir, staged_output
 
 DEFAULT_PENETRATION_DIR = "results/penetration"
 
@@ -219,7 +220,9 @@ def _penetrate(args, target, projectile):
     check_output_dir(args.out, "out")
     job = penetration_job(target, projectile, model=args.model, boundary=args.boundary,
                           epsilon=args.epsilon, crater=args.crater, table_path=args.table)
-    written = write_outputs(job, args.out)
+    folder = Path(args.out)
+    with staged_output(folder) as stage:  # every file or none, also on Ctrl-C or kill
+        written = [str(folder / Path(path).name) for path in write_outputs(job, stage)]
     phases = phases_as_dicts(job["runs"]["runway"])
     if args.json:
         settings = {k: job[k] for k in ("model", "boundary", "epsilon", "crater",
