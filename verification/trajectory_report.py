@@ -262,9 +262,7 @@ def view_3d(job, path):
 
 def trajectory_main(args, target, projectile):
     """``cavex trajectory``: checks, runs, writes, returns the text to print."""
-    import math
-
-    from cavex.errors import CavexInputError, CavexNumericalError, require
+    from cavex.errors import CavexInputError, CavexNumericalError
     from cavex.materials import MAX_VELOCITY
     from cavex.paths import staged_output
 
@@ -276,9 +274,7 @@ def trajectory_main(args, target, projectile):
         raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
                               "'--resistance law' (all or none)")
     folder = check_output_dir(args.out, "out")
-    speed = projectile.V0 if args.velocity is None else args.velocity
-    require(math.isfinite(speed) and 0.0 < speed <= MAX_VELOCITY, "velocity",
-            f"in (0, {MAX_VELOCITY:g}] m/s", speed)
+    speed = projectile.V0 if args.velocity is None else args.velocity  # Shot checks it
     top = MAX_VELOCITY / projectile.r  # the shank's surface speed <= MAX_VELOCITY
     require(math.isfinite(args.spin) and abs(args.spin) <= top, "spin",
             f"in [-{top:g}, {top:g}] rad/s (shank surface speed <= {MAX_VELOCITY:g} m/s)",
