@@ -594,3 +594,34 @@ def test_a_run_that_reaches_the_time_limit_ends_there():
     assert result.phases[-1]["end_reason"] == "time limit"
     assert result.end["state"] == "time limit" and result.end["time_s"] == MAX_TIME
     assert result.end["nose_tip_m"] == result.phases[-1]["end_nose_tip_m"]
+
+
+def test_verify_writes_its_report_complete_or_not_at_all(tmp_path, monkeypatch):
+    """A verify run that fails (or is interrupted) after writing part of its report leaves the
+    previous report in place and no hidden folder behind; a finished one replaces it."""
+    from cavex.verification import report
+
+    out = tmp_path / "report"
+    out.mkdir()
+    (out / "report.md").write_text("old report")
+
+    def failing(target, projectile, *, out_dir, **options):
+        (Path(out_dir) / "report.md").write_text("half a new report")
+        raise KeyboardInterrupt("signal 2")
+
+    monkeypatch.setattr(report, "verify", failing)
+    with pytest.raises(KeyboardInterrupt):
+        report.verify_main(out_dir=out)
+    assert sorted(p.name for p in out.iterdir()) == ["report.md"]
+    assert (out / "report.md").read_text() == "old report"
+
+    def finishing(target, projectile, *, out_dir, **options):
+        (Path(out_dir) / "report.md").write_text("new report")
+        return {"out_dir": str(out_dir), "files": {"report": str(Path(out_dir) / "report.md")},
+                "quick": True}
+
+    monkeypatch.setattr(report, "verify", finishing)
+    monkeypatch.setattr(report, "summary_text", lambda summary: summary["files"]["report"])
+    assert report.verify_main(out_dir=out) == str(out / "report.md")
+    assert sorted(p.name for p in out.iterdir()) == ["report.md"]
+    assert (out / "report.md").read_text() == "new report"

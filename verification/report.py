@@ -22,7 +22,7 @@ import numpy as np
 
 from cavex.errors import CavexInputError
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
-from cavex.paths import check_output_dir
+from cavex.paths import check_output_dir, staged_output
 from cavex.verification import report_plots as plots
 from cavex.verification import report_text as text
 from cavex.verification.number_format import TRAJECTORY_DIGITS, round_dataset, round_nested
@@ -345,6 +345,13 @@ def summary_text(summary):
     ])
 
 
+def _moved(summary, stage, out_dir):
+    """``summary`` with the paths of the staged files in ``stage`` moved to ``out_dir``."""
+    files = {k: str(Path(out_dir) / Path(v).relative_to(stage))
+             for k, v in summary["files"].items()}
+    return {**summary, "out_dir": str(out_dir), "files": files}
+
+
 def verify_main(config_path=None, quick=False, out_dir=None, scheduler=None, workers=None,
                 progress=None, as_json=False):
     """The ``cavex verify`` job: load the config, write the report, return a printable summary
@@ -356,8 +363,13 @@ def verify_main(config_path=None, quick=False, out_dir=None, scheduler=None, wor
         encoding="utf-8")
     out_dir = check_output_dir(DEFAULT_OUT if out_dir is None else out_dir, "out")
     check_execution(workers, scheduler)
-    summary = verify(target, projectile, quick=quick, out_dir=out_dir, scheduler=scheduler,
-                     workers=workers, config_text=config, progress=progress)
+    # the report is written into a hidden folder and moved in complete: Ctrl-C or kill leaves
+    # the previous report as it was, or (if that was removed) no report, never a partial one
+    with staged_output(out_dir) as stage:
+        summary = verify(target, projectile, quick=quick, out_dir=stage, scheduler=scheduler,
+                         workers=workers, config_text=config, progress=progress)
+        remove_report_files(out_dir)  # an old report never mixes with this one
+    summary = _moved(summary, stage, out_dir)
     if as_json:
         return json.dumps(summary_dict(summary), indent=2)
     return summary_text(summary)
