@@ -625,3 +625,16 @@ def test_verify_writes_its_report_complete_or_not_at_all(tmp_path, monkeypatch):
     assert report.verify_main(out_dir=out) == str(out / "report.md")
     assert sorted(p.name for p in out.iterdir()) == ["report.md"]
     assert (out / "report.md").read_text() == "new report"
+
+
+def test_compare_homogeneous_needs_two_layers(capsys, tmp_path):
+    """It was silently ignored: the first layer alone is the target itself."""
+    from cavex.config import default_config_text
+
+    text = default_config_text()
+    one_layer = text[:text.index("[[layers]]", text.index("[[layers]]") + 1)]
+    one_layer = one_layer.replace("thickness = 0.65\n", "")
+    config = tmp_path / "one_layer.toml"
+    config.write_text(one_layer)
+    refused(capsys, tmp_path, ["trajectory", "--config", config, *LAW, "--compare-homogeneous",
+                               "--out", tmp_path / "o"], "--compare-homogeneous")

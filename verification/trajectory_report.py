@@ -273,6 +273,9 @@ def trajectory_main(args, target, projectile):
     if not all(law) if args.resistance == "law" else any(law):
         raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
                               "'--resistance law' (all or none)")
+    if args.compare_homogeneous and len(target.layers) < 2:
+        raise CavexInputError("option '--compare-homogeneous' needs a target of two or more "
+                              "layers (this one is its first layer alone already)")
     folder = check_output_dir(args.out, "out")
     speed = projectile.V0 if args.velocity is None else args.velocity  # Shot checks it
     top = MAX_VELOCITY / projectile.r  # the shank's surface speed <= MAX_VELOCITY
