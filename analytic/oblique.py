@@ -67,11 +67,14 @@ class Shot:
         require(math.isfinite(self.spin), "spin", "finite (rad/s)", self.spin)
 
     def initial_axes(self):
-        """``(velocity direction, axis, body e2, body e3)`` in the target frame."""
+        """``(velocity direction, axis, body e2, body e3)`` in the target frame, for
+        ``obliquity >= 0`` (:meth:`ObliqueModel.initial_state` builds a negative obliquity as
+        the mirror image of the positive one)."""
+        require(self.obliquity >= 0.0, "obliquity", ">= 0 here (mirror the shot)",
+                self.obliquity)
         th = math.radians(self.obliquity)
         d = np.array([math.sin(th), 0.0, math.cos(th)])
-        side = -1.0 if self.obliquity < 0 else 1.0  # negative obliquity: the mirror shot
-        ep = np.array([side * math.cos(th), 0.0, -abs(math.sin(th))])  # toward the surface
+        ep = np.array([math.cos(th), 0.0, -math.sin(th)])  # toward the surface
         ey = np.array([0.0, 1.0, 0.0])
         al, ps = math.radians(self.attack), math.radians(self.attack_plane)
         turn = math.cos(ps) * ep + math.sin(ps) * ey
