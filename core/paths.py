@@ -10,6 +10,7 @@ writes.
 import os
 import shutil
 import signal
+import sys
 import tempfile
 import threading
 from contextlib import contextmanager
@@ -89,6 +90,16 @@ def staged_output(folder):
         caught = [s for s in (signal.SIGINT, signal.SIGTERM)
                   if signal.getsignal(s) is not signal.SIG_IGN]
     previous = [signal.signal(s, interrupt) for s in caught]
+    # an interrupt raised inside a finaliser or a garbage-collector callback is "unraisable":
+    # Python would print it as a multi-line "Exception ignored in ..." report; it is recorded
+    # in ``received`` and raised below instead
+    unraisable = sys.unraisablehook
+
+    def quiet(report):
+        if not (received and issubclass(report.exc_type, KeyboardInterrupt)):
+            unraisable(report)
+
+    sys.unraisablehook = quiet
     try:
         yield stage
         held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
@@ -100,6 +111,7 @@ def staged_output(folder):
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, held)
     finally:
+        sys.unraisablehook = unraisable
         for s, handler in zip(caught, previous, strict=True):
             signal.signal(s, signal.SIG_DFL if handler is None else handler)
         shutil.rmtree(stage, ignore_errors=True)

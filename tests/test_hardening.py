@@ -582,7 +582,7 @@ def test_ctrl_c_during_a_trajectory_run(tmp_path):
     process.send_signal(signal.SIGINT)
     stdout, stderr = process.communicate(timeout=60)
     assert process.returncode == 130, (stdout, stderr)
-    assert stderr.splitlines() == ["cavex: interrupted"] and stdout == ""
+    assert stderr.splitlines() == ["cavex: interrupted"] and stdout == "", (stdout, stderr)
     assert not out.exists()
 
 
