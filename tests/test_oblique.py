@@ -240,3 +240,32 @@ def test_default_runway_at_normal_incidence_against_the_1d_integrator(runway):
     assert three_d == without
     assert 0.0 < three_d - tunnel < body.nose_length
     assert crater > three_d
+
+
+def test_events_end_each_phase_where_they_say(runway):
+    """Interface crossings, axis parallel to the surface, ricochet and perforation stop the
+    integration exactly on their event surfaces (to the root finder's tolerance)."""
+    target, projectile = runway
+    law = {"law_A": 2e8, "law_B": 2500.0, "contact_ramp": 1.0}
+    deep = fly(target, projectile, Shot(900.0, obliquity=10.0), "law", **law)
+    crossings = [ph for ph in deep.phases if ph["end_reason"].startswith("nose tip crossed")]
+    assert len(crossings) == 2
+    for phase, H in zip(crossings, target.interface_depths, strict=True):
+        assert phase["end_nose_tip_m"][2] == pytest.approx(H, abs=1e-9)
+    assert [ph["label"] for ph in deep.phases] == ["concrete", "macadam", "soil"]
+    assert deep.end["state"] == "stopped"
+
+    grazing = fly(target.single(0), projectile, Shot(300.0, obliquity=75.0), "law", **law)
+    reasons = [ph["end_reason"] for ph in grazing.phases]
+    assert reasons == ["axis parallel to the surface",
+                       "ricochet: left the target through the entry face"]
+    assert grazing.phases[0]["end_pitch_deg"] == pytest.approx(90.0, abs=1e-6)
+    end = grazing.solutions[-1].y[:, -1]
+    assert grazing.end["state"] == "ricochet"
+    assert grazing.model.extreme_depths(end)[0] == pytest.approx(0.0, abs=1e-9)
+
+    through = fly(target.single(0), projectile, Shot(600.0, obliquity=20.0), "law",
+                  bottom=0.3, **law)
+    end = through.solutions[-1].y[:, -1]
+    assert through.end["state"] == "perforation"
+    assert through.model.extreme_depths(end)[1] == pytest.approx(0.3, abs=1e-9)
