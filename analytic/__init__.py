@@ -10,6 +10,7 @@ from cavex.analytic.cavity import (
 )
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.nose import nose_force, ogive_coefficients
+from cavex.analytic.oblique import Shot, fly
 from cavex.analytic.paper_model import (
     PaperCoefficients,
     PaperModel,
@@ -20,7 +21,8 @@ from cavex.analytic.paper_model import (
 from cavex.analytic.penetration import Trajectory, penetrate
 from cavex.analytic.resistance import ClosedFormResistance
 
-__all__ = ["CavityState", "ClosedFormResistance", "PaperCoefficients", "PaperModel", "Trajectory",
-           "cavity_solution", "cavity_stress", "nose_force", "ogive_coefficients",
+__all__ = ["CavityState", "ClosedFormResistance", "PaperCoefficients", "PaperModel", "Shot",
+           "Trajectory", "cavity_solution", "cavity_stress", "fly", "nose_force",
+           "ogive_coefficients",
            "paper_coefficients", "paper_phase_depths", "paper_stress", "penetrate",
            "plastic_radius", "quasi_static_coefficients", "response_state", "spherical_problem"]

@@ -1,11 +1,18 @@
-"""The Python API in one script: closed form, FE and penetration for the default runway.
+"""The Python API in one script: closed form, FE, penetration and an oblique shot, default runway.
 
 Run it as ``python examples/api_example.py``; ``tests/test_examples.py`` runs it and checks its
 numbers. SI units (Pa, m, s, kg), compression positive.
 """
 
 from cavex import load_config
-from cavex.analytic import ClosedFormResistance, cavity_stress, penetrate, spherical_problem
+from cavex.analytic import (
+    ClosedFormResistance,
+    Shot,
+    cavity_stress,
+    fly,
+    penetrate,
+    spherical_problem,
+)
 from cavex.fem import expand_cavity
 
 
@@ -35,8 +42,18 @@ def main():
           f"(estimated error {fe.error_estimate:.2%})")
     print(f"projectile stops at {trajectory.depth[-1]:.3f} m after "
           f"{trajectory.t[-1] * 1e3:.2f} ms")
+
+    # 5. An oblique shot in 3-D (docs/oblique.md): 600 m/s at 20 deg, derived dynamic law
+    #    along each surface element's normal; contact ramp 1 m/s for a quick look (the
+    #    default 0.1 m/s is 6x slower and 0.5 % more accurate in depth)
+    shot = fly(target, projectile, Shot(600.0, obliquity=20.0), contact_ramp=1.0)
+    x, _, z = shot.end["nose_tip_m"]
+    print(f"oblique shot: {shot.end['state']} with the nose tip at x = {x:.3f} m, "
+          f"z = {z:.3f} m, pitch {shot.end['pitch_deg']:.2f} deg "
+          f"({len(shot.phases)} phases: {', '.join(p['label'] for p in shot.phases)})")
     return {"dynamic": dynamic, "quasi_static": quasi_static, "fe": fe.cavity_stress,
-            "fe_error_estimate": fe.error_estimate, "final_depth": float(trajectory.depth[-1])}
+            "fe_error_estimate": fe.error_estimate, "final_depth": float(trajectory.depth[-1]),
+            "oblique": shot.end}
 
 
 if __name__ == "__main__":

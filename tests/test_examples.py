@@ -22,6 +22,12 @@ def test_api_example_runs_and_agrees(capsys):
     # the quasi-static convention freezes b: larger at 500 m/s (measured +0.50 %)
     assert out["quasi_static"] / out["dynamic"] - 1.0 == pytest.approx(0.0050, abs=5e-4)
     assert 2.0 < out["final_depth"] < 4.0
+    # the oblique shot stops in macadam (results/oblique/report.md at 0.1 m/s: 0.753 m,
+    # pitch change 0.84 deg) after its entry turn toward the striking direction
+    assert "oblique shot: stopped" in printed
+    assert out["oblique"]["state"] == "stopped"
+    assert 0.65 < out["oblique"]["nose_tip_m"][2] < 0.8
+    assert 20.0 < out["oblique"]["pitch_deg"] < 22.0
 
 
 def test_example_sweep_is_valid():
