@@ -256,11 +256,18 @@ class ObliqueModel:
         events.append((stop, "stopped"))
         return events
 
-    def run(self, shot, max_phases=50):
-        """Integrate ``shot`` to a final event; returns a :class:`Result`."""
+    def run(self, shot, max_phases=50, progress=None):
+        """Integrate ``shot`` to a final event; returns a :class:`Result`. ``progress``:
+        optional ``callable(t, y)`` called after every integrator step."""
         y = self.initial_state(shot)
         energy0 = self.energy(y, transverse_only=True)
         events = self._events(y, energy0)
+        hooks = []
+        if progress is not None:  # an event that never fires: solve_ivp calls it every step
+            def step(t, y):
+                progress(t, y)
+                return 1.0
+            hooks.append(step)
         t0, phases, sols = 0.0, [], []
         final = {"stopped", "ricochet: left the target through the entry face",
                  "perforation: left through the bottom face"}
@@ -271,7 +278,8 @@ class ObliqueModel:
         label = self.phase_label(y)
         for _ in range(max_phases):
             sol = solve_ivp(self.rhs, (t0, MAX_TIME), y, method=self.method, rtol=self.rtol,
-                            atol=self.atol, events=[e for e, _ in events], dense_output=True)
+                            atol=self.atol, events=[e for e, _ in events] + hooks,
+                            dense_output=True)
             if sol.status == -1:
                 raise CavexNumericalError(f"trajectory integration failed at t = {sol.t[-1]} "
                                           f"s: {sol.message}")
@@ -358,10 +366,12 @@ class ObliqueModel:
 
 
 def fly(target, projectile, shot=None, resistance="derived", *, body=None, bottom=None,
-        rtol=RTOL, atol=ATOL, method=METHOD, contact_ramp=None, **law_options):
-    """One trajectory: :class:`Result` of ``shot`` (default: normal incidence at ``V0``)."""
+        rtol=RTOL, atol=ATOL, method=METHOD, contact_ramp=None, progress=None,
+        **law_options):
+    """One trajectory: :class:`Result` of ``shot`` (default: normal incidence at ``V0``);
+    ``progress(t, y)`` is called after every integrator step."""
     shot = shot or Shot(projectile.V0)
     law = make_law(target, projectile, resistance, bottom=bottom, **law_options)
     model = ObliqueModel(target, projectile, law, body=body, bottom=bottom, rtol=rtol,
                          atol=atol, method=method, contact_ramp=contact_ramp)
-    return model.run(shot)
+    return model.run(shot, progress=progress)

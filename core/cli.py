@@ -141,6 +141,9 @@ def build_parser():
     trajectory.add_argument("--compare-homogeneous", action="store_true",
                             help="also the same shot into the first layer alone")
     trajectory.add_argument("--json", action="store_true", help="print JSON")
+    trajectory.add_argument("--progress", action=argparse.BooleanOptionalAction,
+                            help="progress bar of integrator steps on stderr (default: when "
+                            "stderr is a terminal)")
     trajectory.add_argument("--out", default="results/trajectory",
                             help="output folder (default results/trajectory)")
     _describe(commands)

@@ -108,3 +108,16 @@ def test_findings_are_computed_from_the_table():
     assert lines[0].startswith("obliquity_deg,speed_m_s,contact_ramp_m_s,target")
     normal = next(line for line in lines if line.startswith(f"0,800,{RAMPS[0]:g},runway"))
     assert normal.split(",")[12] == "0"  # lateral overload 1e-5 g: under the noise floor
+
+
+def test_progress_is_called_once_per_step():
+    """``fly(progress=...)`` is called after every integrator step (the command's bar)."""
+    target, projectile = load_config()
+    seen = []
+    result = fly(target, projectile, Shot(500.0, obliquity=15.0), "law", law_A=2e8,
+                 law_B=2500.0, contact_ramp=1.0, progress=lambda t, y: seen.append(t))
+    steps = sum(s.t.size - 1 for s in result.solutions)
+    # solve_ivp calls an event function once at the start of each phase and once per step
+    assert len(seen) == steps + len(result.solutions)
+    # the last call is at the end of the step in which the final event lies
+    assert result.end["time_s"] <= seen[-1] and seen[0] == 0.0

@@ -9,6 +9,8 @@ interfaces marked, a 3-D view of the path in the layered block (pyvista, off-scr
 
 import json
 import math
+import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +20,7 @@ from cavex.analytic.surface_force import rotation_matrix as rotation
 from cavex.errors import require
 from cavex.paths import check_output_dir
 from cavex.verification.number_format import format_number
-from cavex.verification.runner import save_figure, write_text_atomic
+from cavex.verification.runner import save_figure, show_progress, write_text_atomic
 
 DEFAULT_DIR = "results/trajectory"
 MIN_CONTACT_RAMP = 0.01  # m/s: ~10x the default's run time
@@ -26,8 +28,9 @@ MIN_CONTACT_RAMP = 0.01  # m/s: ~10x the default's run time
 
 def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="dynamic",
                    free_surface=True, table=None, law_A=None, law_B=None,
-                   compare_homogeneous=False, contact_ramp=None):
-    """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``."""
+                   compare_homogeneous=False, contact_ramp=None, progress=False):
+    """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``;
+    ``progress``: a tqdm bar per run on stderr (steps, simulated time, speed)."""
     contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
     # the command keeps the regularisation on: without it (or far below the default) an
     # oblique shot's sliding shank needs millions of steps (docs/oblique.md)
@@ -38,7 +41,8 @@ def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="
     if table is not None:
         from cavex.verification.table import load_table
         options["table"] = load_table(table)
-    runs = {"runway": fly(target, projectile, shot, resistance, **options)}
+    with _steps("runway", progress) as step:
+        runs = {"runway": fly(target, projectile, shot, resistance, progress=step, **options)}
     if compare_homogeneous and len(target.layers) > 1:
         single = target.single(0)
         if resistance == "table":  # the table belongs to the runway; first layer by closed form
@@ -46,12 +50,35 @@ def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="
             resistance_single = "derived"
         else:
             resistance_single = resistance
-        runs["first layer only"] = fly(single, projectile, shot, resistance_single, **options)
+        with _steps("first layer only", progress) as step:
+            runs["first layer only"] = fly(single, projectile, shot, resistance_single,
+                                           progress=step, **options)
     settings = {"speed_m_s": shot.speed, "obliquity_deg": shot.obliquity,
                 "attack_deg": shot.attack, "attack_plane_deg": shot.attack_plane,
                 "spin_rad_s": shot.spin, "resistance": resistance, "boundary": boundary,
                 "free_surface": free_surface, "contact_ramp_m_s": contact_ramp}
     return {"runs": runs, "settings": settings, "target": target}
+
+
+@contextmanager
+def _steps(name, enabled):
+    """``callable(t, y)`` advancing a tqdm bar of integrator steps (None when disabled)."""
+    if not enabled:
+        yield None
+        return
+    from tqdm.auto import tqdm
+
+    bar = tqdm(desc=name, unit=" steps", file=sys.stderr, dynamic_ncols=True, leave=False)
+
+    def step(t, y):
+        bar.update()
+        bar.set_postfix_str(f"t = {t * 1e3:.3f} ms, {float(np.linalg.norm(y[7:10])):.1f} m/s",
+                            refresh=False)
+
+    try:
+        yield step
+    finally:
+        bar.close()
 
 
 def summary(result):
@@ -290,7 +317,8 @@ def trajectory_main(args, target, projectile):
                                  boundary=args.boundary, free_surface=not args.no_free_surface,
                                  table=args.table, law_A=args.law_A, law_B=args.law_B,
                                  compare_homogeneous=args.compare_homogeneous,
-                                 contact_ramp=args.contact_ramp)
+                                 contact_ramp=args.contact_ramp,
+                                 progress=show_progress(args.progress))
     except FloatingPointError as exc:
         raise CavexNumericalError(f"the trajectory overflowed ({exc}): forces far beyond the "
                                   "projectile's mass and inertia") from None
@@ -323,8 +351,8 @@ def trajectory_main(args, target, projectile):
         lines += [f"{p['label']:<10} {p['end_time_s'] * 1e3:14.4f} "
                   f"{p['end_nose_tip_m'][2]:10.4f} {p['end_pitch_deg']:8.2f} "
                   f"{p['end_speed_m_s']:8.2f}  {p['end_reason']}" for p in s["phases"]]
-        lines.append(f"end: {e['state']}, nose tip ({e['nose_tip_m'][0]:.4f}, "
-                     f"{e['nose_tip_m'][1]:.4f}, {e['nose_tip_m'][2]:.4f}) m, pitch "
+        tip = ", ".join(f"{c:.4f}".replace("-0.0000", "0.0000") for c in e["nose_tip_m"])
+        lines.append(f"end: {e['state']}, nose tip ({tip}) m, pitch "
                      f"{e['pitch_deg']:.2f} deg; peaks: axial {s['max_axial_g']:.0f} g, "
                      f"lateral {s['max_lateral_g']:.0f} g")
     lines += ["", "wrote: " + ", ".join(written)]
