@@ -269,3 +269,21 @@ def test_events_end_each_phase_where_they_say(runway):
     end = through.solutions[-1].y[:, -1]
     assert through.end["state"] == "perforation"
     assert through.model.extreme_depths(end)[1] == pytest.approx(0.3, abs=1e-9)
+
+
+def test_paper_law_is_the_printed_model_at_the_mapped_depth(runway):
+    """At its grid nodes the paper law is the paper's printed sigma_r at the 1-D nose depth
+    L = z + l - r (exactly: the same coefficients), between them linear."""
+    from cavex.analytic.paper_model import paper_stress
+    from cavex.analytic.stress_laws import PaperLaw
+
+    target, projectile = runway
+    law = PaperLaw(target, projectile)
+    offset = projectile.l - projectile.r
+    nodes = np.array([0.1, 0.3, 0.6502, 0.9, 1.2])  # on the 0.2 mm grid
+    vn = np.array([0.0, 150.0, 400.0, 650.0, 900.0])
+    z = nodes - offset
+    sigma = law.stress(z, np.tile([0.0, 0.0, 1.0], (z.size, 1)), vn)
+    printed = np.array([paper_stress(target, projectile, L, v) for L, v in zip(nodes, vn,
+                                                                             strict=True)])
+    np.testing.assert_allclose(sigma, printed, rtol=1e-12)  # measured: equal to round-off
