@@ -97,10 +97,11 @@ def _derived(scalars, tables, counts, depths, z, nz, vn, radii, zones):
 
 @njit(cache=True, error_model="numpy")
 def element_stress(kind, scalars, values, tables, counts, depths, z, nz, vn, radii, zones):
-    """``(sigma_n, status)`` of one element of any law (``status``: ``OK``, ``WALK_FAILED``,
-    ``BEYOND_TABLE``). ``scalars`` per kind: ``DEPTH_QUADRATIC`` ``(offset, L_0, dL)`` with
-    ``values[:, 0:2] = (s_0, s_2)``; ``TABLE`` ``(offset, L_0, dL, dV2)`` with ``values[i, j]``
-    at ``(L_0 + i dL, j dV2)``; ``DERIVED`` ``(a, free surface, bottom, dynamic)`` with the
+    """``(sigma_n, status)`` of one element of any law. ``status``: ``OK``; ``WALK_FAILED``
+    (``sigma_n`` NaN); ``BEYOND_TABLE`` (``sigma_n`` at the table's largest velocity).
+    ``scalars`` per kind: ``DEPTH_QUADRATIC`` ``(offset, L_0, dL)`` with ``values[:, 0:2] =
+    (s_0, s_2)``; ``TABLE`` ``(offset, L_0, dL, dV2)`` with ``values[i, j]`` at
+    ``(L_0 + i dL, j dV2)``; ``DERIVED`` ``(a, free surface, bottom, dynamic)`` with the
     material tables of every (own layer, direction) group. ``radii`` ``(1, >= n - 1)`` and
     ``zones`` ``(0, 1, 2)`` are scratch."""
     if kind == DERIVED:
@@ -109,16 +110,18 @@ def element_stress(kind, scalars, values, tables, counts, depths, z, nz, vn, rad
     if kind == DEPTH_QUADRATIC:
         return (_lerp(depth, scalars[1], scalars[2], 0, values)
                 + _lerp(depth, scalars[1], scalars[2], 1, values) * vn * vn), OK
-    # TABLE: bilinear in (L, V^2)
+    # TABLE: bilinear in (L, V^2); beyond the largest velocity: that velocity's value, flagged
     fj = vn * vn / scalars[3]
-    if fj > values.shape[1] - 1:
-        return np.nan, BEYOND_TABLE
+    beyond = fj > values.shape[1] - 1
+    if beyond:
+        fj = values.shape[1] - 1.0
     fi = min(max((depth - scalars[1]) / scalars[2], 0.0), values.shape[0] - 1.0)
     i = min(int(fi), values.shape[0] - 2)
     j = min(int(fj), values.shape[1] - 2)
     u, w = fi - i, fj - j
     return ((1.0 - u) * ((1.0 - w) * values[i, j] + w * values[i, j + 1])
-            + u * ((1.0 - w) * values[i + 1, j] + w * values[i + 1, j + 1])), OK
+            + u * ((1.0 - w) * values[i + 1, j] + w * values[i + 1, j + 1])), (
+                BEYOND_TABLE if beyond else OK)
 
 
 @njit(cache=True, error_model="numpy")
