@@ -22,7 +22,7 @@ from scipy.integrate import solve_ivp
 from cavex.analytic.projectile_body import build_body
 from cavex.analytic.stress_laws import OK, make_law, raise_for
 from cavex.analytic.surface_force import derivative, mirror_state, rotation_matrix, surface_loads
-from cavex.errors import CavexNumericalError, require
+from cavex.errors import CavexNumericalError, is_finite_number, require
 from cavex.materials import MAX_VELOCITY
 
 G = 9.80665  # m/s^2, for overloads in g
@@ -148,9 +148,8 @@ class ObliqueModel:
         self.bottom = bottom
         self.rtol, self.atol, self.method = rtol, atol, method
         contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
-        require(isinstance(contact_ramp, (int, float)) and math.isfinite(contact_ramp)
-                and 0.0 <= contact_ramp <= 100.0, "contact_ramp", "in [0, 100] m/s",
-                contact_ramp)
+        require(is_finite_number(contact_ramp) and 0.0 <= contact_ramp <= 100.0,
+                "contact_ramp", "in [0, 100] m/s", contact_ramp)
         self.contact_ramp = float(contact_ramp)
         self.mu = float(projectile.mu)
         self.interfaces = list(target.interface_depths)
@@ -216,8 +215,9 @@ class ObliqueModel:
 
     def extreme_depths(self, y):
         """Deepest and shallowest depth of the body surface (elements and tip)."""
-        z = y[2] + (self._p @ rotation_matrix(y[3:7]).T)[:, 2]
-        tz = self.tip(y)[2]
+        down = rotation_matrix(y[3:7])[2]  # the target's z in body coordinates
+        z = y[2] + self._p @ down
+        tz = y[2] + down @ self._tip
         return max(z.max(), tz), min(z.min(), tz)
 
     # -- integration ----------------------------------------------------------------------
@@ -296,8 +296,7 @@ class ObliqueModel:
             if getattr(fired, "crossing", False):
                 j = getattr(fired, "interface", None)
                 if j is not None:  # the layer the tip has just entered
-                    layer = j + 1 if fired.direction > 0 else j
-                    label = self.target.layers[layer].name or f"layer {layer + 1}"
+                    label = self.layer_name(j + 1 if fired.direction > 0 else j)
                 fired.direction = -fired.direction
             if reason in final:
                 break
@@ -307,9 +306,11 @@ class ObliqueModel:
         return Result(history=history, phases=phases, end=self._end_state(y, t0, reason),
                       solutions=sols, model=self)
 
-    def phase_label(self, y):
-        layer = self.target.layer_at(max(self.tip(y)[2], 0.0))
+    def layer_name(self, layer):
         return self.target.layers[layer].name or f"layer {layer + 1}"
+
+    def phase_label(self, y):
+        return self.layer_name(self.target.layer_at(max(self.tip(y)[2], 0.0)))
 
     def _phase(self, label, t, y, reason):
         end = self._end_state(y, t, reason)

@@ -28,19 +28,23 @@ Every law is one compiled function of the element's depth ``z``, the vertical co
 - :class:`PlainLaw` (``DEPTH_QUADRATIC`` on one depth): ``sigma_n = A + B V_n^2`` everywhere.
 """
 
-import math
 
 import numpy as np
 from numba import njit
 
-from cavex.analytic.cavity import FAILED, _point, material_table
-from cavex.errors import CavexInputError, CavexNumericalError, require
+from cavex.analytic.cavity import BOUNDARIES, FAILED, _point, material_table
+from cavex.errors import (
+    CavexInputError,
+    CavexNumericalError,
+    is_finite_number,
+    require,
+    require_choice,
+)
 
 HORIZONTAL = 1e-12  # |n_z| below which a normal counts as horizontal
 FAR = 1e6  # m: interface radius standing for "never met"
 DEPTH_QUADRATIC, TABLE, DERIVED = range(3)
 OK, WALK_FAILED, BEYOND_TABLE, NOT_FINITE = range(4)
-BOUNDARIES = ("dynamic", "quasi-static")
 RESISTANCES = ("derived", "paper", "table", "law")
 _EMPTY1 = np.empty(0)
 _EMPTY2 = np.empty((0, 0))
@@ -171,7 +175,7 @@ class DerivedLaw(_Law):
     name = "derived"
 
     def __init__(self, target, radius, boundary="dynamic", free_surface=True, bottom=None):
-        require(boundary in BOUNDARIES, "boundary", "'dynamic' or 'quasi-static'", boundary)
+        require_choice(boundary, BOUNDARIES, "boundary")
         self.target, self.radius, self.boundary = target, float(radius), boundary
         self.free_surface, self.bottom = free_surface, bottom
         layers = target.layers
@@ -219,8 +223,7 @@ class TableLaw(_Law):
         lo = float(resistance.depths[0])
         hi = max(float(resistance.depths[-1]), lo + 1e-3) if extent is None else extent
         grid = np.linspace(lo, hi, depth_points)
-        self.vmax = float(resistance.velocities[-1])
-        v2 = np.linspace(0.0, self.vmax ** 2, velocity_points)
+        v2 = np.linspace(0.0, float(resistance.velocities[-1]) ** 2, velocity_points)
         values = np.array([resistance.wall_stress(L, np.sqrt(v2)) for L in grid])
         self.data = (TABLE, np.array([p.l - p.r, lo, grid[1] - grid[0], v2[1]]), values,
                      _EMPTY3, _NO_COUNTS, _EMPTY1)
@@ -240,8 +243,8 @@ class PlainLaw(_Law):
         # keep the forces finite: 1e40 Pa stalls the integrator, 1e100 Pa overflows it
         for name, value, top, unit in (("law_A", A, MAX_LAW_A, "Pa"),
                                        ("law_B", B, MAX_LAW_B, "kg/m^3")):
-            require(isinstance(value, (int, float)) and math.isfinite(value)
-                    and 0.0 <= value <= top, name, f"in [0, {top:g}] {unit}", value)
+            require(is_finite_number(value) and 0.0 <= value <= top, name,
+                    f"in [0, {top:g}] {unit}", value)
         self.A, self.B = float(A), float(B)
         self.data = (DEPTH_QUADRATIC, np.array([0.0, 0.0, 1.0]), np.array([[self.A, self.B]]),
                      _EMPTY3, _NO_COUNTS, _EMPTY1)

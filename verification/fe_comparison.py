@@ -7,14 +7,13 @@ the default error target: a problem whose estimated discretisation error exceeds
 
 from dataclasses import replace
 
-from cavex.analytic.cavity import cavity_solution, check_problem
+from cavex.analytic.cavity import BOUNDARIES, cavity_solution, check_problem
 from cavex.analytic.geometry import spherical_problem
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET, MAX_REFINEMENTS
 from cavex.fem.expansion import expand_cavities
 from cavex.fem.output import write_result
 from cavex.paths import check_output_dir
 
-BOUNDARIES = ("dynamic", "quasi-static")
 #: Numerics settings renamed in JSON output (their unit appended)
 NUMERICS_JSON_KEYS = {"seed_radius": "seed_radius_m", "tension_cutoff": "tension_cutoff_Pa"}
 
