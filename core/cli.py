@@ -5,13 +5,12 @@ import json
 import os
 import re
 import sys
-from pathlib import Path
 
 from cavex import __version__
 from cavex.analytic.paper_model import EPSILON_READINGS
 from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
-from cavex.paths import check_output_dir, staged_output
+from cavex.paths import check_output_dir, write_staged
 
 DEFAULT_PENETRATION_DIR = "results/penetration"
 
@@ -220,12 +219,11 @@ def _penetrate(args, target, projectile):
     if (args.resistance == "table") != (args.table is not None):
         raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
                               "neither)")
-    check_output_dir(args.out, "out")
+    folder = check_output_dir(args.out, "out")
     job = penetration_job(target, projectile, model=args.model, boundary=args.boundary,
                           epsilon=args.epsilon, crater=args.crater, table_path=args.table)
-    folder = Path(args.out)
-    with staged_output(folder) as stage:  # every file or none, also on Ctrl-C or kill
-        written = [str(folder / Path(path).name) for path in write_outputs(job, stage)]
+    # every file or none, also on Ctrl-C or kill
+    written = write_staged(folder, lambda stage: write_outputs(job, stage))
     phases = phases_as_dicts(job["runs"]["runway"])
     if args.json:
         settings = {k: job[k] for k in ("model", "boundary", "epsilon", "crater",

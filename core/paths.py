@@ -120,3 +120,12 @@ def staged_output(folder):
                 folder.rmdir()  # only if empty: nothing was moved in
             except OSError:
                 pass
+
+
+def write_staged(folder, write):
+    """``write(stage)`` (writes a command's files into ``stage``, returns their paths) inside
+    :func:`staged_output` of ``folder``; returns the paths the files have in ``folder``."""
+    folder = Path(folder)
+    with staged_output(folder) as stage:
+        written = write(stage)
+    return [str(folder / Path(path).relative_to(stage)) for path in written]

@@ -33,6 +33,7 @@ from cavex.verification.number_format import (
 )
 from cavex.verification.report import _settings_lines, write_grid
 from cavex.verification.report_analysis import analyse
+from cavex.verification.runner import write_columns_csv
 from cavex.verification.table import analytic_table, write_table
 
 # relative spread between CPUs, per kind of number (module docstring)
@@ -184,8 +185,8 @@ def test_penetration_csv_unchanged_by_a_perturbed_trajectory(penetration, tmp_pa
     picked = {k: v[generic] for k, v in columns.items()}
     perturbed = {k: v if k == "phase" else v * (1 + 1e-8) for k, v in picked.items()}
     assert generic.mean() > 0.5  # rows checked (measured 0.64: a row needs all 4 columns clear)
-    a = penetration_report._write_csv(tmp_path / "a.csv", picked)
-    b = penetration_report._write_csv(tmp_path / "b.csv", perturbed)
+    a = write_columns_csv(tmp_path / "a.csv", picked)
+    b = write_columns_csv(tmp_path / "b.csv", perturbed)
     assert a.read_bytes() == b.read_bytes()
 
 

@@ -29,6 +29,7 @@ from cavex.config import load_config
 from cavex.paths import check_output_dir
 from cavex.verification.number_format import format_number
 from cavex.verification.runner import run_cases, save_figure, write_text_atomic
+from cavex.verification.trajectory_report import peaks
 
 OBLIQUITIES = (0.0, 10.0, 20.0, 30.0, 45.0, 60.0)
 VELOCITIES = (400.0, 600.0, 800.0, 1000.0)
@@ -69,7 +70,6 @@ def shot_summary(result, approach_depth):
     """Numbers of one shot; ``approach_depth``: nose-tip depth from which the attitude change
     near the first interface is counted (the same depth for the shot into concrete alone)."""
     h = result.history
-    rate = np.gradient(h["pitch_deg"], h["t_s"])
     near = np.flatnonzero(h["tip_z_m"] >= approach_depth)
     return {"state": result.end["state"], "time_s": result.end["time_s"],
             "tip_x_m": result.end["nose_tip_m"][0], "tip_z_m": result.end["nose_tip_m"][2],
@@ -77,10 +77,7 @@ def shot_summary(result, approach_depth):
             "pitch_change_deg": result.end["pitch_deg"] - float(h["pitch_deg"][0]),
             "pitch_change_deep_deg": (result.end["pitch_deg"] - float(h["pitch_deg"][near[0]])
                                       if near.size else None),
-            "max_pitch_rate_deg_s": float(np.abs(rate).max()),
-            "max_axial_g": float(h["axial_g"].max()),
-            "max_lateral_g": float(h["lateral_g"].max()),
-            "overload_peaks": overload_peaks(h)}
+            **peaks(h), "overload_peaks": overload_peaks(h)}
 
 
 def study_chunk(chunk):

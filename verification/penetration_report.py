@@ -5,15 +5,12 @@ digits (the integrator's tolerance; see :mod:`cavex.verification.number_format`)
 are the same when regenerated on another CPU.
 """
 
-import csv
-import io
 from pathlib import Path
 
 from cavex.analytic.penetration import crater_depth, penetrate
 from cavex.analytic.resistance import ClosedFormResistance, check_model, model_boundary
 from cavex.config import load_config
-from cavex.verification.number_format import format_number
-from cavex.verification.runner import save_figure, write_text_atomic
+from cavex.verification.runner import save_figure, write_columns_csv
 from cavex.verification.table2 import table2_comparison
 
 
@@ -92,8 +89,8 @@ def write_outputs(job, out_dir):
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, trajectory in job["runs"].items():
-        written.append(_write_csv(out / f"trajectory_{name}.csv", trajectory.as_columns()))
-    written.append(_write_csv(out / "phases_runway.csv",
+        written.append(write_columns_csv(out / f"trajectory_{name}.csv", trajectory.as_columns()))
+    written.append(write_columns_csv(out / "phases_runway.csv",
                               _columns(phases_as_dicts(job["runs"]["runway"]))))
     written += _write_figures(job, out)
     return [str(p) for p in written]
@@ -101,17 +98,6 @@ def write_outputs(job, out_dir):
 
 def _columns(rows):
     return {key: [row[key] for row in rows] for key in rows[0]}
-
-
-def _write_csv(path, columns):
-    """``columns`` as CSV, every number through :func:`format_number`."""
-    text = io.StringIO(newline="")
-    writer = csv.writer(text)
-    writer.writerow(columns)
-    writer.writerows([format_number(x) for x in row]
-                     for row in zip(*columns.values(), strict=True))
-    write_text_atomic(path, text.getvalue())
-    return path
 
 
 def _write_figures(job, out):

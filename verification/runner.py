@@ -11,8 +11,10 @@ exactly).
 """
 
 import contextlib
+import csv
 import ctypes
 import fcntl
+import io
 import json
 import math
 import multiprocessing
@@ -200,6 +202,20 @@ def write_text_atomic(path, text):
         handle.flush()
         os.fsync(handle.fileno())
     os.replace(tmp, path)
+
+
+def write_columns_csv(path, columns):
+    """``columns`` (name -> sequence) as CSV, atomically, every number through
+    :func:`~cavex.verification.number_format.format_number`; returns ``path``."""
+    from cavex.verification.number_format import format_number
+
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow(columns)
+    writer.writerows([format_number(x) for x in row]
+                     for row in zip(*columns.values(), strict=True))
+    write_text_atomic(path, text.getvalue())
+    return path
 
 
 def save_figure(fig, path, **savefig):

@@ -18,9 +18,13 @@ import numpy as np
 from cavex.analytic.oblique import CONTACT_RAMP, Shot, fly
 from cavex.analytic.surface_force import rotation_matrix as rotation
 from cavex.errors import require
-from cavex.paths import check_output_dir
-from cavex.verification.number_format import format_number
-from cavex.verification.runner import save_figure, show_progress, write_text_atomic
+from cavex.paths import check_output_dir, write_staged
+from cavex.verification.runner import (
+    save_figure,
+    show_progress,
+    write_columns_csv,
+    write_text_atomic,
+)
 
 DEFAULT_DIR = "results/trajectory"
 MIN_CONTACT_RAMP = 0.01  # m/s: ~10x the default's run time
@@ -81,41 +85,34 @@ def _steps(name, enabled):
         bar.close()
 
 
-def summary(result):
-    """End state and phases (JSON-ready), plus the largest pitch rate and overloads."""
-    h = result.history
+def peaks(history):
+    """The largest pitch rate (deg/s), axial and lateral overload (g) of a history."""
+    h = history
     rate = np.gradient(h["pitch_deg"], h["t_s"]) if h["t_s"].size > 2 else np.zeros(1)
-    return {"end": result.end, "phases": result.phases,
-            "max_pitch_rate_deg_s": float(np.max(np.abs(rate))),
+    return {"max_pitch_rate_deg_s": float(np.max(np.abs(rate))),
             "max_axial_g": float(np.max(h["axial_g"])),
             "max_lateral_g": float(np.max(h["lateral_g"]))}
 
 
-def write_outputs(job, out):
-    """CSV, summary JSON and figures into ``out``; returns the paths written."""
+def summary(result):
+    """End state and phases (JSON-ready), plus the largest pitch rate and overloads."""
+    return {"end": result.end, "phases": result.phases, **peaks(result.history)}
+
+
+def write_outputs(job, runs, out):
+    """CSV histories, the summary JSON (``runs``: :func:`summary` of each run) and the figures
+    into ``out``; returns the paths written."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    written = []
-    for name, result in job["runs"].items():
-        path = folder / f"history_{name.replace(' ', '_')}.csv"
-        write_text_atomic(path, history_csv(result.history))
-        written.append(str(path))
+    written = [str(write_columns_csv(folder / f"history_{name.replace(' ', '_')}.csv",
+                                     result.history))
+               for name, result in job["runs"].items()]
     path = folder / "summary.json"
-    text = json.dumps({"settings": job["settings"],
-                       "runs": {k: summary(v) for k, v in job["runs"].items()}}, indent=2)
+    text = json.dumps({"settings": job["settings"], "runs": runs}, indent=2)
     write_text_atomic(path, text + "\n")
     written.append(str(path))
     written += figures(job, folder)
     return written
-
-
-def history_csv(history):
-    names = list(history)
-    rows = [",".join(names)]
-    columns = [history[n] for n in names]
-    for i in range(columns[0].size):
-        rows.append(",".join(format_number(float(c[i])) for c in columns))
-    return "\n".join(rows) + "\n"
 
 
 # --- figures ----------------------------------------------------------------------------------
@@ -291,7 +288,6 @@ def trajectory_main(args, target, projectile):
     """``cavex trajectory``: checks, runs, writes, returns the text to print."""
     from cavex.errors import CavexInputError, CavexNumericalError
     from cavex.materials import MAX_VELOCITY
-    from cavex.paths import staged_output
 
     if (args.resistance == "table") != (args.table is not None):
         raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
@@ -335,8 +331,8 @@ def trajectory_main(args, target, projectile):
     except ValueError:
         raise CavexNumericalError("the trajectory summary is not finite (peaks, pitch "
                                   "rate)") from None
-    with staged_output(folder) as stage:  # every file or none, also on Ctrl-C or kill
-        written = [str(folder / Path(path).name) for path in write_outputs(job, stage)]
+    # every file or none, also on Ctrl-C or kill
+    written = write_staged(folder, lambda stage: write_outputs(job, runs, stage))
     if args.json:
         main = runs["runway"]
         return json.dumps({"end": main["end"], "phases": main["phases"],

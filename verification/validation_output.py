@@ -15,12 +15,11 @@ import io
 import json
 import shlex
 import time
-from pathlib import Path
 
 import numpy as np
 
 from cavex.errors import CavexInputError
-from cavex.paths import check_output_dir, staged_output
+from cavex.paths import check_output_dir, write_staged
 from cavex.verification.runner import check_execution, save_figure, write_text_atomic
 from cavex.verification.shots import read_shots
 from cavex.verification.validation import (
@@ -58,8 +57,8 @@ def validate_main(shots_path, calibration_paths=(), out_dir=None, as_json=False,
                  scheduler=scheduler, progress=progress)
     seconds = time.monotonic() - began
     result["command"] = command or command_line(shots_path, calibration_paths, out)
-    with staged_output(out) as stage:  # every file or none, also on Ctrl-C or kill
-        written = [str(out / Path(path).name) for path in write_outputs(result, stage)]
+    # every file or none, also on Ctrl-C or kill
+    written = write_staged(out, lambda stage: write_outputs(result, stage))
     if as_json:
         return json.dumps(public(result), indent=2)
     return summary_text(result, seconds, written)
