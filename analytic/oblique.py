@@ -152,7 +152,6 @@ class ObliqueModel:
                 "contact_ramp", "in [0, 100] m/s", contact_ramp)
         self.contact_ramp = float(contact_ramp)
         self.mu = float(projectile.mu)
-        self.interfaces = list(target.interface_depths)
         b = self.body
         self._p = b.points
         self._inertia = b.inertia
@@ -230,7 +229,7 @@ class ObliqueModel:
             crossing.terminal, crossing.crossing, crossing.interface = True, True, j
             return crossing, f"nose tip crossed interface {j + 1} (z = {H:g} m)"
 
-        for j, H in enumerate(self.interfaces):
+        for j, H in enumerate(self.target.interface_depths):
             events.append(make_layer(H, j))
 
         def ricochet(t, y):

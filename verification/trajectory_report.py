@@ -17,7 +17,7 @@ import numpy as np
 
 from cavex.analytic.oblique import CONTACT_RAMP, Shot, fly
 from cavex.analytic.surface_force import rotation_matrix as rotation
-from cavex.errors import require
+from cavex.errors import is_finite_number, require
 from cavex.paths import check_output_dir, write_staged
 from cavex.verification.runner import (
     save_figure,
@@ -38,7 +38,7 @@ def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="
     contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
     # the command keeps the regularisation on: without it (or far below the default) an
     # oblique shot's sliding shank needs millions of steps (docs/oblique.md)
-    require(math.isfinite(contact_ramp) and MIN_CONTACT_RAMP <= contact_ramp <= 100.0,
+    require(is_finite_number(contact_ramp) and MIN_CONTACT_RAMP <= contact_ramp <= 100.0,
             "contact_ramp", f"in [{MIN_CONTACT_RAMP:g}, 100] m/s", contact_ramp)
     options = {"boundary": boundary, "free_surface": free_surface, "table": table,
                "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp}
