@@ -20,6 +20,16 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from cavex.analytic.projectile_body import build_body
+from cavex.analytic.rosenbrock import (
+    END_TIME,
+    EVENT,
+    RUNNING,
+    STEP_TOO_SMALL,
+    event_values,
+    hermite,
+    initial_step,
+    integrate,
+)
 from cavex.analytic.stress_laws import OK, make_law, raise_for
 from cavex.analytic.surface_force import derivative, mirror_state, rotation_matrix, surface_loads
 from cavex.errors import CavexNumericalError, is_finite_number, require
@@ -28,11 +38,18 @@ from cavex.materials import MAX_VELOCITY
 G = 9.80665  # m/s^2, for overloads in g
 STOP_ENERGY = 1e-6  # stop when translational + transverse rotational energy < this x initial
 MAX_TIME = 1.0  # s
-METHOD, RTOL, ATOL = "RK45", 1e-6, 1e-9  # convergence: docs/oblique.md
+# the compiled ROS2 W-method (cavex.analytic.rosenbrock); any solve_ivp method name is the
+# reference. Convergence: docs/oblique.md
+COMPILED = "ROS2"
+METHOD, RTOL, ATOL = COMPILED, 1e-3, 1e-6
+CHUNK = 2000  # accepted steps per call of the compiled integrator (progress is reported after)
+RICOCHET = "ricochet: left the target through the entry face"
+PERFORATION = "perforation: left through the bottom face"
+STOPPED = "stopped"
 # contact regularisation: the stress rises linearly over 0 < V_n < CONTACT_RAMP (m/s); without
 # it a shank sliding along the tunnel wall chatters (V_n changes sign every step) and the
 # adaptive integrator stalls. Its effect is measured in docs/oblique.md.
-CONTACT_RAMP = 0.1
+CONTACT_RAMP = 0.01
 
 
 # ------------------------------------------------------------------------------------------
@@ -134,6 +151,22 @@ class Result:
         raise ValueError(f"t = {t} s is outside the trajectory")
 
 
+class Segment:
+    """One phase of the compiled integrator: accepted times ``t`` (N), states ``y`` and
+    derivatives ``f`` (14, N); ``sol(t)`` is the cubic Hermite interpolant of the step that
+    holds ``t`` (the dense output the events are located on)."""
+
+    def __init__(self, t, y, f):
+        self.t, self.y, self.f = t, y.T, f.T
+
+    def sol(self, t):
+        k = int(np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.t.size - 2))
+        h = self.t[k + 1] - self.t[k]
+        s = (t - self.t[k]) / h if h > 0.0 else 1.0
+        return hermite(s, h, self.y[:, k], self.f[:, k], self.y[:, k + 1], self.f[:, k + 1],
+                       np.empty(14))
+
+
 class ObliqueModel:
     """Rigid projectile + stress law + layered target: right-hand side, events, integrator.
 
@@ -159,19 +192,20 @@ class ObliqueModel:
                          self.contact_ramp, np.inf if bottom is None else float(bottom), *law.data)
         self._tip = b.tip
         self.evaluations = 0
+        self._step = None  # the compiled integrator's next step, kept across phases
 
     # -- forces ---------------------------------------------------------------------------
     def loads(self, y):
         """``(F, M_body, power, rotation)``: total surface force (target frame), moment about
         the centre of mass (body frame), power of the surface forces, rotation matrix."""
-        force, moment, power, status, vn = surface_loads(y, *self._surface)
+        force, moment, power, status, vn, _ = surface_loads(y, *self._surface)
         if status != OK:
             raise_for(status, vn)
         return force, moment, power, rotation_matrix(y[3:7])
 
     def rhs(self, t, y):
         self.evaluations += 1
-        dy, status, vn = derivative(y, self.body.mass, self._inertia, *self._surface)
+        dy, _, status, vn = derivative(y, self.body.mass, self._inertia, *self._surface)
         if status != OK:
             raise_for(status, vn)
         return dy
@@ -212,98 +246,121 @@ class ObliqueModel:
     def axis(self, y):
         return rotation_matrix(y[3:7])[:, 0]
 
-    def extreme_depths(self, y):
-        """Deepest and shallowest depth of the body surface (elements and tip)."""
-        down = rotation_matrix(y[3:7])[2]  # the target's z in body coordinates
-        z = y[2] + self._p @ down
-        tz = y[2] + down @ self._tip
-        return max(z.max(), tz), min(z.min(), tz)
-
     # -- integration ----------------------------------------------------------------------
-    def _events(self, y0, energy0):
-        events = []
+    def _events(self, energy0):
+        """``(directions, descriptions, event arguments)`` of the events of
+        :func:`cavex.analytic.rosenbrock.event_values`; a description is ``(reason, crossing,
+        interface)``: a crossing event flips its direction after firing and continues."""
+        depths = np.asarray(self.target.interface_depths, dtype=float)
+        described = [(f"nose tip crossed interface {j + 1} (z = {H:g} m)", True, j)
+                     for j, H in enumerate(depths)]
+        described += [(RICOCHET, False, None), (PERFORATION, False, None),
+                      ("axis parallel to the surface", True, None), (STOPPED, False, None)]
+        directions = np.zeros(len(described))
+        directions[depths.size:depths.size + 2] = -1.0, 1.0
+        directions[-1] = -1.0
+        args = (self._tip, self._p, depths, np.inf if self.bottom is None else float(self.bottom),
+                STOP_ENERGY * energy0)
+        return directions, described, args
 
-        def make_layer(H, j):
-            def crossing(t, y):
-                return self.tip(y)[2] - H
-            crossing.terminal, crossing.crossing, crossing.interface = True, True, j
-            return crossing, f"nose tip crossed interface {j + 1} (z = {H:g} m)"
-
-        for j, H in enumerate(self.target.interface_depths):
-            events.append(make_layer(H, j))
-
-        def ricochet(t, y):
-            return self.extreme_depths(y)[0]
-        ricochet.terminal, ricochet.direction = True, -1.0
-        events.append((ricochet, "ricochet: left the target through the entry face"))
-        if self.bottom is not None:
-            def perforation(t, y):
-                return self.extreme_depths(y)[1] - self.bottom
-            perforation.terminal, perforation.direction = True, 1.0
-            events.append((perforation, "perforation: left through the bottom face"))
-
-        def parallel(t, y):
-            return self.axis(y)[2]
-        parallel.terminal, parallel.crossing = True, True
-        events.append((parallel, "axis parallel to the surface"))
-
-        threshold = STOP_ENERGY * energy0
-
-        def stop(t, y):
-            return self.energy(y, transverse_only=True) - threshold
-        stop.terminal, stop.direction = True, -1.0
-        events.append((stop, "stopped"))
-        return events
+    def event_values(self, y, args):
+        return event_values(y, *args[:4], self.body.mass, self._inertia, args[4],
+                            np.empty(len(self.target.interface_depths) + 4))
 
     def run(self, shot, max_phases=50, progress=None):
         """Integrate ``shot`` to a final event; returns a :class:`Result`. ``progress``:
         optional ``callable(t, y)`` called after every integrator step."""
         y = self.initial_state(shot)
-        energy0 = self.energy(y, transverse_only=True)
-        events = self._events(y, energy0)
-        hooks = []
-        if progress is not None:  # an event that never fires: solve_ivp calls it every step
-            def step(t, y):
-                progress(t, y)
-                return 1.0
-            hooks.append(step)
+        directions, described, args = self._events(self.energy(y, transverse_only=True))
+        g = self.event_values(y, args)
+        for k, (_, crossing, _) in enumerate(described):  # the next crossing is away from
+            if crossing:  # the side the state is on now
+                directions[k] = 1.0 if g[k] < 0.0 else -1.0
         t0, phases, sols = 0.0, [], []
-        final = {"stopped", "ricochet: left the target through the entry face",
-                 "perforation: left through the bottom face"}
-        reason = "time limit"
-        for event, _ in events:  # two-way events: the next crossing is away from the side
-            if getattr(event, "crossing", False):  # the state is on now
-                event.direction = 1.0 if event(t0, y) < 0.0 else -1.0
         label = self.phase_label(y)
+        reason = "time limit"
+        phase = self._compiled_phase if self.method == COMPILED else self._scipy_phase
         for _ in range(max_phases):
-            sol = solve_ivp(self.rhs, (t0, MAX_TIME), y, method=self.method, rtol=self.rtol,
-                            atol=self.atol, events=[e for e, _ in events] + hooks,
-                            dense_output=True)
-            if sol.status == -1:
-                raise CavexNumericalError(f"trajectory integration failed at t = {sol.t[-1]} "
-                                          f"s: {sol.message}")
+            sol, which = phase(t0, y, directions, args, progress)
             sols.append(sol)
-            if sol.status == 0:
-                t0, y, reason = sol.t[-1], sol.y[:, -1].copy(), "time limit"
+            t0, y = sol.t[-1], sol.y[:, -1].copy()
+            if which is None:
+                reason = "time limit"
                 phases.append(self._phase(label, t0, y, reason))
                 break
-            which = next(i for i, te in enumerate(sol.t_events) if te.size)
-            t0, y = sol.t_events[which][0], sol.y_events[which][0].copy()
-            reason = events[which][1]
-            fired = events[which][0]
+            reason, crossing, interface = described[which]
             phases.append(self._phase(label, t0, y, reason))
-            if getattr(fired, "crossing", False):
-                j = getattr(fired, "interface", None)
-                if j is not None:  # the layer the tip has just entered
-                    label = self.layer_name(j + 1 if fired.direction > 0 else j)
-                fired.direction = -fired.direction
-            if reason in final:
+            if crossing:
+                if interface is not None:  # the layer the tip has just entered
+                    label = self.layer_name(interface + 1 if directions[which] > 0
+                                            else interface)
+                directions[which] = -directions[which]
+            else:
                 break
         else:
             raise CavexNumericalError(f"more than {max_phases} phases")
         history = self._history(sols)
         return Result(history=history, phases=phases, end=self._end_state(y, t0, reason),
                       solutions=sols, model=self)
+
+    def _compiled_phase(self, t0, y, directions, args, progress):
+        """One phase with the compiled ROS2 integrator (:mod:`cavex.analytic.rosenbrock`):
+        ``(Segment, index of the event that ended it or None)``."""
+        mass, inertia = self.body.mass, self._inertia
+        f, jac, status, vn = derivative(y, mass, inertia, *self._surface)
+        self.evaluations += 1
+        if status != OK:
+            raise_for(status, vn)
+        h = self._step or initial_step(y, f, self.rtol, self.atol, MAX_TIME)
+        ts, ys, fs = np.empty(CHUNK + 1), np.empty((CHUNK + 1, 14)), np.empty((CHUNK + 1, 14))
+        parts = []
+        while True:
+            status, steps, h, evaluations, event, vn = integrate(
+                t0, y, f, jac, h, MAX_TIME, self.rtol, self.atol, CHUNK, directions, args, ts,
+                ys, fs, mass, inertia, self._surface)
+            self.evaluations += evaluations
+            parts.append((ts[1:steps + 1].copy(), ys[1:steps + 1].copy(), fs[1:steps + 1].copy())
+                         if parts else (ts[:steps + 1].copy(), ys[:steps + 1].copy(),
+                                        fs[:steps + 1].copy()))
+            if progress is not None:
+                for k in range(1, steps + 1):
+                    progress(ts[k], ys[k])
+            if status == STEP_TOO_SMALL:
+                raise CavexNumericalError(f"trajectory integration failed at t = {ts[steps]} "
+                                          "s: the step size became too small")
+            if status not in (RUNNING, EVENT, END_TIME):
+                raise_for(status, vn)
+            if status != RUNNING:
+                break
+            t0, y = ts[steps], ys[steps].copy()
+            f, jac, status, vn = derivative(y, mass, inertia, *self._surface)
+            self.evaluations += 1
+        self._step = h
+        segment = Segment(*(np.concatenate(c) for c in zip(*parts, strict=True)))
+        return segment, (event if status == EVENT else None)
+
+    def _scipy_phase(self, t0, y, directions, args, progress):
+        """One phase with ``scipy.integrate.solve_ivp`` (the reference integrators)."""
+        def make(k):
+            def event(t, y):
+                return self.event_values(y, args)[k]
+            event.terminal, event.direction = True, directions[k]
+            return event
+
+        events = [make(k) for k in range(directions.size)]
+        if progress is not None:  # an event that never fires: solve_ivp calls it every step
+            def step(t, y):
+                progress(t, y)
+                return 1.0
+            events.append(step)
+        sol = solve_ivp(self.rhs, (t0, MAX_TIME), y, method=self.method, rtol=self.rtol,
+                        atol=self.atol, events=events, dense_output=True)
+        if sol.status == -1:
+            raise CavexNumericalError(f"trajectory integration failed at t = {sol.t[-1]} "
+                                      f"s: {sol.message}")
+        if sol.status == 0:
+            return sol, None
+        return sol, next(i for i, te in enumerate(sol.t_events) if te.size)
 
     def layer_name(self, layer):
         return self.target.layers[layer].name or f"layer {layer + 1}"

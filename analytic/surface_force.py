@@ -19,7 +19,22 @@ the round-off guard) carries the load ``P = A_i w sigma_n(z, n_3, V_n) min(V_n /
           \mathbf t = \mathbf u_t / |\mathbf u_t|, \quad
           \mathbf u_t = \mathbf u - V_n \mathbf n.
 
-Sums: ``F = sum f``, ``M = R^T sum p x f`` (body frame), power ``sum f . u``. Motion:
+Sums: ``F = sum f``, ``M = R^T sum p x f`` (body frame), power ``sum f . u``.
+
+Contact damping (the stiff part of the Jacobian, for the linearly implicit integrator of
+:mod:`cavex.analytic.rosenbrock`): on the ramp ``0 < V_n < V_r`` the load grows as
+``kappa V_n`` with ``kappa = A_i w sigma_n / V_r`` (large for a small ramp: a sliding shank is
+a stiff damper). With ``u = v - [p]_x omega_t`` its contribution to
+``d(F, sum p x f)/d(v, omega_t)`` is ``-kappa b a^T``, ``a = (n, p x n)``,
+``b = (d, p x d)``, ``d = n + mu t``; the kernel returns
+``D = d(dv/dt, d omega/dt)/d(v, omega)`` in the state's frames (body-frame ``omega``),
+
+.. math:: D = -\mathrm{diag}(1/m, I^{-1})\,\mathrm{diag}(1, R^T)
+          \Big(\sum \kappa\, \mathbf b \mathbf a^T\Big)\,\mathrm{diag}(1, R),
+
+without the slow parts (``d sigma_n / d V_n``, the turning of ``t``, the gyroscopic term).
+
+Motion:
 
 .. math:: \dot{\mathbf x} = \mathbf v, \quad
           \dot q = \tfrac12 q \otimes (0, \boldsymbol\omega), \quad
@@ -87,12 +102,14 @@ def mirror_state(y):
     return m
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, contact_ramp, bottom,
-                  kind, scalars, values, tables, counts, depths, radii, zones, out):
+                  kind, scalars, values, tables, counts, depths, radii, zones, out, damping):
     """Force, moment about the centre of mass (target frame) and power of element ``i``
-    into ``out[0:7]``; returns ``(status, V_n)``."""
+    into ``out[0:7]``, its contact damping ``kappa b a^T`` (module docstring, target frame)
+    into ``damping``; returns ``(status, V_n)``."""
     out[:] = 0.0
+    damping[:, :] = 0.0
     p0 = rot[0, 0] * points[i, 0] + rot[0, 1] * points[i, 1] + rot[0, 2] * points[i, 2]
     p1 = rot[1, 0] * points[i, 0] + rot[1, 1] * points[i, 1] + rot[1, 2] * points[i, 2]
     p2 = rot[2, 0] * points[i, 0] + rot[2, 1] * points[i, 1] + rot[2, 2] * points[i, 2]
@@ -130,17 +147,28 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
     out[4] = p2 * f0 - p0 * f2
     out[5] = p0 * f1 - p1 * f0
     out[6] = f0 * u0 + f1 * u1 + f2 * u2
+    if contact_ramp > 0.0 and vn < contact_ramp and load > 0.0:
+        kappa = load / vn  # = A_i w sigma_n / V_r on the ramp
+        a = (n0, n1, n2, p1 * n2 - p2 * n1, p2 * n0 - p0 * n2, p0 * n1 - p1 * n0)
+        b = (-f0 / load, -f1 / load, -f2 / load, -out[3] / load, -out[4] / load,
+             -out[5] / load)
+        for r in range(6):
+            kb = kappa * b[r]
+            for c in range(6):
+                damping[r, c] = kb * a[c]
     return status, vn
 
 
 @njit(cache=True, error_model="numpy")
 def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
                   kind, scalars, values, tables, counts, depths):
-    """``(F (3, target frame), M (3, body frame), power, status, V_n of a failed element)``
-    of the surface forces in state ``y`` (module docstring; the law arrays are
-    ``law.data``). Each element is added together with its mirror image ``partners[i]``
-    (``theta -> -theta``) first, so that a shot and its mirror shot sum the same numbers
-    in the same order: the mirrored trajectory is mirrored to the last bit."""
+    """``(F (3, target frame), M (3, body frame), power, status, V_n of a failed element,
+    C)`` of the surface forces in state ``y`` (module docstring; the law arrays are
+    ``law.data``; ``C = diag(1, R^T) (sum kappa b a^T) diag(1, R)``, the contact damping
+    on ``(v, omega)``). Each element is added
+    together with its mirror image ``partners[i]`` (``theta -> -theta``) first, so that a
+    shot and its mirror shot sum the same numbers in the same order: the mirrored trajectory
+    is mirrored to the last bit."""
     rot = rotation_matrix(y[3:7])
     omega = np.empty(3)
     for r in range(3):
@@ -152,6 +180,9 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contac
     zones = np.empty((0, 1, 2))
     one = np.empty(7)
     other = np.empty(7)
+    damping = np.zeros((6, 6))
+    one_damping = np.empty((6, 6))
+    other_damping = np.empty((6, 6))
     beyond = 0.0  # largest normal velocity beyond a table's range (0: none)
     for i in range(areas.shape[0]):
         j = partners[i]
@@ -161,25 +192,41 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contac
             status, vn = _element_load(j if second else i, y, rot, omega, scale, points,
                                        normals, areas, sizes, mu, contact_ramp, bottom, kind,
                                        scalars, values, tables, counts, depths, radii, zones,
-                                       other if second else one)
+                                       other if second else one,
+                                       other_damping if second else one_damping)
             if status == BEYOND_TABLE:
                 beyond = max(beyond, vn)
             elif status != OK:
-                return total[0:3], total[3:6], total[6], status, vn
+                return total[0:3], total[3:6], total[6], status, vn, damping
         if j != i:
             one += other
+            one_damping += other_damping
         total += one
+        damping += one_damping
     moment = rot.T @ total[3:6]
+    # to the state's frames: omega_t = R omega, body moment R^T M
+    turned = damping.copy()
+    for r in range(6):
+        for c in range(3):
+            turned[r, 3 + c] = (damping[r, 3] * rot[0, c] + damping[r, 4] * rot[1, c]
+                                + damping[r, 5] * rot[2, c])
+    for c in range(6):
+        for r in range(3):
+            damping[3 + r, c] = (rot[0, r] * turned[3, c] + rot[1, r] * turned[4, c]
+                                 + rot[2, r] * turned[5, c])
+        for r in range(3):
+            damping[r, c] = turned[r, c]
     if beyond > 0.0:
-        return total[0:3], moment, total[6], BEYOND_TABLE, beyond
-    return total[0:3], moment, total[6], OK, 0.0
+        return total[0:3], moment, total[6], BEYOND_TABLE, beyond, damping
+    return total[0:3], moment, total[6], OK, 0.0, damping
 
 
 @njit(cache=True, error_model="numpy")
 def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length, mu, contact_ramp,
                bottom, kind, scalars, values, tables, counts, depths):
-    """``(dy/dt, status, V_n of a failed element)`` (module docstring)."""
-    force, moment, power, status, vn = surface_loads(
+    """``(dy/dt, D, status, V_n of a failed element)`` (module docstring; ``D`` the 6 x 6
+    contact damping block of the Jacobian)."""
+    force, moment, power, status, vn, damping = surface_loads(
         y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
         kind, scalars, values, tables, counts, depths)
     dy = np.empty(14)
@@ -196,6 +243,11 @@ def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length
     dy[11] = (moment[1] - (w2 * i0 * w0 - w0 * i2 * w2)) / i1
     dy[12] = (moment[2] - (w0 * i1 * w1 - w1 * i0 * w0)) / i2
     dy[13] = power
+    jac = np.empty((6, 6))
+    for r in range(6):
+        scale = -1.0 / (mass if r < 3 else inertia[r - 3])
+        for c in range(6):
+            jac[r, c] = scale * damping[r, c]
     # an integrator stage may try a state whose normal velocities exceed a table's (stiff
     # contact): it gets the table's largest velocity; the accepted states are checked when the
     # history is sampled (surface_loads reports BEYOND_TABLE there)
@@ -204,5 +256,5 @@ def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length
     if status == OK:
         for k in range(14):
             if not math.isfinite(dy[k]):
-                return dy, NOT_FINITE, vn
-    return dy, status, vn
+                return dy, jac, NOT_FINITE, vn
+    return dy, jac, status, vn

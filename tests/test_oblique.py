@@ -12,6 +12,7 @@ from cavex.analytic.penetration import penetrate
 from cavex.analytic.projectile_body import build_body
 from cavex.analytic.resistance import ClosedFormResistance
 from cavex.analytic.stress_laws import DerivedLaw, make_law
+from cavex.analytic.surface_force import rotation_matrix
 from cavex.config import load_config
 
 
@@ -87,23 +88,28 @@ def test_derived_law_is_cavity_stress_element_by_element(runway, boundary):
         assert sigma[i] == pytest.approx(ref, rel=1e-14)  # measured: equal
 
 
-def _one_layer_normal(runway, boundary):
+def _one_layer_normal(runway, boundary, method="DOP853", rtol=1e-10):
     target, projectile = runway
     single = target.single(0)
     body = build_body(projectile)
     start = body.nose_length + 0.5 * body.sizes.max() + 1e-4  # nose fully embedded
     law = make_law(single, projectile, "derived", boundary=boundary, free_surface=False)
-    model = ObliqueModel(single, projectile, law, body=body, rtol=1e-10, atol=1e-13,
-                         method="DOP853", contact_ramp=0.0)
+    model = ObliqueModel(single, projectile, law, body=body, rtol=rtol, atol=1e-3 * rtol,
+                         method=method, contact_ramp=0.0)
     result = model.run(Shot(projectile.V0, tip_depth=start))
     one_d = penetrate(single, projectile, ClosedFormResistance(single, projectile, "derived",
                                                                 boundary), crater=None)
     return start, result, one_d
 
 
-@pytest.mark.parametrize("boundary", ["dynamic", "quasi-static"])
-def test_normal_incidence_one_layer_is_the_1d_tunnel(runway, boundary):
-    start, result, one_d = _one_layer_normal(runway, boundary)
+@pytest.mark.parametrize("boundary, method, rtol", [("dynamic", "DOP853", 1e-10),
+                                                     ("quasi-static", "DOP853", 1e-10),
+                                                     ("dynamic", "ROS2", 1e-6)])
+def test_normal_incidence_one_layer_is_the_1d_tunnel(runway, boundary, method, rtol):
+    """The 1-D tunnel phase, with the reference DOP853 and with the compiled default ROS2 (a
+    smooth problem here: its global error falls as rtol, measured depth error 3.3e-7, 3.3e-8,
+    3.3e-9 at rtol 1e-6, 1e-7, 1e-8 with 1631, 5134, 16214 steps: second order)."""
+    start, result, one_d = _one_layer_normal(runway, boundary, method, rtol)
     _, projectile = runway
     h = result.history
     # no lateral motion or rotation (round-off of sums of ~10^5 N); measured <= 2e-9 rad/s
@@ -181,24 +187,52 @@ def test_work_of_surface_forces_is_the_kinetic_energy_lost(runway):
     target, projectile = runway
     projectile = replace(projectile, mu=0.1)
     shot = Shot(700.0, obliquity=30.0, attack=3.0, attack_plane=40.0, spin=500.0)
+    # the reference integrator (the compiled default's energy balance: the next test)
     result = fly(target.single(0), projectile, shot, "law", law_A=2e8, law_B=2500.0,
-            contact_ramp=1.0)
-    model = result.model
-    y0 = result.solutions[0].y[:, 0]
-    y1 = result.solutions[-1].y[:, -1]
-    lost = model.energy(y0) - model.energy(y1)
+                 contact_ramp=1.0, method="RK45", rtol=1e-6, atol=1e-9)
     # measured 9.6e-10 relative (RK45, rtol 1e-6: the work is integrated with the state)
-    assert abs(-y1[13] / lost - 1.0) < 1e-6
+    assert abs(_work_mismatch(result)) < 1e-6
     assert abs(result.history["yaw_deg"]).max() > 0.1  # a genuinely 3-D shot
 
 
-def test_surface_discretisation_converges_at_second_order(runway):
+def _work_mismatch(result):
+    """Work of the surface forces over the kinetic energy lost, minus 1."""
+    y0, y1 = result.solutions[0].y[:, 0], result.solutions[-1].y[:, -1]
+    return -y1[13] / (result.model.energy(y0) - result.model.energy(y1)) - 1.0
+
+
+def test_compiled_integrator_energy_balance_converges(runway):
+    """The default ROS2 integrator on the same 3-D shot with friction, spin and the default
+    contact ramp: the work-energy mismatch is its global error. Measured 9.5e-4, 4.4e-4,
+    2.2e-4 at rtol 1e-3, 1e-4, 1e-5 (and 1.9e-5, 1.8e-6 at 1e-6, 1e-7): first order in the
+    tolerance at tight tolerances (the contact's switching makes the right-hand side only
+    piecewise smooth), slower at loose ones."""
+    from dataclasses import replace
+    target, projectile = runway
+    projectile = replace(projectile, mu=0.1)
+    shot = Shot(700.0, obliquity=30.0, attack=3.0, attack_plane=40.0, spin=500.0)
+    rtols = np.array([1e-3, 1e-4, 1e-5])
+    mismatch = np.array([abs(_work_mismatch(fly(target.single(0), projectile, shot, "law",
+                                                  law_A=2e8, law_B=2500.0, rtol=r,
+                                                  atol=1e-3 * r))) for r in rtols])
+    rate = np.polyfit(np.log(rtols), np.log(mismatch), 1)[0]
+    print("work-energy mismatch", mismatch, "fitted order in rtol", rate)
+    assert mismatch[0] < 2e-3 and rate > 0.25
+    assert np.all(np.diff(mismatch) < 0.0)
+
+
+@pytest.mark.parametrize("contact_ramp, order", [(0.1, 1.8), (0.01, 1.3)])
+def test_surface_discretisation_converges(runway, contact_ramp, order):
     """Force of the surface on a body crossing the free surface (oblique, yawed, rotating),
     for refinements of all three element counts by 2: errors against a 4x finer level
     (262 144 elements) fitted to h^p. The smoothed embedded fraction and the midpoint rules
-    are second order; measured p = 2.09 (force errors 5.8e-3, 1.1e-3, 3.2e-4 of |F| at 4 096,
-    16 384, 65 536 elements; 4.1e-2 at the default 256: the entry transient, whose effect on
-    the final depth is 3e-4, benchmarks/oblique_speed.py)."""
+    are second order where the integrand is smooth; the wetted region ends where ``V_n``
+    changes sign, and over a ramp ``V_r`` much smaller than the change of ``V_n`` across an
+    element the load jumps there: a jump along a line costs the midpoint rule its second
+    order (``h^(3/2)`` on average). Measured p = 2.09 at V_r = 0.1 m/s (force errors 5.8e-3,
+    1.1e-3, 3.2e-4 of |F| at 4 096, 16 384, 65 536 elements) and p = 1.48 at the default
+    0.01 m/s (the final depth of a trajectory is converged to 0.1 % at the default 256
+    elements: benchmarks/oblique_speed.py, docs/oblique.md)."""
     target, projectile = runway
     law = make_law(target, projectile, "derived")
     shot = Shot(800.0, obliquity=30.0, attack=3.0, attack_plane=30.0)
@@ -206,7 +240,7 @@ def test_surface_discretisation_converges_at_second_order(runway):
     forces = []
     for f in levels:
         body = build_body(projectile, nose_points=2 * f, azimuths=4 * f, shank_rings=2 * f)
-        model = ObliqueModel(target, projectile, law, body=body)
+        model = ObliqueModel(target, projectile, law, body=body, contact_ramp=contact_ramp)
         y = model.initial_state(shot)
         y[2] += 0.07  # nose tip 7 cm deep: the body crosses the free surface
         y[10:13] = [50.0, 200.0, -100.0]
@@ -215,7 +249,7 @@ def test_surface_discretisation_converges_at_second_order(runway):
     errors = np.linalg.norm(forces[:-1] - forces[-1], axis=1) / np.linalg.norm(forces[-1])
     rate = np.polyfit(np.log(1.0 / np.array(levels[:-1])), np.log(errors), 1)[0]
     print("force errors", errors, "fitted order", rate)
-    assert rate > 1.8
+    assert rate > order
     assert errors[-1] < 1e-3
 
 
@@ -262,13 +296,20 @@ def test_events_end_each_phase_where_they_say(runway):
     assert grazing.phases[0]["end_pitch_deg"] == pytest.approx(90.0, abs=1e-6)
     end = grazing.solutions[-1].y[:, -1]
     assert grazing.end["state"] == "ricochet"
-    assert grazing.model.extreme_depths(end)[0] == pytest.approx(0.0, abs=1e-9)
+    assert _extreme_depths(grazing.model, end)[0] == pytest.approx(0.0, abs=1e-9)
 
     through = fly(target.single(0), projectile, Shot(600.0, obliquity=20.0), "law",
                   bottom=0.3, **law)
     end = through.solutions[-1].y[:, -1]
     assert through.end["state"] == "perforation"
-    assert through.model.extreme_depths(end)[1] == pytest.approx(0.3, abs=1e-9)
+    assert _extreme_depths(through.model, end)[1] == pytest.approx(0.3, abs=1e-9)
+
+
+def _extreme_depths(model, y):
+    """Deepest and shallowest depth of the body's surface points and tip (numpy)."""
+    rot = rotation_matrix(y[3:7])
+    z = y[2] + (np.vstack([model.body.points, model.body.tip]) @ rot.T)[:, 2]
+    return z.max(), z.min()
 
 
 def test_paper_law_is_the_printed_model_at_the_mapped_depth(runway):
