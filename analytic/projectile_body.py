@@ -38,7 +38,7 @@ from cavex.errors import require
 
 NOSE_POINTS = 8
 AZIMUTHS = 16
-SHANK_RINGS = 8
+SHANK_RINGS = 16
 
 
 @dataclass(frozen=True)

@@ -140,6 +140,9 @@ def build_parser():
     trajectory.add_argument("--compare-homogeneous", action="store_true",
                             help="also the same shot into the first layer alone")
     trajectory.add_argument("--json", action="store_true", help="print JSON")
+    trajectory.add_argument("--figures", action=argparse.BooleanOptionalAction, default=True,
+                            help="draw the figures (default; --no-figures: the CSV histories "
+                            "and summary.json only, for scripted runs)")
     trajectory.add_argument("--progress", action=argparse.BooleanOptionalAction,
                             help="progress bar of integrator steps on stderr (default: when "
                             "stderr is a terminal)")

@@ -99,9 +99,9 @@ def summary(result):
     return {"end": result.end, "phases": result.phases, **peaks(result.history)}
 
 
-def write_outputs(job, runs, out):
-    """CSV histories, the summary JSON (``runs``: :func:`summary` of each run) and the figures
-    into ``out``; returns the paths written."""
+def write_outputs(job, runs, out, draw=True):
+    """CSV histories, the summary JSON (``runs``: :func:`summary` of each run) and, if
+    ``draw``, the figures into ``out``; returns the paths written."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     written = [str(write_columns_csv(folder / f"history_{name.replace(' ', '_')}.csv",
@@ -111,7 +111,8 @@ def write_outputs(job, runs, out):
     text = json.dumps({"settings": job["settings"], "runs": runs}, indent=2)
     write_text_atomic(path, text + "\n")
     written.append(str(path))
-    written += figures(job, folder)
+    if draw:
+        written += figures(job, folder)
     return written
 
 
@@ -332,7 +333,8 @@ def trajectory_main(args, target, projectile):
         raise CavexNumericalError("the trajectory summary is not finite (peaks, pitch "
                                   "rate)") from None
     # every file or none, also on Ctrl-C or kill
-    written = write_staged(folder, lambda stage: write_outputs(job, runs, stage))
+    written = write_staged(folder, lambda stage: write_outputs(job, runs, stage,
+                                                              draw=args.figures))
     if args.json:
         main = runs["runway"]
         return json.dumps({"end": main["end"], "phases": main["phases"],
