@@ -130,7 +130,7 @@ def build_parser():
                             default="dynamic", help="convention of the derived law")
     trajectory.add_argument("--contact-ramp", dest="contact_ramp", type=float, default=None,
                             help="contact regularisation: the stress rises linearly over "
-                            "0 < V_n < this (m/s; default 0.1; docs/oblique.md)")
+                            "0 < V_n < this (m/s; default 0.01; docs/oblique.md)")
     trajectory.add_argument("--table", help="NetCDF table from `cavex table` (--resistance table)")
     trajectory.add_argument("--law-A", dest="law_A", type=float, help="A of sigma_n = A + B "
                             "V_n^2 (Pa)")
