@@ -264,7 +264,7 @@ class ObliqueModel:
         return directions, described, args
 
     def event_values(self, y, args):
-        return event_values(y, *args[:4], self.body.mass, self._inertia, args[4],
+        return event_values(y, self.body.mass, self._inertia, args,
                             np.empty(len(self.target.interface_depths) + 4))
 
     def run(self, shot, max_phases=50, progress=None):

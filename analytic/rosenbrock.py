@@ -25,10 +25,14 @@ Step control: the embedded first-order solution ``y_n + h k_1`` gives the estima
 Events: the functions of :func:`event_values` (nose tip at each interface, deepest and
 shallowest point of the body, the axis's ``z`` component, transverse kinetic energy) are
 checked after every accepted step with the sign rules of ``scipy.integrate.solve_ivp``
-(``direction`` > 0: from below to above zero, < 0: from above, 0: either); a root is located
-by bisection to 4 ulp of ``t`` on the cubic Hermite interpolant of the step (``y`` and ``f``
-at both ends: third order), which is also the dense output of the trajectory. Every event is
-terminal: integration stops at the earliest root of the step.
+(``direction`` > 0: from below to above zero, < 0: from above, 0: either). A root is first
+located by bisection on the cubic Hermite interpolant of the step (``y`` and ``f`` at both
+ends; also the dense output of the trajectory), then landed on with a step of the method
+itself, its length found by secant iteration to 4 ulp of ``t``: an interpolated state's
+lateral velocity is off the stiff contact's slow manifold by the interpolation error, which
+the damper turns into a spurious side force (a 95 000 g spike at an interface crossing, and a
+kick into the next phase). Every event is terminal: integration stops at the earliest root of
+the step.
 
 One call advances at most ``max_steps`` accepted steps and returns, so that the caller can
 report progress and resume (:func:`integrate`).
@@ -44,16 +48,19 @@ from cavex.analytic.surface_force import derivative, rotation_matrix
 
 GAMMA = 1.0 + 1.0 / math.sqrt(2.0)
 SAFETY, SHRINK, GROW = 0.9, 0.2, 5.0
+EPS = 2.220446049250313e-16
 # statuses of integrate() beside the stress-law statuses (OK, WALK_FAILED, ..., NOT_FINITE)
 RUNNING, EVENT, END_TIME, STEP_TOO_SMALL = 10, 11, 12, 13
 
 
 @njit(cache=True, error_model="numpy")
-def event_values(y, tip, points, depths, bottom, mass, inertia, energy_stop, out):
-    """Event functions of the state ``y`` into ``out``: ``tip_z - H_j`` for every interface,
+def event_values(y, mass, inertia, event_args, out):
+    """Event functions of the state ``y`` into ``out`` (``event_args = (tip, points, depths,
+    bottom, energy_stop)``, body frame): ``tip_z - H_j`` for every interface,
     then the deepest point of the body (ricochet when it rises through 0), the shallowest
     minus the bottom (perforation; 0 without a bottom), the axis's ``z`` component (axis
     parallel to the surface) and the kinetic energy without spin minus ``energy_stop``."""
+    tip, points, depths, bottom, energy_stop = event_args
     rot = rotation_matrix(y[3:7])
     down0, down1, down2 = rot[2, 0], rot[2, 1], rot[2, 2]  # target z in body coordinates
     tip_z = y[2] + (down0 * tip[0] + down1 * tip[1] + down2 * tip[2])
@@ -152,6 +159,87 @@ def _stage(matrix, f, out):
 
 
 @njit(cache=True, error_model="numpy")
+def ros2_step(y, f, jac, h, rtol, atol, mass, inertia, surface, y1):
+    """One ROS2 step of length ``h`` from ``y`` (``f = f(y)``, ``jac`` its damping block)
+    into ``y1``; returns ``(scaled error, status, V_n)`` (module docstring)."""
+    matrix = np.empty((6, 6))
+    for r in range(6):
+        for c in range(6):
+            matrix[r, c] = (1.0 if r == c else 0.0) - GAMMA * h * jac[r, c]
+    k1 = _stage(matrix, f, np.empty(14))
+    stage = np.empty(14)
+    for k in range(14):
+        stage[k] = y[k] + h * k1[k]
+    fstage, _, status, vn = derivative(stage, mass, inertia, *surface)
+    if status != OK:
+        return np.inf, status, vn
+    for k in range(14):
+        stage[k] = fstage[k] - 2.0 * k1[k]
+    k2 = _stage(matrix, stage, np.empty(14))
+    for k in range(14):
+        y1[k] = y[k] + h * (1.5 * k1[k] + 0.5 * k2[k])
+        stage[k] = 0.5 * h * (k1[k] + k2[k])
+    estimate = _stage(matrix, stage, np.empty(14))  # filtered: (I - gamma h J)^-1 e
+    return scaled_rms(estimate, y, y1, rtol, atol), OK, 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _fires(g0, g1, direction):
+    """``solve_ivp``'s rule: does an event with these values at the ends of a step fire?"""
+    up = g0 <= 0.0 and g1 >= 0.0
+    down = g0 >= 0.0 and g1 <= 0.0
+    return ((up and direction > 0.0) or (down and direction < 0.0)
+            or ((up or down) and direction == 0.0))
+
+
+@njit(cache=True, error_model="numpy")
+def _hermite_root(e, g_start, t, h, y, f, y1, f1, mass, inertia, event_args, gs, probe):
+    """Fraction of the step at which event ``e`` changes sign on the cubic Hermite
+    interpolant (bisection to 4 ulp of ``t``; the returned end is on the far side)."""
+    lo, hi = 0.0, 1.0
+    while (hi - lo) * h > 4.0 * EPS * max(abs(t), abs(t + h)) and hi - lo > EPS:
+        mid = 0.5 * (lo + hi)
+        hermite(mid, h, y, f, y1, f1, probe)
+        event_values(probe, mass, inertia, event_args, gs)
+        if (gs[e] >= 0.0) == (g_start >= 0.0) and gs[e] != 0.0:
+            lo = mid
+        else:
+            hi = mid
+    return hi
+
+
+@njit(cache=True, error_model="numpy")
+def _land(e, fraction, t, h, y, f, jac, rtol, atol, mass, inertia, surface, event_args, gs,
+          out):
+    """The state at the root of event ``e`` reached by a ROS2 step from ``(t, y)`` (not by the
+    interpolant, whose lateral velocity is off the contact's slow manifold by up to the
+    interpolation error and would carry a spurious damper force): secant iteration on the step
+    length, from the interpolant's root, to 4 ulp of ``t``. Returns ``(fraction, status,
+    V_n, steps taken)`` with the state in ``out``."""
+    tolerance = 4.0 * EPS * max(abs(t), abs(t + h)) / h
+    s_prev, s = fraction, fraction * (1.0 - 1e-6)
+    _, status, vn = ros2_step(y, f, jac, s_prev * h, rtol, atol, mass, inertia, surface, out)
+    calls = 1
+    if status != OK:
+        return s_prev, status, vn, calls
+    g_prev = event_values(out, mass, inertia, event_args, gs)[e]
+    for _ in range(50):
+        _, status, vn = ros2_step(y, f, jac, s * h, rtol, atol, mass, inertia, surface, out)
+        calls += 1
+        if status != OK:
+            return s, status, vn, calls
+        g = event_values(out, mass, inertia, event_args, gs)[e]
+        if g == 0.0 or g == g_prev:
+            return s, OK, 0.0, calls
+        s_new = min(max(s - g * (s - s_prev) / (g - g_prev), 0.0), 1.0)
+        s_prev, g_prev, s = s, g, s_new
+        if abs(s - s_prev) <= tolerance:
+            break
+    _, status, vn = ros2_step(y, f, jac, s * h, rtol, atol, mass, inertia, surface, out)
+    return s, status, vn, calls + 1
+
+
+@njit(cache=True, error_model="numpy")
 def integrate(t, y, f, jac, h, t_end, rtol, atol, max_steps, directions, event_args, ts, ys,
               fs, mass, inertia, surface):
     """Advance from ``(t, y)`` (``f = f(y)``, ``jac`` its damping block) by at most
@@ -159,24 +247,16 @@ def integrate(t, y, f, jac, h, t_end, rtol, atol, max_steps, directions, event_a
     ``ts[1:], ys[1:], fs[1:]`` (row 0 is the start). Returns ``(status, steps, h_next,
     evaluations, event, V_n)``: ``status`` RUNNING (``max_steps`` taken), EVENT (the last row
     is the root of event ``event``), END_TIME, STEP_TOO_SMALL or a failed stress-law status of
-    the right-hand side (``V_n`` of the failed element). ``event_args`` are the arguments of
-    :func:`event_values` after ``y`` and before ``out``, ``surface`` those of
+    the right-hand side (``V_n`` of the failed element). ``event_args`` are the ``event_args``
+    of :func:`event_values`, ``surface`` those of
     :func:`cavex.analytic.surface_force.derivative` after ``inertia``."""
-    points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom, kind, \
-        scalars, values, tables, counts, depths = surface
-    tip, event_points, event_depths, event_bottom, energy_stop = event_args
     y = y.copy()
     n_events = directions.shape[0]
-    g0 = event_values(y, tip, event_points, event_depths, event_bottom, mass, inertia,
-                      energy_stop, np.empty(n_events))
+    g0 = event_values(y, mass, inertia, event_args, np.empty(n_events))
     g1 = np.empty(n_events)
     gs = np.empty(n_events)
-    k1 = np.empty(14)
-    k2 = np.empty(14)
     y1 = np.empty(14)
-    stage = np.empty(14)
     probe = np.empty(14)
-    matrix = np.empty((6, 6))
     ts[0] = t
     ys[0] = y
     fs[0] = f
@@ -186,26 +266,10 @@ def integrate(t, y, f, jac, h, t_end, rtol, atol, max_steps, directions, event_a
         if t >= t_end:
             return END_TIME, steps, h, evaluations, -1, 0.0
         h = min(h, t_end - t)
-        for r in range(6):
-            for c in range(6):
-                matrix[r, c] = (1.0 if r == c else 0.0) - GAMMA * h * jac[r, c]
-        _stage(matrix, f, k1)
-        for k in range(14):
-            stage[k] = y[k] + h * k1[k]
-        fstage, _, status, vn = derivative(stage, mass, inertia, points, normals, areas, sizes,
-                                           partners, length, mu, contact_ramp, bottom, kind,
-                                           scalars, values, tables, counts, depths)
+        err, status, vn = ros2_step(y, f, jac, h, rtol, atol, mass, inertia, surface, y1)
         evaluations += 1
         if status != OK:
             return status, steps, h, evaluations, -1, vn
-        for k in range(14):
-            probe[k] = fstage[k] - 2.0 * k1[k]
-        _stage(matrix, probe, k2)
-        for k in range(14):
-            y1[k] = y[k] + h * (1.5 * k1[k] + 0.5 * k2[k])
-            probe[k] = 0.5 * h * (k1[k] + k2[k])
-        _stage(matrix, probe, stage)  # the filtered estimate (I - gamma h J)^-1 e
-        err = scaled_rms(stage, y, y1, rtol, atol)
         if not math.isfinite(err):
             return STEP_TOO_SMALL, steps, h, evaluations, -1, 0.0
         if err > 1.0:
@@ -213,47 +277,30 @@ def integrate(t, y, f, jac, h, t_end, rtol, atol, max_steps, directions, event_a
             if h <= 1e-15 * max(abs(t), 1e-6):
                 return STEP_TOO_SMALL, steps, h, evaluations, -1, 0.0
             continue
-        f1, jac1, status, vn = derivative(y1, mass, inertia, points, normals, areas, sizes,
-                                          partners, length, mu, contact_ramp, bottom, kind,
-                                          scalars, values, tables, counts, depths)
+        f1, jac1, status, vn = derivative(y1, mass, inertia, *surface)
         evaluations += 1
         if status != OK:
             return status, steps, h, evaluations, -1, vn
-        event_values(y1, tip, event_points, event_depths, event_bottom, mass, inertia,
-                     energy_stop, g1)
-        # the earliest root among the events that fire in this step
-        first, t_first, root = -1, np.inf, 1.0
+        event_values(y1, mass, inertia, event_args, g1)
+        # the earliest root among the events that fire in this step, on the interpolant
+        first, root = -1, np.inf
         for e in range(n_events):
-            up = g0[e] <= 0.0 and g1[e] >= 0.0
-            down = g0[e] >= 0.0 and g1[e] <= 0.0
-            if not ((up and directions[e] > 0.0) or (down and directions[e] < 0.0)
-                    or ((up or down) and directions[e] == 0.0)):
-                continue
-            lo, hi = 0.0, 1.0  # bisection on the step fraction, g(lo) on the g0 side
-            while (hi - lo) * h > 4.0 * 2.220446049250313e-16 * max(abs(t), abs(t + h)):
-                mid = 0.5 * (lo + hi)
-                hermite(mid, h, y, f, y1, f1, probe)
-                event_values(probe, tip, event_points, event_depths, event_bottom, mass,
-                             inertia, energy_stop, gs)
-                if (gs[e] >= 0.0) == (g0[e] >= 0.0) and gs[e] != 0.0:
-                    lo = mid
-                else:
-                    hi = mid
-                if hi - lo <= 2.220446049250313e-16:
-                    break
-            if t + hi * h < t_first:
-                first, t_first = e, t + hi * h
-                root = hi
-        if first >= 0:
-            hermite(root, h, y, f, y1, f1, probe)
-            f_root, jac_root, status, vn = derivative(
-                probe, mass, inertia, points, normals, areas, sizes, partners, length, mu,
-                contact_ramp, bottom, kind, scalars, values, tables, counts, depths)
-            evaluations += 1
+            if _fires(g0[e], g1[e], directions[e]):
+                fraction = _hermite_root(e, g0[e], t, h, y, f, y1, f1, mass, inertia,
+                                         event_args, gs, probe)
+                if fraction < root:
+                    first, root = e, fraction
+        if first >= 0:  # land on it with a step of the method
+            root, status, vn, calls = _land(first, root, t, h, y, f, jac, rtol, atol, mass,
+                                            inertia, surface, event_args, gs, probe)
+            evaluations += calls
+            if status == OK:
+                f_root, _, status, vn = derivative(probe, mass, inertia, *surface)
+                evaluations += 1
             if status != OK:
                 return status, steps, h, evaluations, -1, vn
             steps += 1
-            ts[steps] = t_first
+            ts[steps] = t + root * h
             ys[steps] = probe
             fs[steps] = f_root
             return EVENT, steps, h, evaluations, first, 0.0
