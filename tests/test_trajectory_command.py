@@ -122,8 +122,8 @@ def test_findings_are_computed_from_the_table():
     lines = table_csv(results).splitlines()
     assert lines[0].startswith("obliquity_deg,speed_m_s,contact_ramp_m_s,target")
     normal = next(line for line in lines if line.startswith(f"0,800,{RAMPS[0]:g},runway"))
-    assert "lateral" not in lines[0]  # a step-sampled spike: not written (module docstring)
-    assert normal.split(",")[5:7] == ["0.10", "1.20"]  # depths and positions to 0.01 m
+    assert normal.split(",")[5:7] == ["0.100", "1.200"]  # depths and positions to 1 mm
+    assert normal.split(",")[12] == "0"  # lateral overload 1e-5 g: under the noise floor
 
 
 def test_progress_is_called_once_per_step():
