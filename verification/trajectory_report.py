@@ -28,7 +28,7 @@ from cavex.verification.runner import (
 
 DEFAULT_DIR = "results/trajectory"
 # m/s: below it the damping Jacobian frozen over a ROS2 step misjudges the switching contact
-# and the steps explode (1e-4 m/s: 289 377 steps against 613 at 1e-3, docs/oblique.md)
+# and the steps explode (1e-4 m/s: 241 823 steps against 419 at 1e-3, docs/oblique.md)
 MIN_CONTACT_RAMP = 0.001
 
 
