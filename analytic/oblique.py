@@ -43,6 +43,11 @@ MAX_TIME = 1.0  # s
 COMPILED = "ROS2"
 METHOD, RTOL, ATOL = COMPILED, 1e-3, 1e-6
 CHUNK = 2000  # accepted steps per call of the compiled integrator (progress is reported after)
+# smallest step, relative to the time the striking speed takes to cover the body's length
+# (measured shots take steps >= 2e-8 of it, the first step): below it the step size has
+# collapsed (forces far beyond the body's mass or inertia, a crawling shot) and the run is a
+# numerical failure
+MIN_STEP = 1e-12
 RICOCHET = "ricochet: left the target through the entry face"
 PERFORATION = "perforation: left through the bottom face"
 STOPPED = "stopped"
@@ -271,6 +276,7 @@ class ObliqueModel:
         """Integrate ``shot`` to a final event; returns a :class:`Result`. ``progress``:
         optional ``callable(t, y)`` called after every integrator step."""
         y = self.initial_state(shot)
+        self._min_step = MIN_STEP * self.body.length / shot.speed
         directions, described, args = self._events(self.energy(y, transverse_only=True))
         g = self.event_values(y, args)
         for k, (_, crossing, _) in enumerate(described):  # the next crossing is away from
@@ -316,8 +322,8 @@ class ObliqueModel:
         parts = []
         while True:
             status, steps, h, evaluations, event, vn = integrate(
-                t0, y, f, jac, h, MAX_TIME, self.rtol, self.atol, CHUNK, directions, args, ts,
-                ys, fs, mass, inertia, self._surface)
+                t0, y, f, jac, h, MAX_TIME, self._min_step, self.rtol, self.atol, CHUNK,
+                directions, args, ts, ys, fs, mass, inertia, self._surface)
             self.evaluations += evaluations
             parts.append((ts[1:steps + 1].copy(), ys[1:steps + 1].copy(), fs[1:steps + 1].copy())
                          if parts else (ts[:steps + 1].copy(), ys[:steps + 1].copy(),

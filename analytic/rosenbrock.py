@@ -240,10 +240,11 @@ def _land(e, fraction, t, h, y, f, jac, rtol, atol, mass, inertia, surface, even
 
 
 @njit(cache=True, error_model="numpy")
-def integrate(t, y, f, jac, h, t_end, rtol, atol, max_steps, directions, event_args, ts, ys,
-              fs, mass, inertia, surface):
+def integrate(t, y, f, jac, h, t_end, min_step, rtol, atol, max_steps, directions, event_args,
+              ts, ys, fs, mass, inertia, surface):
     """Advance from ``(t, y)`` (``f = f(y)``, ``jac`` its damping block) by at most
-    ``max_steps`` accepted steps of initial size ``h``, writing the accepted points into
+    ``max_steps`` accepted steps of initial size ``h`` (none below ``min_step``: the step size
+    has collapsed, STEP_TOO_SMALL), writing the accepted points into
     ``ts[1:], ys[1:], fs[1:]`` (row 0 is the start). Returns ``(status, steps, h_next,
     evaluations, event, V_n)``: ``status`` RUNNING (``max_steps`` taken), EVENT (the last row
     is the root of event ``event``), END_TIME, STEP_TOO_SMALL or a failed stress-law status of
@@ -265,6 +266,8 @@ def integrate(t, y, f, jac, h, t_end, rtol, atol, max_steps, directions, event_a
     while steps < max_steps:
         if t >= t_end:
             return END_TIME, steps, h, evaluations, -1, 0.0
+        if h < min_step:
+            return STEP_TOO_SMALL, steps, h, evaluations, -1, 0.0
         h = min(h, t_end - t)
         err, status, vn = ros2_step(y, f, jac, h, rtol, atol, mass, inertia, surface, y1)
         evaluations += 1
@@ -274,8 +277,6 @@ def integrate(t, y, f, jac, h, t_end, rtol, atol, max_steps, directions, event_a
             return STEP_TOO_SMALL, steps, h, evaluations, -1, 0.0
         if err > 1.0:
             h *= max(SHRINK, SAFETY / math.sqrt(err))
-            if h <= 1e-15 * max(abs(t), 1e-6):
-                return STEP_TOO_SMALL, steps, h, evaluations, -1, 0.0
             continue
         f1, jac1, status, vn = derivative(y1, mass, inertia, *surface)
         evaluations += 1
