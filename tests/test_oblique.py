@@ -91,7 +91,11 @@ def test_derived_law_is_cavity_stress_element_by_element(runway, boundary):
 def _one_layer_normal(runway, boundary, method="DOP853", rtol=1e-10):
     target, projectile = runway
     single = target.single(0)
-    body = build_body(projectile)
+    # 8 shank rings: the shank carries no load here; with the default 16 the round-off lateral
+    # velocity near the end (omega ~2e-8 rad/s) crosses the 1e-9 round-off guard of V_n and,
+    # without a contact ramp (which this comparison needs), shank elements switch on and off:
+    # the same answer (depth 1.6e-11) but 56 053 DOP853 steps (173 s) instead of 525
+    body = build_body(projectile, shank_rings=8)
     start = body.nose_length + 0.5 * body.sizes.max() + 1e-4  # nose fully embedded
     law = make_law(single, projectile, "derived", boundary=boundary, free_surface=False)
     model = ObliqueModel(single, projectile, law, body=body, rtol=rtol, atol=1e-3 * rtol,
