@@ -4,9 +4,10 @@ The rigid body (:mod:`cavex.analytic.projectile_body`) moves under the different
 law of :mod:`cavex.analytic.surface_force`: every surface element inside the target and moving
 into it feels the normal stress of a stress law (:mod:`cavex.analytic.stress_laws`) at its own
 normal velocity, plus Coulomb friction; the summed force and moment drive the six degrees of
-freedom. This module sets up the shot, integrates the equations of motion with
-``scipy.integrate.solve_ivp`` between events (the nose tip crossing an interface, ricochet,
-perforation, the axis parallel to the surface, stop) and samples the history.
+freedom. This module sets up the shot, integrates the equations of motion between events (the
+nose tip crossing an interface, ricochet, perforation, the axis parallel to the surface, stop)
+with the compiled ROS2 integrator of :mod:`cavex.analytic.rosenbrock` (or, as the reference,
+any ``scipy.integrate.solve_ivp`` method) and samples the history.
 
 Target frame: free surface ``z = 0``, ``z`` positive into the target, ``x`` along the striking
 velocity's horizontal component, ``y`` completing a right-handed frame. Pitch: angle (deg)
@@ -276,6 +277,7 @@ class ObliqueModel:
         """Integrate ``shot`` to a final event; returns a :class:`Result`. ``progress``:
         optional ``callable(t, y)`` called after every integrator step."""
         y = self.initial_state(shot)
+        self._step = None  # every run starts afresh: the same shot, the same bits
         self._min_step = MIN_STEP * self.body.length / shot.speed
         directions, described, args = self._events(self.energy(y, transverse_only=True))
         g = self.event_values(y, args)

@@ -368,3 +368,15 @@ def test_table_law_survives_integrator_stages_beyond_the_table(runway):
     # the accepted states: every surface element's normal velocity within the table (the
     # history sampling raises otherwise); and the shot ends in macadam like the closed form
     assert 0.65 < result.end["nose_tip_m"][2] < 0.85
+
+
+def test_a_model_run_twice_gives_the_same_bits(runway):
+    """The compiled integrator keeps its step across phases, not across runs."""
+    target, projectile = runway
+    model = ObliqueModel(target, projectile, make_law(target, projectile, "law", law_A=2e8,
+                                                      law_B=2500.0))
+    first = model.run(Shot(600.0, obliquity=20.0))
+    model.run(Shot(900.0, obliquity=40.0))
+    again = model.run(Shot(600.0, obliquity=20.0))
+    assert np.array_equal(first.history["t_s"], again.history["t_s"])
+    assert first.end == again.end
