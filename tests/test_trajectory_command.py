@@ -13,7 +13,7 @@ from cavex.cli import main
 from cavex.config import load_config
 from cavex.verification.oblique_study import RAMPS, findings, overload_peaks, table_csv
 
-# contact ramp 1 m/s: 6x faster than the default 0.1; these tests are about the files
+# contact ramp 1 m/s (the default is 0.01): these tests are about the files, not the contact
 LAW = ["--resistance", "law", "--law-A", "2e8", "--law-B", "2500", "--contact-ramp", "1"]
 
 
