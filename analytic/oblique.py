@@ -238,12 +238,10 @@ class ObliqueModel:
         omega = np.array([shot.spin, 0.0, 0.0])
         return np.concatenate([x, q, v, omega, [0.0]])
 
-    def energy(self, y, transverse_only=False):
-        """Kinetic energy (J): translational plus rotational (without spin if asked)."""
+    def energy(self, y):
+        """Kinetic energy (J): translational plus rotational."""
         w, I = y[10:13], self._inertia  # noqa: E741 (the inertia tensor)
-        rotational = 0.5 * (I[1] * w[1] ** 2 + I[2] * w[2] ** 2)
-        if not transverse_only:
-            rotational += 0.5 * I[0] * w[0] ** 2
+        rotational = 0.5 * (I[0] * w[0] ** 2 + I[1] * w[1] ** 2 + I[2] * w[2] ** 2)
         return 0.5 * self.body.mass * float(y[7:10] @ y[7:10]) + rotational
 
     def tip(self, y):
@@ -253,10 +251,11 @@ class ObliqueModel:
         return rotation_matrix(y[3:7])[:, 0]
 
     # -- integration ----------------------------------------------------------------------
-    def _events(self, energy0):
+    def _events(self, y0):
         """``(directions, descriptions, event arguments)`` of the events of
-        :func:`cavex.analytic.rosenbrock.event_values`; a description is ``(reason, crossing,
-        interface)``: a crossing event flips its direction after firing and continues."""
+        :func:`cavex.analytic.rosenbrock.event_values` for a run from ``y0``; a description is
+        ``(reason, crossing, interface)``: a crossing event flips its direction after firing
+        and continues."""
         depths = np.asarray(self.target.interface_depths, dtype=float)
         described = [(f"nose tip crossed interface {j + 1} (z = {H:g} m)", True, j)
                      for j, H in enumerate(depths)]
@@ -266,8 +265,9 @@ class ObliqueModel:
         directions[depths.size:depths.size + 2] = -1.0, 1.0
         directions[-1] = -1.0
         args = (self._tip, self._p, depths, np.inf if self.bottom is None else float(self.bottom),
-                STOP_ENERGY * energy0)
-        return directions, described, args
+                0.0)
+        energy0 = self.event_values(y0, args)[-1]  # the stop function at zero: the energy
+        return directions, described, (*args[:4], STOP_ENERGY * energy0)
 
     def event_values(self, y, args):
         return event_values(y, self.body.mass, self._inertia, args,
@@ -279,7 +279,7 @@ class ObliqueModel:
         y = self.initial_state(shot)
         self._step = None  # every run starts afresh: the same shot, the same bits
         self._min_step = MIN_STEP * self.body.length / shot.speed
-        directions, described, args = self._events(self.energy(y, transverse_only=True))
+        directions, described, args = self._events(y)
         g = self.event_values(y, args)
         for k, (_, crossing, _) in enumerate(described):  # the next crossing is away from
             if crossing:  # the side the state is on now
@@ -340,9 +340,7 @@ class ObliqueModel:
                 raise_for(status, vn)
             if status != RUNNING:
                 break
-            t0, y = ts[steps], ys[steps].copy()
-            f, jac, status, vn = derivative(y, mass, inertia, *self._surface)
-            self.evaluations += 1
+            t0, y, f = ts[steps], ys[steps].copy(), fs[steps].copy()  # jac: integrate's
         self._step = h
         segment = Segment(*(np.concatenate(c) for c in zip(*parts, strict=True)))
         return segment, (event if status == EVENT else None)

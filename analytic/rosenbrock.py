@@ -192,12 +192,18 @@ def _fires(g0, g1, direction):
             or ((up or down) and direction == 0.0))
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _time_resolution(t, h):
+    """4 ulp of the times of a step from ``t`` to ``t + h``: where a root is resolved."""
+    return 4.0 * EPS * max(abs(t), abs(t + h))
+
+
 @njit(cache=True, error_model="numpy")
 def _hermite_root(e, g_start, t, h, y, f, y1, f1, mass, inertia, event_args, gs, probe):
     """Fraction of the step at which event ``e`` changes sign on the cubic Hermite
     interpolant (bisection to 4 ulp of ``t``; the returned end is on the far side)."""
     lo, hi = 0.0, 1.0
-    while (hi - lo) * h > 4.0 * EPS * max(abs(t), abs(t + h)) and hi - lo > EPS:
+    while (hi - lo) * h > _time_resolution(t, h) and hi - lo > EPS:
         mid = 0.5 * (lo + hi)
         hermite(mid, h, y, f, y1, f1, probe)
         event_values(probe, mass, inertia, event_args, gs)
@@ -216,7 +222,7 @@ def _land(e, fraction, t, h, y, f, jac, rtol, atol, mass, inertia, surface, even
     interpolation error and would carry a spurious damper force): secant iteration on the step
     length, from the interpolant's root, to 4 ulp of ``t``. Returns ``(fraction, status,
     V_n, steps taken)`` with the state in ``out``."""
-    tolerance = 4.0 * EPS * max(abs(t), abs(t + h)) / h
+    tolerance = _time_resolution(t, h) / h
     s_prev, s = fraction, fraction * (1.0 - 1e-6)
     _, status, vn = ros2_step(y, f, jac, s_prev * h, rtol, atol, mass, inertia, surface, out)
     calls = 1
@@ -242,7 +248,8 @@ def _land(e, fraction, t, h, y, f, jac, rtol, atol, mass, inertia, surface, even
 @njit(cache=True, error_model="numpy")
 def integrate(t, y, f, jac, h, t_end, min_step, rtol, atol, max_steps, directions, event_args,
               ts, ys, fs, mass, inertia, surface):
-    """Advance from ``(t, y)`` (``f = f(y)``, ``jac`` its damping block) by at most
+    """Advance from ``(t, y)`` (``f = f(y)``, ``jac`` its damping block, overwritten with that
+    of the last accepted state, from which a RUNNING integration resumes) by at most
     ``max_steps`` accepted steps of initial size ``h`` (none below ``min_step``: the step size
     has collapsed, STEP_TOO_SMALL), writing the accepted points into
     ``ts[1:], ys[1:], fs[1:]`` (row 0 is the start). Returns ``(status, steps, h_next,
@@ -309,7 +316,7 @@ def integrate(t, y, f, jac, h, t_end, min_step, rtol, atol, max_steps, direction
         t = t + h
         y[:] = y1
         f = f1
-        jac = jac1
+        jac[:, :] = jac1
         g0[:] = g1
         ts[steps] = t
         ys[steps] = y
