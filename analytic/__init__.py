@@ -9,8 +9,6 @@ from cavex.analytic.cavity import (
     response_state,
 )
 from cavex.analytic.geometry import spherical_problem
-from cavex.analytic.nose import nose_force, ogive_coefficients
-from cavex.analytic.oblique import Shot, fly
 from cavex.analytic.paper_model import (
     PaperCoefficients,
     PaperModel,
@@ -18,8 +16,10 @@ from cavex.analytic.paper_model import (
     paper_phase_depths,
     paper_stress,
 )
-from cavex.analytic.penetration import Trajectory, penetrate
-from cavex.analytic.resistance import ClosedFormResistance
+from cavex.analytic.penetration.integrator import Trajectory, penetrate
+from cavex.analytic.penetration.nose import nose_force, ogive_coefficients
+from cavex.analytic.penetration.oblique import Shot, fly
+from cavex.analytic.penetration.resistance import ClosedFormResistance
 
 __all__ = ["CavityState", "ClosedFormResistance", "PaperCoefficients", "PaperModel", "Shot",
            "Trajectory", "cavity_solution", "cavity_stress", "fly", "nose_force",

@@ -60,10 +60,8 @@ from functools import lru_cache
 import numpy as np
 from numba import njit
 
-from cavex.errors import CavexNumericalError, require, require_choice
-from cavex.materials import MAX_VELOCITY
-
-BOUNDARIES = ("dynamic", "quasi-static")
+from cavex.errors import CavexNumericalError
+from cavex.problem import arrays, check_arrays
 
 # Paper's Fig. 2 states, by number of concentric layers and position code of b:
 # code 2j = b inside layer j, code 2j+1 = b held at interface j (layer j+1 not yielded).
@@ -358,72 +356,6 @@ def state_labels(codes):
     return labels[inverse.reshape(-1)]
 
 
-def _first_bad(ok, value):
-    """The first element of ``value`` where ``ok`` is False, as a Python scalar."""
-    return np.broadcast_to(value, ok.shape)[~ok].flat[0].item()
-
-
-def _refuse(ok, parameter, accepted, value, other=None):
-    """Raise for the first element where ``ok`` is False; ``accepted`` may be a function of the
-    matching element of ``other`` (broadcast with ``value``)."""
-    ok = np.broadcast_to(ok, np.broadcast_shapes(np.shape(ok), np.shape(value),
-                                                 np.shape(other)))
-    if callable(accepted):
-        accepted = accepted(_first_bad(ok, other))
-    require(False, parameter, accepted, _first_bad(ok, value))
-
-
-def _arrays(interfaces, velocity, radius, free_radius):
-    """Float arrays of the inputs (``free_radius`` None becomes ``inf``)."""
-    return (np.asarray(interfaces, dtype=float), np.asarray(velocity, dtype=float),
-            np.asarray(radius, dtype=float),
-            np.asarray(np.inf if free_radius is None else free_radius, dtype=float))
-
-
-def check_problem(layers, interfaces, velocity, radius, boundary, free_radius=None):
-    """Validate a concentric-layer problem (scalars or arrays, see :func:`cavity_solution`);
-    raise ``CavexInputError`` naming the parameter and its range."""
-    _check_arrays(layers, *_arrays(interfaces, velocity, radius, free_radius), boundary)
-
-
-def _holds(ok):
-    """Whether a condition holds everywhere (a bool, or an array of them)."""
-    return ok if type(ok) is bool else bool(np.all(ok))
-
-
-def _check_arrays(layers, interfaces, velocity, radius, free_radius, boundary):
-    require(len(layers) >= 1, "layers", "at least one material", len(layers))
-    count = interfaces.shape[-1] if interfaces.ndim else -1
-    require(count == len(layers) - 1, "interfaces",
-            f"of length len(layers) - 1 = {len(layers) - 1}", count)
-    if interfaces.ndim == 1 and velocity.ndim == radius.ndim == free_radius.ndim == 0:
-        # one point: the same conditions on Python floats (faster than on 0-d arrays)
-        columns = interfaces.tolist()
-        velocity, radius, free_radius = velocity.item(), radius.item(), free_radius.item()
-    else:
-        columns = [interfaces[..., i] for i in range(count)]
-    # finite and in range, written so that NaN fails every comparison
-    ok = (radius > 0.0) & (radius < math.inf)
-    if not _holds(ok):
-        _refuse(ok, "radius", "a finite number > 0", radius)
-    ok = (velocity >= 0.0) & (velocity <= MAX_VELOCITY)
-    if not _holds(ok):
-        _refuse(ok, "velocity", f"in [0, {MAX_VELOCITY:g}] m/s", velocity)
-    require_choice(boundary, BOUNDARIES, "boundary")
-    previous = radius
-    for i, h in enumerate(columns):
-        ok = (h > previous) & (h < math.inf)
-        if not _holds(ok):
-            _refuse(ok, f"interfaces[{i}]",
-                    lambda inner: f"finite and > {inner} (increasing, outside the cavity)",
-                    h, previous)
-        previous = h
-    ok = free_radius > radius
-    if not _holds(ok):
-        _refuse(ok, "free_radius", lambda a: f"None or > radius = {a} (m, outside the cavity; "
-                "layers beyond it are ignored)", free_radius, radius)
-
-
 # ------------------------------------------------------------------------------------------
 # Evaluation
 # ------------------------------------------------------------------------------------------
@@ -460,9 +392,9 @@ def evaluate(layers, interfaces, velocity, radius, boundary, free_radius=None, z
              check=True):
     """Broadcast, (validate) and solve; returns ``(shape, values, codes, zones)`` flat."""
     layers = tuple(layers)
-    interfaces, velocity, radius, c = _arrays(interfaces, velocity, radius, free_radius)
+    interfaces, velocity, radius, c = arrays(interfaces, velocity, radius, free_radius)
     if check:
-        _check_arrays(layers, interfaces, velocity, radius, c, boundary)
+        check_arrays(layers, interfaces, velocity, radius, c, boundary)
     shape = np.broadcast_shapes(velocity.shape, interfaces.shape[:-1], radius.shape, c.shape)
     size = math.prod(shape)
     values, codes, out_zones = solve_flat(

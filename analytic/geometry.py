@@ -38,3 +38,8 @@ def wall_layer(target, projectile, depth, switch="cavity"):
     """Index in ``target.layers`` of the layer at the cavity wall at nose depth ``depth``."""
     layers, _ = spherical_problem(target, projectile, depth, switch)
     return len(target.layers) - len(layers)
+
+
+def switch_depths(target, projectile):
+    """Nose depths ``H_i + l - r`` where the wall layer changes (``switch="cavity"``)."""
+    return tuple(H + projectile.l - projectile.r for H in target.interface_depths)

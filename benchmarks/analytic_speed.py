@@ -17,8 +17,8 @@ import numpy as np
 
 from cavex.analytic.cavity import cavity_stress
 from cavex.analytic.geometry import spherical_problem
-from cavex.analytic.penetration import penetrate
-from cavex.analytic.resistance import ClosedFormResistance
+from cavex.analytic.penetration.integrator import penetrate
+from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.config import load_config
 
 ARRAY_POINTS = 200_000

@@ -12,7 +12,7 @@ import time
 import numpy as np
 
 from cavex import load_config
-from cavex.verification.fe_comparison import compare_at_depth
+from cavex.verification.fedata.comparison import compare_at_depth
 
 LEVELS = [(15.0, 0.06), (30.0, 0.03), (60.0, 0.015)]
 

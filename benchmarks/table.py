@@ -53,7 +53,7 @@ def tree_rss(process):
 
 
 def run_once(velocities, depths, workers, out):
-    command = [sys.executable, "-m", "cavex.cli", "table", "-o", out]
+    command = [sys.executable, "-m", "cavex.verification.cli", "table", "-o", out]
     if velocities is not None:
         command += ["--velocities", *map(str, velocities), "--depths", *map(str, depths)]
     if workers:

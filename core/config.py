@@ -1,5 +1,8 @@
-"""Reading targets and projectiles from TOML (strict: unknown keys and wrong types are errors)."""
+"""Targets and projectiles as TOML: read (strict: unknown keys and wrong types are errors) and
+written back (the tables, their TOML text and its fingerprint)."""
 
+import hashlib
+import json
 import tomllib
 from importlib import resources
 
@@ -10,7 +13,7 @@ LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c"}
 PROJECTILE_KEYS = {"r", "l", "R", "crh", "m", "V0", "length", "inertia", "cg", "mu"}
 TOP_KEYS = {"projectile", "layers"}
 # written by `cavex calibrate` beside the calibrated target; read by `cavex validate`
-# (cavex.verification.calibration), ignored by the commands that only need the target
+# (cavex.verification.validation.calibration), ignored by the commands that only need the target
 OPTIONAL_TOP_KEYS = {"calibration"}
 
 
@@ -89,3 +92,47 @@ def _number(value, name):
     require(isinstance(value, (int, float)) and not isinstance(value, bool), name, "a number",
             value)
     return float(value)
+
+
+def target_table(target):
+    """The ``[[layers]]`` tables of a :class:`cavex.materials.Target` (JSON-able, exact)."""
+    tables = []
+    for i, material in enumerate(target.layers):
+        table = {"name": material.name} if material.name else {}
+        if i < len(target.thicknesses):
+            table["thickness"] = float(target.thicknesses[i])
+        table.update(E=float(material.E), nu=float(material.nu), rho=float(material.rho),
+                     lam=float(material.lam), tau=float(material.tau))
+        tables.append(table)
+    return tables
+
+
+def projectile_table(projectile):
+    """The ``[projectile]`` table of a :class:`cavex.materials.Projectile`."""
+    return {key: float(getattr(projectile, key)) for key in ("r", "l", "R", "m", "V0")}
+
+
+def config_text(target, projectile):
+    """TOML text that :func:`cavex.config.load_config` reads back to ``(target, projectile)``."""
+    lines = ["[projectile]"]
+    lines += [f"{k} = {_toml_value(v)}" for k, v in projectile_table(projectile).items()]
+    for table in target_table(target):
+        lines += ["", "[[layers]]"] + [f"{k} = {_toml_value(v)}" for k, v in table.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _toml_value(value):
+    return json.dumps(value) if isinstance(value, str) else repr(float(value))
+
+
+def fingerprint_data(target, projectile):
+    """The data the table depends on: every layer key and the projectile's ``r`` and ``l``."""
+    p = projectile_table(projectile)
+    return {"layers": target_table(target), "projectile": {"r": p["r"], "l": p["l"]}}
+
+
+def fingerprint(target, projectile):
+    """sha256 of the canonical JSON (sorted keys, repr floats) of :func:`fingerprint_data`."""
+    text = json.dumps(fingerprint_data(target, projectile), sort_keys=True,
+                      separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()

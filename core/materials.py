@@ -163,7 +163,7 @@ class Projectile:
         absent: :attr:`body_length`, a solid steel body of the given mass.
     inertia : float, optional
         Transverse moment of inertia about the centre of mass (kg m^2), > 0; absent: a solid
-        body of uniform density (``cavex.analytic.projectile_body``).
+        body of uniform density (``cavex.analytic.penetration.body``).
     cg : float, optional
         Centre of mass, m from the nose tip, in (0, length); absent: uniform density.
     mu : float

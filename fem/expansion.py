@@ -18,7 +18,6 @@ from dataclasses import asdict
 
 import numpy as np
 
-from cavex.analytic.cavity import check_problem
 from cavex.errors import CavexInputError, require
 from cavex.fem.discretisation import Discretisation
 from cavex.fem.estimate import estimate_errors, refine_above
@@ -27,6 +26,7 @@ from cavex.fem.mesh import element_layers, reference_mesh
 from cavex.fem.result import ExpansionResult
 from cavex.fem.settings import make_numerics
 from cavex.fem.solver import RadialSolver
+from cavex.problem import check_problem
 
 DEFAULT_BATCH = 200     # cases per stack (measured optimum on a 2-core machine: 100-400)
 ON_ERROR = ("return", "raise")

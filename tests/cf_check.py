@@ -12,7 +12,7 @@ registry, the route pint-xarray documents for CF files.
 import numpy as np
 import pytest
 
-# the only unit strings cavex writes (cavex.verification.cf_metadata.UNITS)
+# the only unit strings cavex writes (cavex.verification.output.cf_metadata.UNITS)
 ALLOWED_UNITS = {"m s-1", "m", "Pa", "kg m-3", "s", "degree", "1"}
 FLAG_WORD = set("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.+@-")
 

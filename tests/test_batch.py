@@ -14,14 +14,14 @@ import pytest
 import xarray as xr
 
 from cavex.errors import CavexInputError
-from cavex.verification.batch import (
+from cavex.verification.fedata.batch import (
     batch_main,
     load_sweep,
     parse_sweep,
     run_sweep,
     sweep_cases,
 )
-from cavex.verification.cases import fe_cases
+from cavex.verification.fedata.cases import fe_cases
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sweep.toml"
 
@@ -154,7 +154,7 @@ def test_sweep_killed_and_resumed_computes_only_the_missing_cases(tmp_path):
     sweep.write_text(text)
     out = tmp_path / "out"
     script = textwrap.dedent(f"""
-        from cavex.verification.batch import run_sweep
+        from cavex.verification.fedata.batch import run_sweep
         run_sweep({str(sweep)!r}, {str(out)!r}, workers=1, chunk_size=2)
     """)
     process = subprocess.Popen([sys.executable, "-c", script])

@@ -29,9 +29,9 @@ from cavex.analytic.cavity import (
     response_state,
 )
 from cavex.analytic.geometry import spherical_problem
-from cavex.analytic.nose import nose_force
 from cavex.analytic.paper_model import paper_coefficients, paper_stress
-from cavex.analytic.resistance import ClosedFormResistance
+from cavex.analytic.penetration.nose import nose_force
+from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.config import load_config
 from cavex.errors import CavexInputError
 from cavex.materials import Material

@@ -7,10 +7,11 @@ import pytest
 import xarray as xr
 from cf_check import ALLOWED_UNITS, check_cf, check_quantify
 
+from cavex.analytic.penetration.tabulated import load_table
 from cavex.config import load_config
-from cavex.verification.batch import _dataset, _description, parse_sweep, sweep_cases
-from cavex.verification.cf_metadata import UNITS, decode_flags, flag_attrs, flag_word
-from cavex.verification.table import analytic_table, load_table, write_table
+from cavex.verification.fedata.batch import _dataset, _description, parse_sweep, sweep_cases
+from cavex.verification.fedata.table import analytic_table, write_table
+from cavex.verification.output.cf_metadata import UNITS, decode_flags, flag_attrs, flag_word
 
 
 @pytest.fixture(scope="module")

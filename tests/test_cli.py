@@ -18,10 +18,10 @@ import pytest
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.paper_model import paper_coefficients
-from cavex.analytic.penetration import penetrate
-from cavex.analytic.resistance import ClosedFormResistance
-from cavex.cli import main
+from cavex.analytic.penetration.integrator import penetrate
+from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.config import default_config_text, load_config
+from cavex.verification.cli import main
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 TRAJECTORY_COLUMNS = ["t_s", "depth_m", "velocity_m_s", "deceleration_m_s2", "phase"]

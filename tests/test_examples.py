@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from cavex.analytic.oblique import CONTACT_RAMP
-from cavex.verification.batch import parse_sweep, sweep_cases
+from cavex.analytic.penetration.oblique import CONTACT_RAMP
+from cavex.verification.fedata.batch import parse_sweep, sweep_cases
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

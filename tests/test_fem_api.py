@@ -10,7 +10,7 @@ from cavex import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
 from cavex.fem import expand_cavity, write_result
 from cavex.materials import Material
-from cavex.verification.fe_comparison import compare_at_depth
+from cavex.verification.fedata.comparison import compare_at_depth
 
 CONCRETE = Material(E=25e9, nu=0.4999, rho=2500.0, lam=0.15, tau=25e6, name="concrete")
 SOIL = Material(E=0.12e9, nu=0.4999, rho=1600.0, lam=0.5, tau=6e6, name="soil")

@@ -10,11 +10,11 @@ the small-strain closed form only where E/tau is small (soil: up to 7 %).
 
 import numpy as np
 import pytest
+from finite_strain import finite_strain_cavity_stress
 
 from cavex.analytic.cavity import cavity_stress
 from cavex.fem import expand_cavity
 from cavex.materials import Material
-from cavex.verification.finite_strain import finite_strain_cavity_stress
 
 RADIUS = 0.0125
 TABLE1 = {"concrete": dict(E=25e9, rho=2500.0, lam=0.15, tau=25e6),

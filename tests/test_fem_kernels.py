@@ -47,12 +47,32 @@ def test_point_kernel_equals_the_numpy_return_map(dilatancy, cutoff):
     assert np.array_equal(kernel["plastic"], oracle.plastic)
     stress = np.abs(oracle.tau_r) + np.abs(oracle.tau_t) + material.tau
     strain = np.abs(eps_r) + np.abs(eps_t) + material.tau / material.K
+    # Points returned to the apex of the cone (no tension cut-off; strength lam P + tau J and
+    # the deviator Q both within round-off of 0: about a quarter of this sample) are a singular
+    # corner: which part of the plastic strain is deviatoric is decided by round-off there, and
+    # two compilations of the same arithmetic (numba's LLVM against numpy) differ by up to
+    # 1.3e-11 of the stress (measured: at 42 and 41 of the apex points with dilatancy 0 and 20;
+    # none with a cut-off). Both must sit on the apex and agree to 1e-10 there; elsewhere the
+    # return is well conditioned and must agree to 1e-13.
+    P = -(oracle.tau_r + 2.0 * oracle.tau_t) / 3.0
+    J = np.exp(eps_r + 2.0 * eps_t)
+    strength = np.abs(material.lam * P + material.tau * J)
+    apex = oracle.plastic & (strength <= 1e-9 * stress)
+    P_kernel = -(kernel["tau_r"] + 2.0 * kernel["tau_t"]) / 3.0
+    assert np.all(np.abs(material.lam * P_kernel + material.tau * J)[apex]
+                  <= 1e-9 * stress[apex])
+    tolerance = np.where(apex, 1e-10, 1e-13)
     for name, scale in (("tau_r", stress), ("tau_t", stress)):
-        assert np.max(np.abs(kernel[name] - getattr(oracle, name)) / scale) <= 1e-13
+        assert np.all(np.abs(kernel[name] - getattr(oracle, name)) <= tolerance * scale)
     for name in ("theta_p", "gamma_p"):
         scale = strain + np.abs(getattr(oracle, name))
-        assert np.max(np.abs(kernel[name] - getattr(oracle, name)) / scale) <= 1e-13
-    assert np.max(np.abs(kernel["yield_ratio"] - oracle.yield_ratio)) <= 1e-13
+        assert np.all(np.abs(kernel[name] - getattr(oracle, name)) <= tolerance * scale)
+    # the yield ratio c |Q| / strength is 0/0 on the apex; elsewhere the stresses' 1e-13
+    # carried through the quotient
+    ratio = oracle.yield_ratio
+    with np.errstate(divide="ignore"):
+        bound = 1e-13 * (1.0 + ratio) * (1.0 + 3.0 * stress / strength)
+    assert np.all((np.abs(kernel["yield_ratio"] - ratio) <= bound)[~apex])
     for i, name in enumerate(("C_rr", "C_rt", "C_tr", "C_tt")):
         diff = np.abs(kernel[name] - oracle.tangent[i // 2, i % 2]) / (material.K + material.G)
         assert np.max(diff) <= 1e-11

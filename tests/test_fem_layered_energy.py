@@ -6,7 +6,7 @@ import pytest
 from cavex import load_config
 from cavex.fem import expand_cavity
 from cavex.materials import Material
-from cavex.verification.fe_comparison import compare_at_depth
+from cavex.verification.fedata.comparison import compare_at_depth
 
 CONCRETE = Material(E=25e9, nu=0.4999, rho=2500.0, lam=0.15, tau=25e6)
 

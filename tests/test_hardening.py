@@ -12,12 +12,13 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from cavex.cli import main
+from cavex.analytic.penetration.tabulated import load_table
 from cavex.config import default_config_text, load_config
 from cavex.errors import CavexInputError
-from cavex.verification.cases import config_tables, make_fe_cases, probe_cases
-from cavex.verification.runner import read_store, run_cases, write_case
-from cavex.verification.table import analytic_table, load_table, write_table
+from cavex.verification.cli import main
+from cavex.verification.fedata.cases import config_tables, make_fe_cases, probe_cases
+from cavex.verification.fedata.runner import read_store, run_cases, write_case
+from cavex.verification.fedata.table import analytic_table, write_table
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sweep.toml"
 SMALL_SWEEP = """
@@ -255,8 +256,8 @@ def test_pool_workers_end_with_their_parent():
 
     script = textwrap.dedent("""
         import os, sys, time
-        from cavex.verification.cases import probe_cases
-        from cavex.verification.runner import run_cases
+        from cavex.verification.fedata.cases import probe_cases
+        from cavex.verification.fedata.runner import run_cases
         cases = [{"id": f"p{i}", "x": 1.0, "sleep": 30.0} for i in range(2)]
         run_cases(probe_cases, cases, workers=2, chunk_size=1)
     """)
@@ -321,7 +322,8 @@ def test_a_closed_pipe_is_not_an_error(tmp_path):
     import subprocess
     import sys
 
-    command = (f"{sys.executable} -m cavex.cli stress --velocity 300 --depth 0.3 | head -c 10")
+    command = (f"{sys.executable} -m cavex.verification.cli stress --velocity 300 --depth 0.3 "
+               "| head -c 10")
     done = subprocess.run(["bash", "-o", "pipefail", "-c", command], capture_output=True,
                           text=True, timeout=120)
     assert "Traceback" not in done.stderr and "BrokenPipe" not in done.stderr
@@ -540,7 +542,7 @@ def test_an_interrupt_while_writing_leaves_no_files(tmp_path):
     created); the files move into the folder only all together."""
     import signal
 
-    from cavex.paths import staged_output
+    from cavex.verification.output.paths import staged_output
 
     handlers = [signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)]
     for signum in (signal.SIGINT, signal.SIGTERM):
@@ -571,9 +573,9 @@ def test_ctrl_c_during_a_trajectory_run(tmp_path):
     import time
 
     out = tmp_path / "o"
-    process = subprocess.Popen([sys.executable, "-m", "cavex.cli", "trajectory", *LAW, "--out",
-                                str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True)
+    process = subprocess.Popen([sys.executable, "-m", "cavex.verification.cli", "trajectory",
+                                *LAW, "--out", str(out)], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 60.0
     while time.monotonic() < deadline and process.poll() is None:
         if out.exists() and any(out.glob(".cavex-partial-*/*")):
@@ -587,7 +589,7 @@ def test_ctrl_c_during_a_trajectory_run(tmp_path):
 
 
 def test_a_run_that_reaches_the_time_limit_ends_there():
-    from cavex.analytic.oblique import MAX_TIME, Shot, fly
+    from cavex.analytic.penetration.oblique import MAX_TIME, Shot, fly
 
     target, projectile = load_config()
     result = fly(target.single(0), projectile, Shot(1000.0), "law", law_A=0.0, law_B=0.0)
@@ -599,7 +601,7 @@ def test_a_run_that_reaches_the_time_limit_ends_there():
 def test_verify_writes_its_report_complete_or_not_at_all(tmp_path, monkeypatch):
     """A verify run that fails (or is interrupted) after writing part of its report leaves the
     previous report in place and no hidden folder behind; a finished one replaces it."""
-    from cavex.verification import report
+    from cavex.verification.report import build as report
 
     out = tmp_path / "report"
     out.mkdir()

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from cavex.cli import build_parser, main
+from cavex.verification.cli import build_parser, main
 
 #: The one spelling of every unit in a JSON key (SI; velocity m/s as ``_m_s``, overload in g).
 UNIT_SUFFIXES = ("_m", "_s", "_Pa", "_m_s", "_m_s2", "_kg", "_kg_m3", "_J", "_N", "_deg",
@@ -138,7 +138,7 @@ def test_table(capsys, tmp_path):
 
 def test_verify(capsys, tmp_path, monkeypatch):
     """``cavex verify --quick --json`` on a smaller grid (the command path is the same)."""
-    from cavex.verification import report
+    from cavex.verification.report import build as report
 
     monkeypatch.setattr(report, "verify", functools.partial(
         report.verify, velocities=[0.0, 1000.0], depths=[0.3, 0.8]))

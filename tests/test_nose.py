@@ -20,7 +20,12 @@ from scipy.integrate import quad
 
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
-from cavex.analytic.nose import QUADRATURE_POINTS, nose_force, nose_rule, ogive_coefficients
+from cavex.analytic.penetration.nose import (
+    QUADRATURE_POINTS,
+    nose_force,
+    nose_rule,
+    ogive_coefficients,
+)
 from cavex.materials import Material, Projectile, Target
 
 # Round-off level of a sum of 8 positive terms of size ~F (a few ulps): 1e-13 is ~500 ulps,

@@ -1,4 +1,5 @@
-"""The 3-D oblique-penetration model (cavex.analytic.oblique): reductions to the 1-D model,
+"""The 3-D oblique-penetration model (cavex.analytic.penetration.oblique): reductions to the 1-D
+model,
 symmetry, energy, discretisation convergence (docs/oblique.md)."""
 
 
@@ -6,13 +7,13 @@ import numpy as np
 import pytest
 
 from cavex.analytic.cavity import cavity_stress
-from cavex.analytic.nose import ogive_coefficients
-from cavex.analytic.oblique import ObliqueModel, Shot, fly
-from cavex.analytic.penetration import penetrate
-from cavex.analytic.projectile_body import build_body
-from cavex.analytic.resistance import ClosedFormResistance
-from cavex.analytic.stress_laws import DerivedLaw, make_law
-from cavex.analytic.surface_force import rotation_matrix
+from cavex.analytic.penetration.body import build_body
+from cavex.analytic.penetration.integrator import penetrate
+from cavex.analytic.penetration.nose import ogive_coefficients
+from cavex.analytic.penetration.oblique import ObliqueModel, Shot, fly
+from cavex.analytic.penetration.resistance import ClosedFormResistance
+from cavex.analytic.penetration.stress_laws import DerivedLaw, make_law
+from cavex.analytic.penetration.surface_force import rotation_matrix
 from cavex.config import load_config
 
 
@@ -177,7 +178,7 @@ def test_mirror_shot_with_spin_and_attack_plane_is_exact(runway):
                                      spin=300.0), "law", **options)
     b = fly(target, projectile, Shot(650.0, obliquity=-35.0, attack=4.0, attack_plane=60.0,
                                      spin=-300.0), "law", **options)
-    from cavex.analytic.surface_force import mirror_state
+    from cavex.analytic.penetration.surface_force import mirror_state
     ya = np.concatenate([s.y for s in a.solutions], axis=1)
     yb = np.concatenate([s.y for s in b.solutions], axis=1)
     assert ya.shape == yb.shape
@@ -337,7 +338,7 @@ def test_paper_law_is_the_printed_model_at_the_mapped_depth(runway):
     """At its grid nodes the paper law is the paper's printed sigma_r at the 1-D nose depth
     L = z + l - r (exactly: the same coefficients), between them linear."""
     from cavex.analytic.paper_model import paper_stress
-    from cavex.analytic.stress_laws import PaperLaw
+    from cavex.analytic.penetration.stress_laws import PaperLaw
 
     target, projectile = runway
     law = PaperLaw(target, projectile)
@@ -358,7 +359,7 @@ def test_table_law_survives_integrator_stages_beyond_the_table(runway):
     shot with "the table must reach 1522.83 m/s".)"""
     from pathlib import Path
 
-    from cavex.verification.table import load_table
+    from cavex.analytic.penetration.tabulated import load_table
 
     target, projectile = runway
     grid = Path(__file__).resolve().parents[1] / "results" / "verification" / "grid.nc"

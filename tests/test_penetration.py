@@ -21,13 +21,13 @@ from scipy.integrate import solve_ivp
 from scipy.interpolate import BPoly
 
 from cavex.analytic.paper_model import paper_coefficients, paper_phase_depths
-from cavex.analytic.penetration import (
+from cavex.analytic.penetration.integrator import (
     crater_depth,
     crater_exit,
     crater_stage,
     penetrate,
 )
-from cavex.analytic.resistance import ClosedFormResistance
+from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.config import load_config
 from cavex.materials import Material, Projectile
 

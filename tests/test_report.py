@@ -9,9 +9,10 @@ import xarray as xr
 from cf_check import check_cf, check_quantify
 
 from cavex.config import default_config_text, load_config
-from cavex.verification import report, report_picture
-from cavex.verification import table as table_module
-from cavex.verification.report_analysis import TOLERANCES
+from cavex.verification.fedata import table as table_module
+from cavex.verification.report import build as report
+from cavex.verification.report import picture as report_picture
+from cavex.verification.report.analysis import TOLERANCES
 
 PNG = b"\x89PNG\r\n\x1a\n"
 PERCENT = re.compile(r"^([+-]\d+\.\d{3}) %$")
@@ -311,7 +312,7 @@ def test_validity_matches_recomputed_errors(quick_report):
 
 
 def test_failed_cell_and_renderer_failure(tmp_path, monkeypatch, capsys):
-    from cavex.verification.cases import fe_cases
+    from cavex.verification.fedata.cases import fe_cases
 
     def failing(chunk):
         out = fe_cases(chunk)

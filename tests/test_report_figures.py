@@ -13,14 +13,15 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from cavex.analytic.penetration import crater_depth
+from cavex.analytic.geometry import switch_depths
+from cavex.analytic.penetration.integrator import crater_depth
 from cavex.config import load_config
-from cavex.verification import penetration_report
-from cavex.verification import report_plots as plots
-from cavex.verification.report import quick_axes
-from cavex.verification.report_analysis import analyse
-from cavex.verification.report_html import markdown_to_html, slug
-from cavex.verification.table import analytic_table, switch_depths, write_table
+from cavex.verification.commands import penetrate as penetration_report
+from cavex.verification.fedata.table import analytic_table, write_table
+from cavex.verification.report import plots
+from cavex.verification.report.analysis import analyse
+from cavex.verification.report.build import quick_axes
+from cavex.verification.report.html import markdown_to_html, slug
 
 PNG = b"\x89PNG\r\n\x1a\n"
 DEPTHS = (0.1, 0.3, 0.5, 0.7, 0.9, 1.1, 1.3, 2.0, 3.0)

@@ -17,9 +17,11 @@ import pytest
 import xarray as xr
 
 from cavex.config import load_config
-from cavex.verification import penetration_report
-from cavex.verification.batch import VARIABLES as BATCH_VARIABLES
-from cavex.verification.number_format import (
+from cavex.verification.commands import penetrate as penetration_report
+from cavex.verification.fedata.batch import VARIABLES as BATCH_VARIABLES
+from cavex.verification.fedata.table import analytic_table, write_table
+from cavex.verification.output.files import write_columns_csv
+from cavex.verification.output.number_format import (
     CLOSED_FORM_DIGITS,
     DEFAULT_DIGITS,
     ESTIMATE_DIGITS,
@@ -31,10 +33,8 @@ from cavex.verification.number_format import (
     round_significant,
     variable_digits,
 )
-from cavex.verification.report import _settings_lines, write_grid
-from cavex.verification.report_analysis import analyse
-from cavex.verification.runner import write_columns_csv
-from cavex.verification.table import analytic_table, write_table
+from cavex.verification.report.analysis import analyse
+from cavex.verification.report.build import _settings_lines, write_grid
 
 # relative spread between CPUs, per kind of number (module docstring)
 SPREAD = {TRAJECTORY_DIGITS: 1e-8, CLOSED_FORM_DIGITS: 1e-13, FE_DIGITS: 1e-11,

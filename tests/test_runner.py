@@ -17,8 +17,8 @@ import time
 import pytest
 
 from cavex.errors import CavexInputError
-from cavex.verification.cases import config_tables, fe_cases, make_fe_cases, probe_cases
-from cavex.verification.runner import read_store, run_cases, write_case
+from cavex.verification.fedata.cases import config_tables, fe_cases, make_fe_cases, probe_cases
+from cavex.verification.fedata.runner import read_store, run_cases, write_case
 
 COARSE = {"elements_per_decade": 8, "growth_per_step": 0.15, "seed_ratio": 5,
           "error_estimate": False, "snapshots": 1}
@@ -104,8 +104,8 @@ def test_store_resume_computes_only_missing_cases(tmp_path):
     run_cases(probe_cases, cases[:2], store=store, workers=1)  # a subset first
     script = textwrap.dedent(f"""
         import json
-        from cavex.verification.cases import probe_cases
-        from cavex.verification.runner import run_cases
+        from cavex.verification.fedata.cases import probe_cases
+        from cavex.verification.fedata.runner import run_cases
         run_cases(probe_cases, json.loads({json.dumps(json.dumps(cases))}),
                   store={str(store)!r}, workers=1, chunk_size=1)
     """)

@@ -16,31 +16,30 @@ import xarray as xr
 from scipy.interpolate import PchipInterpolator
 
 from cavex.analytic.cavity import cavity_solution, cavity_stress
-from cavex.analytic.geometry import spherical_problem
-from cavex.analytic.penetration import penetrate
-from cavex.analytic.resistance import ClosedFormResistance
+from cavex.analytic.geometry import spherical_problem, switch_depths
+from cavex.analytic.penetration.integrator import penetrate
+from cavex.analytic.penetration.resistance import ClosedFormResistance
+from cavex.analytic.penetration.tabulated import (
+    TabulatedResistance,
+    compare_trajectories,
+    load_table,
+    pchip,
+    trajectory_summary,
+)
 from cavex.config import load_config, parse_config
 from cavex.errors import CavexInputError
 from cavex.materials import Target
-from cavex.verification.cases import fe_cases
-from cavex.verification.number_format import round_dataset
-from cavex.verification.runner import read_store, run_cases
-from cavex.verification.table import (
+from cavex.verification.fedata.cases import fe_cases
+from cavex.verification.fedata.runner import read_store, run_cases
+from cavex.verification.fedata.table import (
     DEFAULT_DEPTHS,
     DEFAULT_VELOCITIES,
     analytic_table,
     build_table,
-    load_table,
-    switch_depths,
     table_cases,
     write_table,
 )
-from cavex.verification.tabulated_resistance import (
-    TabulatedResistance,
-    compare_trajectories,
-    pchip,
-    trajectory_summary,
-)
+from cavex.verification.output.number_format import round_dataset
 
 COARSE = {"elements_per_decade": 10, "growth_per_step": 0.1, "outer_ratio": 200,
           "seed_ratio": 5}
@@ -284,7 +283,7 @@ def test_small_fe_table_builds_and_drives_the_integrator(fe_table, runway, tmp_p
     settings = json.loads(fe_table.attrs["solver_settings"])
     assert settings["numerics"]["elements_per_decade"] == 10 and settings["nu"] is None
     path = write_table(fe_table, tmp_path / "fe.nc")
-    from cavex.verification.tabulated_resistance import penetrate_with_table
+    from cavex.analytic.penetration.tabulated import penetrate_with_table
 
     trajectory = penetrate_with_table(target, projectile, path)
     assert trajectory.phases[-1].end_reason == "projectile stopped"

@@ -7,10 +7,10 @@ values (``PAPER_TABLE2``) are typed in, as reference values.
 import pytest
 
 from cavex.analytic.paper_model import layer_epsilon
-from cavex.analytic.penetration import crater_depth
+from cavex.analytic.penetration.integrator import crater_depth
 from cavex.config import load_config
-from cavex.verification.table2 import PAPER_TABLE2, table2_rows
-from cavex.verification.table2_study import (
+from cavex.verification.studies.table2 import PAPER_TABLE2, table2_rows
+from cavex.verification.studies.table2_study import (
     ADMISSIBLE,
     PRINT_HALF_UNIT,
     Reading,

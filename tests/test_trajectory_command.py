@@ -1,5 +1,6 @@
 """``cavex trajectory`` end to end: the files and figures it writes hold the trajectory the API
-computes, and the study's analysis functions (verification/oblique_study.py) on known input."""
+computes, and the study's analysis functions (verification/studies/oblique_study.py) on known
+input."""
 
 import csv
 import json
@@ -8,10 +9,10 @@ import matplotlib.image
 import numpy as np
 import pytest
 
-from cavex.analytic.oblique import Shot, fly
-from cavex.cli import main
+from cavex.analytic.penetration.oblique import Shot, fly
 from cavex.config import load_config
-from cavex.verification.oblique_study import RAMPS, findings, overload_peaks, table_csv
+from cavex.verification.cli import main
+from cavex.verification.studies.oblique_study import RAMPS, findings, overload_peaks, table_csv
 
 # contact ramp 1 m/s (the default is 0.01): these tests are about the files, not the contact
 LAW = ["--resistance", "law", "--law-A", "2e8", "--law-B", "2500", "--contact-ramp", "1"]

@@ -20,23 +20,28 @@ import tomllib
 import numpy as np
 import pytest
 
-from cavex.analytic.penetration import crater_depth, penetrate
-from cavex.analytic.resistance import ClosedFormResistance
-from cavex.cli import main
+from cavex.analytic.penetration.integrator import crater_depth, penetrate
+from cavex.analytic.penetration.resistance import ClosedFormResistance
+from cavex.analytic.penetration.tabulated import TabulatedResistance
 from cavex.errors import CavexInputError
-from cavex.verification import empirical
-from cavex.verification.calibration import fit, read_calibration
-from cavex.verification.concrete import Mapping, aci_modulus, concrete_material, shot_target
-from cavex.verification.shots import Shot, parse_shots, read_shots, shot_projectile
-from cavex.verification.table import analytic_table
-from cavex.verification.tabulated_resistance import TabulatedResistance
-from cavex.verification.validation import (
+from cavex.verification.cli import main
+from cavex.verification.fedata.table import analytic_table
+from cavex.verification.validation import empirical
+from cavex.verification.validation.calibration import fit, read_calibration
+from cavex.verification.validation.concrete import (
+    Mapping,
+    aci_modulus,
+    concrete_material,
+    shot_target,
+)
+from cavex.verification.validation.predict import (
     TABLE_DEPTHS,
     closed_form_depth,
     penetration_depth,
     ratio_statistics,
     table_velocities,
 )
+from cavex.verification.validation.shots import Shot, parse_shots, read_shots, shot_projectile
 
 SHOTS = "examples/shots_forrestal1994.csv"
 COLUMNS = "id,mass_kg,diameter_m,length_m,crh,V0_m_s,fc_Pa,rho_kg_m3,depth_m"
@@ -376,7 +381,7 @@ def test_committed_validation_report_is_consistent():
     the one the numbers give."""
     from pathlib import Path
 
-    from cavex.verification.validation_output import verdict
+    from cavex.verification.commands.validate import verdict
 
     folder = Path("results/validation")
     result = json.loads((folder / "validation.json").read_text())

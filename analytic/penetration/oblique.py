@@ -1,0 +1,456 @@
+r"""Oblique penetration with attitude: a rigid projectile in 3-D through the layered target.
+
+The rigid body (:mod:`cavex.analytic.penetration.body`) moves under the differential-area force
+law of :mod:`cavex.analytic.penetration.surface_force`: every surface element inside the target and
+moving into it feels the normal stress of a stress law
+(:mod:`cavex.analytic.penetration.stress_laws`) at its own normal velocity, plus Coulomb friction;
+the summed force and moment drive the six degrees of freedom. This module sets up the shot,
+integrates the equations of motion between events (the nose tip crossing an interface, ricochet,
+perforation, the axis parallel to the surface, stop) with the compiled ROS2 integrator of
+:mod:`cavex.analytic.penetration.rosenbrock` (or, as the reference, any
+``scipy.integrate.solve_ivp`` method) and samples the history.
+
+Target frame: free surface ``z = 0``, ``z`` positive into the target, ``x`` along the striking
+velocity's horizontal component, ``y`` completing a right-handed frame. Pitch: angle (deg)
+between the axis (tail to nose) and ``+z``, positive toward ``+x``.
+"""
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from cavex.analytic.penetration.body import build_body
+from cavex.analytic.penetration.rosenbrock import (
+    END_TIME,
+    EVENT,
+    RUNNING,
+    STEP_TOO_SMALL,
+    event_values,
+    hermite,
+    initial_step,
+    integrate,
+)
+from cavex.analytic.penetration.stress_laws import OK, make_law, raise_for
+from cavex.analytic.penetration.surface_force import (
+    derivative,
+    mirror_state,
+    rotation_matrix,
+    surface_loads,
+)
+from cavex.errors import CavexNumericalError, is_finite_number, require
+from cavex.materials import MAX_VELOCITY
+
+G = 9.80665  # m/s^2, for overloads in g
+STOP_ENERGY = 1e-6  # stop when translational + transverse rotational energy < this x initial
+MAX_TIME = 1.0  # s
+# the compiled ROS2 W-method (cavex.analytic.penetration.rosenbrock); any solve_ivp method name is
+# the reference. Convergence: docs/oblique.md
+COMPILED = "ROS2"
+METHOD, RTOL, ATOL = COMPILED, 1e-3, 1e-6
+CHUNK = 2000  # accepted steps per call of the compiled integrator (progress is reported after)
+# smallest step, relative to the time the striking speed takes to cover the body's length
+# (measured shots take steps >= 2e-8 of it, the first step): below it the step size has
+# collapsed (forces far beyond the body's mass or inertia, a crawling shot) and the run is a
+# numerical failure
+MIN_STEP = 1e-12
+RICOCHET = "ricochet: left the target through the entry face"
+PERFORATION = "perforation: left through the bottom face"
+STOPPED = "stopped"
+# contact regularisation: the stress rises linearly over 0 < V_n < CONTACT_RAMP (m/s); without
+# it a shank sliding along the tunnel wall chatters (V_n changes sign every step) and the
+# adaptive integrator stalls. Its effect is measured in docs/oblique.md.
+CONTACT_RAMP = 0.01
+
+
+# ------------------------------------------------------------------------------------------
+# Shot set-up
+# ------------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Shot:
+    """Striking conditions. Angles in degrees: ``obliquity`` between the velocity and the
+    target normal (+z; negative: the mirror shot, velocity toward -x), ``attack`` between the
+    axis and the velocity, turned in the plane at ``attack_plane`` about the velocity (0: in
+    the plane of obliquity, nose toward +x / the surface; 90: toward +y). ``spin`` (rad/s)
+    about the axis. ``tip_depth``: initial nose-tip depth (m); None: the body's deepest point
+    just touches the surface."""
+
+    speed: float
+    obliquity: float = 0.0
+    attack: float = 0.0
+    attack_plane: float = 0.0
+    spin: float = 0.0
+    tip_depth: float | None = None
+
+    def __post_init__(self):
+        require(math.isfinite(self.speed) and 0.0 < self.speed <= MAX_VELOCITY, "velocity",
+                f"in (0, {MAX_VELOCITY:g}] m/s", self.speed)
+        require(math.isfinite(self.obliquity) and abs(self.obliquity) < 90.0, "obliquity",
+                "in (-90, 90) degrees", self.obliquity)
+        require(math.isfinite(self.attack) and 0.0 <= self.attack < 90.0, "attack",
+                "in [0, 90) degrees", self.attack)
+        require(math.isfinite(self.attack_plane), "attack_plane", "finite (degrees)",
+                self.attack_plane)
+        require(math.isfinite(self.spin), "spin", "finite (rad/s)", self.spin)
+
+    def initial_axes(self):
+        """``(velocity direction, axis, body e2, body e3)`` in the target frame, for
+        ``obliquity >= 0`` (:meth:`ObliqueModel.initial_state` builds a negative obliquity as
+        the mirror image of the positive one)."""
+        require(self.obliquity >= 0.0, "obliquity", ">= 0 here (mirror the shot)",
+                self.obliquity)
+        th = math.radians(self.obliquity)
+        d = np.array([math.sin(th), 0.0, math.cos(th)])
+        ep = np.array([math.cos(th), 0.0, -math.sin(th)])  # toward the surface
+        ey = np.array([0.0, 1.0, 0.0])
+        al, ps = math.radians(self.attack), math.radians(self.attack_plane)
+        turn = math.cos(ps) * ep + math.sin(ps) * ey
+        axis = math.cos(al) * d + math.sin(al) * turn
+        e2 = math.cos(al) * turn - math.sin(al) * d  # unit, orthogonal to the axis
+        # e2 stays in the plane of obliquity for in-plane shots, e3 = axis x e2
+        e3 = np.cross(axis, e2)
+        return d, axis, e2, e3
+
+
+def quaternion_from_matrix(m):
+    """Unit quaternion ``(w, x, y, z)`` of a rotation matrix (body to target)."""
+    tr = m[0, 0] + m[1, 1] + m[2, 2]
+    if tr > 0:
+        s = 2.0 * math.sqrt(tr + 1.0)
+        q = [0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s]
+    else:
+        i = int(np.argmax(np.diag(m)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * math.sqrt(1.0 + m[i, i] - m[j, j] - m[k, k])
+        q = [0.0] * 4
+        q[0] = (m[k, j] - m[j, k]) / s
+        q[1 + i] = 0.25 * s
+        q[1 + j] = (m[j, i] + m[i, j]) / s
+        q[1 + k] = (m[k, i] + m[i, k]) / s
+    q = np.array(q)
+    return q / np.linalg.norm(q)
+
+
+def pitch_yaw(axis):
+    """Pitch (deg): angle of the axis from +z in the x-z plane, positive toward +x; yaw (deg):
+    angle of the axis out of the x-z plane, positive toward +y."""
+    axis = np.asarray(axis)
+    return (np.degrees(np.arctan2(axis[..., 0], axis[..., 2])),
+            np.degrees(np.arctan2(axis[..., 1], np.hypot(axis[..., 0], axis[..., 2]))))
+
+
+# ------------------------------------------------------------------------------------------
+# The model
+# ------------------------------------------------------------------------------------------
+
+@dataclass
+class Result:
+    """Trajectory: samples at the integrator's steps (``history``), phases and the end."""
+
+    history: dict
+    phases: list
+    end: dict
+    solutions: list = field(default_factory=list, repr=False)
+    model: object = field(default=None, repr=False)
+
+    def state(self, t):
+        """State vector at time ``t`` (dense output of the phase that contains it)."""
+        for sol in self.solutions:
+            if sol.t[0] <= t <= sol.t[-1]:
+                return sol.sol(t)
+        raise ValueError(f"t = {t} s is outside the trajectory")
+
+
+class Segment:
+    """One phase of the compiled integrator: accepted times ``t`` (N), states ``y`` and
+    derivatives ``f`` (14, N); ``sol(t)`` is the cubic Hermite interpolant of the step that
+    holds ``t`` (the dense output the events are located on)."""
+
+    def __init__(self, t, y, f):
+        self.t, self.y, self.f = t, y.T, f.T
+
+    def sol(self, t):
+        k = int(np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.t.size - 2))
+        h = self.t[k + 1] - self.t[k]
+        s = (t - self.t[k]) / h if h > 0.0 else 1.0
+        return hermite(s, h, self.y[:, k], self.f[:, k], self.y[:, k + 1], self.f[:, k + 1],
+                       np.empty(14))
+
+
+class ObliqueModel:
+    """Rigid projectile + stress law + layered target: right-hand side, events, integrator.
+
+    State ``y``: centre of mass ``x`` (3), quaternion ``q`` (4, body to target), velocity ``v``
+    (3), body-frame angular velocity ``omega`` (3), work of the surface forces ``W`` (1).
+    """
+
+    def __init__(self, target, projectile, law, *, body=None, bottom=None, rtol=RTOL,
+                 atol=ATOL, method=METHOD, contact_ramp=None):
+        self.target, self.projectile, self.law = target, projectile, law
+        self.body = body or build_body(projectile)
+        self.bottom = bottom
+        self.rtol, self.atol, self.method = rtol, atol, method
+        contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
+        require(is_finite_number(contact_ramp) and 0.0 <= contact_ramp <= 100.0,
+                "contact_ramp", "in [0, 100] m/s", contact_ramp)
+        self.contact_ramp = float(contact_ramp)
+        self.mu = float(projectile.mu)
+        b = self.body
+        self._p = b.points
+        self._inertia = b.inertia
+        self._surface = (b.points, b.normals, b.areas, b.sizes, b.partners, b.length, self.mu,
+                         self.contact_ramp, np.inf if bottom is None else float(bottom), *law.data)
+        self._tip = b.tip
+        self.evaluations = 0
+        self._step = None  # the compiled integrator's next step, kept across phases
+
+    # -- forces ---------------------------------------------------------------------------
+    def loads(self, y):
+        """``(F, M_body, power, rotation)``: total surface force (target frame), moment about
+        the centre of mass (body frame), power of the surface forces, rotation matrix."""
+        force, moment, power, status, vn, _ = surface_loads(y, *self._surface)
+        if status != OK:
+            raise_for(status, vn)
+        return force, moment, power, rotation_matrix(y[3:7])
+
+    def rhs(self, t, y):
+        self.evaluations += 1
+        dy, _, status, vn = derivative(y, self.body.mass, self._inertia, *self._surface)
+        if status != OK:
+            raise_for(status, vn)
+        return dy
+
+    # -- kinematics -----------------------------------------------------------------------
+    def initial_state(self, shot):
+        """State at first contact. A negative obliquity is the mirror image (``x -> -x``) of
+        the shot at ``|obliquity|`` and opposite spin, built by :func:`mirror_state` so that
+        the two trajectories are mirrors to the last bit."""
+        if shot.obliquity < 0.0:
+            return mirror_state(self.initial_state(
+                replace(shot, obliquity=-shot.obliquity, spin=-shot.spin)))
+        d, axis, e2, e3 = shot.initial_axes()
+        rot = np.column_stack([axis, e2, e3])
+        q = quaternion_from_matrix(rot)
+        rot = rotation_matrix(q)
+        tip_offset = rot @ self._tip
+        x = -tip_offset  # nose tip above the origin
+        if shot.tip_depth is None:  # the deepest point of the body on the surface
+            x[2] = -max(float((self._p @ rot.T)[:, 2].max()), float(tip_offset[2]))
+        else:
+            x[2] += shot.tip_depth
+        v = shot.speed * d
+        omega = np.array([shot.spin, 0.0, 0.0])
+        return np.concatenate([x, q, v, omega, [0.0]])
+
+    def energy(self, y):
+        """Kinetic energy (J): translational plus rotational."""
+        w, I = y[10:13], self._inertia  # noqa: E741 (the inertia tensor)
+        rotational = 0.5 * (I[0] * w[0] ** 2 + I[1] * w[1] ** 2 + I[2] * w[2] ** 2)
+        return 0.5 * self.body.mass * float(y[7:10] @ y[7:10]) + rotational
+
+    def tip(self, y):
+        return y[0:3] + rotation_matrix(y[3:7]) @ self._tip
+
+    def axis(self, y):
+        return rotation_matrix(y[3:7])[:, 0]
+
+    # -- integration ----------------------------------------------------------------------
+    def _events(self, y0):
+        """``(directions, descriptions, event arguments)`` of the events of
+        :func:`cavex.analytic.penetration.rosenbrock.event_values` for a run from ``y0``; a
+        description is ``(reason, crossing, interface)``: a crossing event flips its direction after
+        firing and continues."""
+        depths = np.asarray(self.target.interface_depths, dtype=float)
+        described = [(f"nose tip crossed interface {j + 1} (z = {H:g} m)", True, j)
+                     for j, H in enumerate(depths)]
+        described += [(RICOCHET, False, None), (PERFORATION, False, None),
+                      ("axis parallel to the surface", True, None), (STOPPED, False, None)]
+        directions = np.zeros(len(described))
+        directions[depths.size:depths.size + 2] = -1.0, 1.0
+        directions[-1] = -1.0
+        args = (self._tip, self._p, depths, np.inf if self.bottom is None else float(self.bottom),
+                0.0)
+        energy0 = self.event_values(y0, args)[-1]  # the stop function at zero: the energy
+        return directions, described, (*args[:4], STOP_ENERGY * energy0)
+
+    def event_values(self, y, args):
+        return event_values(y, self.body.mass, self._inertia, args,
+                            np.empty(len(self.target.interface_depths) + 4))
+
+    def run(self, shot, max_phases=50, progress=None):
+        """Integrate ``shot`` to a final event; returns a :class:`Result`. ``progress``:
+        optional ``callable(t, y)`` called after every integrator step."""
+        y = self.initial_state(shot)
+        self._step = None  # every run starts afresh: the same shot, the same bits
+        self._min_step = MIN_STEP * self.body.length / shot.speed
+        directions, described, args = self._events(y)
+        g = self.event_values(y, args)
+        for k, (_, crossing, _) in enumerate(described):  # the next crossing is away from
+            if crossing:  # the side the state is on now
+                directions[k] = 1.0 if g[k] < 0.0 else -1.0
+        t0, phases, sols = 0.0, [], []
+        label = self.phase_label(y)
+        reason = "time limit"
+        phase = self._compiled_phase if self.method == COMPILED else self._scipy_phase
+        for _ in range(max_phases):
+            sol, which = phase(t0, y, directions, args, progress)
+            sols.append(sol)
+            t0, y = sol.t[-1], sol.y[:, -1].copy()
+            if which is None:
+                reason = "time limit"
+                phases.append(self._phase(label, t0, y, reason))
+                break
+            reason, crossing, interface = described[which]
+            phases.append(self._phase(label, t0, y, reason))
+            if crossing:
+                if interface is not None:  # the layer the tip has just entered
+                    label = self.layer_name(interface + 1 if directions[which] > 0
+                                            else interface)
+                directions[which] = -directions[which]
+            else:
+                break
+        else:
+            raise CavexNumericalError(f"more than {max_phases} phases")
+        history = self._history(sols)
+        return Result(history=history, phases=phases, end=self._end_state(y, t0, reason),
+                      solutions=sols, model=self)
+
+    def _compiled_phase(self, t0, y, directions, args, progress):
+        """One phase with the compiled ROS2 integrator
+        (:mod:`cavex.analytic.penetration.rosenbrock`):
+        ``(Segment, index of the event that ended it or None)``."""
+        mass, inertia = self.body.mass, self._inertia
+        f, jac, status, vn = derivative(y, mass, inertia, *self._surface)
+        self.evaluations += 1
+        if status != OK:
+            raise_for(status, vn)
+        h = self._step or initial_step(y, f, self.rtol, self.atol, MAX_TIME)
+        ts, ys, fs = np.empty(CHUNK + 1), np.empty((CHUNK + 1, 14)), np.empty((CHUNK + 1, 14))
+        parts = []
+        while True:
+            status, steps, h, evaluations, event, vn = integrate(
+                t0, y, f, jac, h, MAX_TIME, self._min_step, self.rtol, self.atol, CHUNK,
+                directions, args, ts, ys, fs, mass, inertia, self._surface)
+            self.evaluations += evaluations
+            parts.append((ts[1:steps + 1].copy(), ys[1:steps + 1].copy(), fs[1:steps + 1].copy())
+                         if parts else (ts[:steps + 1].copy(), ys[:steps + 1].copy(),
+                                        fs[:steps + 1].copy()))
+            if progress is not None:
+                for k in range(1, steps + 1):
+                    progress(ts[k], ys[k])
+            if status == STEP_TOO_SMALL:
+                raise CavexNumericalError(f"trajectory integration failed at t = {ts[steps]} "
+                                          "s: the step size became too small")
+            if status not in (RUNNING, EVENT, END_TIME):
+                raise_for(status, vn)
+            if status != RUNNING:
+                break
+            t0, y, f = ts[steps], ys[steps].copy(), fs[steps].copy()  # jac: integrate's
+        self._step = h
+        segment = Segment(*(np.concatenate(c) for c in zip(*parts, strict=True)))
+        return segment, (event if status == EVENT else None)
+
+    def _scipy_phase(self, t0, y, directions, args, progress):
+        """One phase with ``scipy.integrate.solve_ivp`` (the reference integrators)."""
+        def make(k):
+            def event(t, y):
+                return self.event_values(y, args)[k]
+            event.terminal, event.direction = True, directions[k]
+            return event
+
+        events = [make(k) for k in range(directions.size)]
+        if progress is not None:  # an event that never fires: solve_ivp calls it every step
+            def step(t, y):
+                progress(t, y)
+                return 1.0
+            events.append(step)
+        sol = solve_ivp(self.rhs, (t0, MAX_TIME), y, method=self.method, rtol=self.rtol,
+                        atol=self.atol, events=events, dense_output=True)
+        if sol.status == -1:
+            raise CavexNumericalError(f"trajectory integration failed at t = {sol.t[-1]} "
+                                      f"s: {sol.message}")
+        if sol.status == 0:
+            return sol, None
+        return sol, next(i for i, te in enumerate(sol.t_events) if te.size)
+
+    def layer_name(self, layer):
+        return self.target.layers[layer].name or f"layer {layer + 1}"
+
+    def phase_label(self, y):
+        return self.layer_name(self.target.layer_at(max(self.tip(y)[2], 0.0)))
+
+    def _phase(self, label, t, y, reason):
+        end = self._end_state(y, t, reason)
+        return {"label": label, "end_reason": reason, "end_time_s": end["time_s"],
+                "end_nose_tip_m": end["nose_tip_m"], "end_pitch_deg": end["pitch_deg"],
+                "end_speed_m_s": end["speed_m_s"]}
+
+    def _end_state(self, y, t, reason):
+        pitch, yaw = pitch_yaw(self.axis(y))
+        state = {"stopped": "stopped", "time limit": "time limit"}.get(
+            reason, reason.split(":")[0])
+        return {"state": state, "time_s": float(t), "nose_tip_m": [float(c) for c in self.tip(y)],
+                "centre_of_mass_m": [float(c) for c in y[0:3]],
+                "pitch_deg": float(pitch), "yaw_deg": float(yaw),
+                "speed_m_s": float(np.linalg.norm(y[7:10])),
+                "work_J": float(y[13])}
+
+    def _history(self, sols):
+        t = np.concatenate([s.t if i == 0 else s.t[1:] for i, s in enumerate(sols)])
+        Y = np.concatenate([s.y if i == 0 else s.y[:, 1:] for i, s in enumerate(sols)], axis=1)
+        n = t.size
+        out = {k: np.empty(n) for k in (
+            "pitch_deg", "yaw_deg", "axial_g", "lateral_g")}
+        tips, forces, moments, omegas = (np.empty((n, 3)) for _ in range(4))
+        for i in range(n):
+            y = Y[:, i]
+            force, moment, _, rot = self.loads(y)
+            axis = rot[:, 0]
+            tips[i] = y[0:3] + rot @ self._tip
+            forces[i], moments[i] = force, rot @ moment
+            omegas[i] = rot @ y[10:13]
+            axial = float(force @ axis)
+            out["axial_g"][i] = -axial / (self.body.mass * G)
+            out["lateral_g"][i] = np.linalg.norm(force - axial * axis) / (self.body.mass * G)
+            out["pitch_deg"][i], out["yaw_deg"][i] = pitch_yaw(axis)
+        history = {"t_s": t}
+        for j, c in enumerate("xyz"):
+            history[f"cg_{c}_m"] = Y[j]
+        for j, c in enumerate("xyz"):
+            history[f"tip_{c}_m"] = tips[:, j]
+        for j, c in enumerate("xyz"):
+            history[f"v_{c}_m_s"] = Y[7 + j]
+        history["speed_m_s"] = np.linalg.norm(Y[7:10], axis=0)
+        history["pitch_deg"], history["yaw_deg"] = out["pitch_deg"], out["yaw_deg"]
+        for j, c in enumerate("xyz"):
+            history[f"omega_{c}_rad_s"] = omegas[:, j]
+        history["axial_g"], history["lateral_g"] = out["axial_g"], out["lateral_g"]
+        for j, c in enumerate("xyz"):
+            history[f"force_{c}_N"] = forces[:, j]
+        for j, c in enumerate("xyz"):
+            history[f"moment_{c}_N_m"] = moments[:, j]
+        history["work_J"] = Y[13]
+        return history
+
+
+def fly(target, projectile, shot=None, resistance="derived", *, body=None, bottom=None,
+        rtol=RTOL, atol=ATOL, method=METHOD, contact_ramp=None, progress=None,
+        **law_options):
+    """One trajectory: :class:`Result` of ``shot`` (default: normal incidence at ``V0``);
+    ``progress(t, y)`` is called after every integrator step."""
+    shot = shot or Shot(projectile.V0)
+    law = make_law(target, projectile, resistance, bottom=bottom, **law_options)
+    model = ObliqueModel(target, projectile, law, body=body, bottom=bottom, rtol=rtol,
+                         atol=atol, method=method, contact_ramp=contact_ramp)
+    return model.run(shot, progress=progress)
+
+
+def peaks(history):
+    """The largest pitch rate (deg/s), axial and lateral overload (g) of a history."""
+    h = history
+    rate = np.gradient(h["pitch_deg"], h["t_s"]) if h["t_s"].size > 2 else np.zeros(1)
+    return {"max_pitch_rate_deg_s": float(np.max(np.abs(rate))),
+            "max_axial_g": float(np.max(h["axial_g"])),
+            "max_lateral_g": float(np.max(h["lateral_g"]))}

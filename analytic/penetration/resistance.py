@@ -1,0 +1,147 @@
+"""Penetration resistance at nose depth ``L`` and velocity ``V`` from a cavity-expansion model.
+
+A resistance model answers two questions for the integrator: the axial nose force ``F(L, V)``
+(N) and the response-state label of the phase it is in. ``crater_force(V)`` is the force of the
+single-medium (first layer) model that the crater stage uses (paper Eq. 34).
+
+Both answers at one ``(L, V)`` come from one evaluation of the closed form through its array
+form (:func:`cavex.analytic.cavity.nose_walk`, the compiled walk over the points of one
+depth): the derived dynamic model solves the cavity at the nose quadrature's velocities
+``V cos(phi_k)`` and at ``V`` itself (the label) in one call; the quasi-static one gets
+``sigma_r = sigma_0 + sigma_2 V^2`` and the label from one point, and the force exactly as
+``C_A + C_B V^2``; the paper model computes its coefficients once. The last few answers are
+kept: the integrator asks for the label at points where it has asked for the force.
+"""
+
+import math
+
+import numpy as np
+
+from cavex.analytic.cavity import material_table, nose_walk, state_label
+from cavex.analytic.geometry import spherical_problem, surrounding
+from cavex.analytic.paper_model import PaperModel
+from cavex.analytic.penetration.nose import nose_rule, ogive_coefficients
+from cavex.errors import CavexNumericalError, require, require_choice
+
+MODELS = ("derived", "paper")
+#: The derived model's default boundary convention: the closed form closest to the FE in every
+#: layer of the default target (results/verification/report.md; README "Commands").
+DEFAULT_BOUNDARY = "dynamic"
+PAPER_BOUNDARY = "quasi-static"  # the paper's printed model has its own convention
+RECENT = 32  # (depth, velocity) answers kept
+
+
+def model_boundary(model, boundary=None):
+    """The boundary convention ``model`` runs with: ``boundary``, or when None the model's
+    default (:data:`DEFAULT_BOUNDARY` for "derived", the paper's quasi-static for "paper")."""
+    if boundary is None:
+        return PAPER_BOUNDARY if model == "paper" else DEFAULT_BOUNDARY
+    return boundary
+
+
+def check_model(model, boundary=None):
+    """The model is known, and the paper model is only offered with its quasi-static boundary
+    (None: the model's default, :func:`model_boundary`)."""
+    require_choice(model, MODELS, "model")
+    boundary = model_boundary(model, boundary)
+    require(model != "paper" or boundary == PAPER_BOUNDARY, "boundary",
+            "'quasi-static' for the paper model", boundary)
+
+
+class ClosedFormResistance:
+    """Resistance from the derived closed forms or the paper's printed model.
+
+    Parameters
+    ----------
+    target, projectile : Target, Projectile
+    model : {"derived", "paper"}
+    boundary : {"dynamic", "quasi-static"}, optional
+        Yield-at-boundary convention of the derived model; default (None) "dynamic" for the
+        derived model and the paper's own quasi-static for the paper model (which accepts
+        no other).
+    switch : {"cavity", "nose-tip"}, optional
+        When a layer stops surrounding the cavity (see ``geometry``); default "cavity" for
+        "derived" and "nose-tip" for "paper", as the paper does.
+    epsilon : str
+        The paper model's reading of epsilon (see ``paper_model``).
+    """
+
+    def __init__(self, target, projectile, model="derived", boundary=None,
+                 switch=None, epsilon="quasi-static"):
+        check_model(model, boundary)
+        boundary = model_boundary(model, boundary)
+        self.target, self.projectile = target, projectile
+        self.model, self.boundary, self.epsilon = model, boundary, epsilon
+        self.switch = switch or ("cavity" if model == "derived" else "nose-tip")
+        spherical_problem(target, projectile, 0.0, self.switch)  # validates the switch
+        self._single = None if target.layers[1:] == () else ClosedFormResistance(
+            target.single(0), projectile, model, boundary, switch, epsilon)
+        self._paper = PaperModel(target, projectile, epsilon) if model == "paper" else None
+        n = len(target.layers)
+        self._tables = [material_table(tuple(target.layers[i:])) for i in range(n)]
+        self._names = [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]
+        self._cosines, self._weights = nose_rule(projectile)
+        self._dynamic = boundary == "dynamic"
+        self._r = float(projectile.r)
+        # C_A + C_B V^2 per unit sigma_0 and sigma_2 (Eqs. 13-14 with tau = rho = 1)
+        self._per_static, self._per_v2 = ogive_coefficients(projectile, 1.0, 1.0, 1.0, 1.0)
+        self._codes = np.empty(3, dtype=np.int64)
+        self._recent = {}  # (depth, velocity) -> (force, label or its parts)
+
+    def force(self, depth, velocity):
+        """Axial nose force (N) at nose-tip depth ``depth`` and velocity ``velocity``."""
+        return self.evaluate(depth, velocity)[0]
+
+    def label(self, depth, velocity):
+        """Phase label: wall layer name and response state (or the paper's equation)."""
+        label = self.evaluate(depth, velocity)[1]
+        if len(label) == 2:
+            return f"Eq. {label[0]} ({label[1]})"
+        first, position, flags, active = label
+        return f"{self._names[first]} ({state_label(position, flags, active)})"
+
+    def crater_force(self, velocity):
+        """Force of the single-medium model of the first layer (used by the crater stage)."""
+        return (self._single or self).force(0.0, velocity)
+
+    def evaluate(self, depth, velocity):
+        """``(force, label parts)`` at ``(depth, velocity)``: the derived model's label as the
+        codes ``(wall layer, position, flags, active layers)`` of :func:`state_label`, the
+        paper's as ``(equation, state)`` (:meth:`label` writes them out).
+
+        The answers of the last few points are kept: the integrator asks for the label where
+        it asked for the force a few evaluations before (DOP853's dense-output stages come
+        in between).
+        """
+        key = (depth, velocity)
+        value = self._recent.get(key)
+        if value is None:
+            if len(self._recent) >= RECENT:
+                self._recent.clear()
+            value = (self._paper_evaluate(depth, velocity) if self._paper is not None
+                     else self._derived_evaluate(depth, velocity))
+            self._recent[key] = value
+        return value
+
+    def _paper_evaluate(self, depth, velocity):
+        A, B, tau, rho, equation, state = self._paper.terms(depth)
+        c_a, c_b = ogive_coefficients(self.projectile, A, B, tau, rho)
+        return c_a + c_b * velocity ** 2, (equation, state)
+
+    def _derived_evaluate(self, depth, velocity):
+        if not (math.isfinite(depth) and depth >= 0.0):
+            spherical_problem(self.target, self.projectile, depth, self.switch)  # raises
+        first, interfaces = surrounding(self.target.interface_depths, self.projectile, depth,
+                                        self.switch)
+        codes = self._codes
+        first_part, second_part, failed = nose_walk(
+            self._tables[first], np.array([interfaces]).reshape(1, len(interfaces)),
+            float(velocity), self._cosines, self._weights, self._r, self._dynamic, codes)
+        if failed:
+            raise CavexNumericalError("dynamic elastic-plastic boundary did not converge "
+                                      f"(V <= {velocity} m/s, depth {depth} m)")
+        if self._dynamic:
+            force = first_part
+        else:
+            force = self._per_static * first_part + self._per_v2 * second_part * velocity ** 2
+        return force, (first, *codes.tolist())

@@ -1,0 +1,267 @@
+r"""Differential-area force law and the rigid body's equations of motion (compiled).
+
+State ``y`` (14): centre of mass ``x`` (target frame), unit quaternion ``q = (w, x, y, z)``
+(body to target), velocity ``v``, body-frame angular velocity ``omega``, work ``W`` of the
+surface forces. For surface element ``i`` (body-frame centroid ``p_i``, outward normal
+``n_i``, area ``A_i``, size ``h_i``) with ``R = R(q)``:
+
+.. math::
+    \mathbf p = R \mathbf p_i, \quad \mathbf n = R \mathbf n_i, \quad
+    \mathbf u = \mathbf v + (R \boldsymbol\omega) \times \mathbf p, \quad
+    V_n = \mathbf u \cdot \mathbf n, \quad z = x_3 + p_3,
+
+embedded fraction ``w = clip(1/2 + z/h_i, 0, 1)`` (and ``clip(1/2 + (z_b - z)/h_i, 0, 1)`` at
+a finite bottom ``z_b``). A wetted element (``w > 0`` and ``V_n > 10^-9 (|v| + L |omega|)``,
+the round-off guard) carries the load ``P = A_i w sigma_n(z, n_3, V_n) min(V_n / V_r, 1)``
+(contact regularisation over ``0 < V_n < V_r``, ``V_r`` = ``contact_ramp``; 0: none), force
+
+.. math:: \mathbf f = -P (\mathbf n + \mu \mathbf t), \quad
+          \mathbf t = \mathbf u_t / |\mathbf u_t|, \quad
+          \mathbf u_t = \mathbf u - V_n \mathbf n.
+
+Sums: ``F = sum f``, ``M = R^T sum p x f`` (body frame), power ``sum f . u``.
+
+Contact damping (the stiff part of the Jacobian, for the linearly implicit integrator of
+:mod:`cavex.analytic.penetration.rosenbrock`): on the ramp ``0 < V_n < V_r`` the load grows as
+``kappa V_n`` with ``kappa = A_i w sigma_n / V_r`` (large for a small ramp: a sliding shank is
+a stiff damper). With ``u = v - [p]_x omega_t`` its contribution to
+``d(F, sum p x f)/d(v, omega_t)`` is ``-kappa b a^T``, ``a = (n, p x n)``,
+``b = (d, p x d)``, ``d = n + mu t``; the kernel returns
+``D = d(dv/dt, d omega/dt)/d(v, omega)`` in the state's frames (body-frame ``omega``),
+
+.. math:: D = -\mathrm{diag}(1/m, I^{-1})\,\mathrm{diag}(1, R^T)
+          \Big(\sum \kappa\, \mathbf b \mathbf a^T\Big)\,\mathrm{diag}(1, R),
+
+without the slow parts (``d sigma_n / d V_n``, the turning of ``t``, the gyroscopic term).
+
+Motion:
+
+.. math:: \dot{\mathbf x} = \mathbf v, \quad
+          \dot q = \tfrac12 q \otimes (0, \boldsymbol\omega), \quad
+          m \dot{\mathbf v} = \mathbf F, \quad
+          I \dot{\boldsymbol\omega} = \mathbf M - \boldsymbol\omega \times I \boldsymbol\omega,
+          \quad \dot W = \sum \mathbf f \cdot \mathbf u,
+
+``I = diag(I_a, I_t, I_t)``. ``sigma_n`` is
+:func:`cavex.analytic.penetration.stress_laws.element_stress`.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from cavex.analytic.penetration.stress_laws import (
+    BEYOND_TABLE,
+    NOT_FINITE,
+    OK,
+    WALK_FAILED,
+    element_stress,
+)
+
+ROUND_OFF = 1e-9  # normal velocities below this x the body's velocity scale count as zero
+
+
+@njit(cache=True, error_model="numpy")
+def rotation_matrix(q):
+    """Rotation matrix (body to target) of the quaternion ``q`` (any norm).
+
+    Written with grouped sums (``(w^2 + x^2) - (y^2 + z^2)``, ...) so that the mirror map of
+    :func:`mirror_state` changes its entries by exact sign flips."""
+    w, x, y, z = q[0], q[1], q[2], q[3]
+    ww, xx, yy, zz = w * w, x * x, y * y, z * z
+    s = 1.0 / ((ww + xx) + (yy + zz))
+    rot = np.empty((3, 3))
+    rot[0, 0] = s * ((ww + xx) - (yy + zz))
+    rot[1, 1] = s * ((ww + yy) - (xx + zz))
+    rot[2, 2] = s * ((ww + zz) - (xx + yy))
+    rot[0, 1] = 2.0 * s * (x * y - w * z)
+    rot[1, 0] = 2.0 * s * (x * y + w * z)
+    rot[0, 2] = 2.0 * s * (x * z + w * y)
+    rot[2, 0] = 2.0 * s * (x * z - w * y)
+    rot[1, 2] = 2.0 * s * (y * z - w * x)
+    rot[2, 1] = 2.0 * s * (y * z + w * x)
+    return rot
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _sum3(a, b, c):
+    """``a + b + c`` added in order of increasing magnitude: the same bits for any order of
+    the terms and the negated sum for the negated terms."""
+    if abs(a) > abs(b):
+        a, b = b, a
+    if abs(b) > abs(c):
+        b, c = c, b
+    if abs(a) > abs(b):
+        a, b = b, a
+    return (a + b) + c
+
+
+def mirror_state(y):
+    """The state of the mirror-image shot (``x -> -x``): with the body mirror
+    ``theta -> -theta`` the rotation becomes ``S R D`` (``S = diag(-1, 1, 1)``,
+    ``D = diag(1, 1, -1)``), i.e. ``q -> (-q_2, -q_3, -q_0, -q_1)``, and the body angular
+    velocity (a pseudovector) ``omega -> (-omega_1, -omega_2, omega_3)``."""
+    m = np.array(y, dtype=float)
+    m[0], m[7] = -y[0], -y[7]
+    m[3:7] = -y[5], -y[6], -y[3], -y[4]
+    m[10], m[11] = -y[10], -y[11]
+    return m
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, contact_ramp, bottom,
+                  kind, scalars, values, tables, counts, depths, radii, zones, out, damping):
+    """Force, moment about the centre of mass (target frame) and power of element ``i``
+    into ``out[0:7]``, its contact damping ``kappa b a^T`` (module docstring, target frame)
+    into ``damping``; returns ``(status, V_n)``."""
+    out[:] = 0.0
+    damping[:, :] = 0.0
+    p0 = rot[0, 0] * points[i, 0] + rot[0, 1] * points[i, 1] + rot[0, 2] * points[i, 2]
+    p1 = rot[1, 0] * points[i, 0] + rot[1, 1] * points[i, 1] + rot[1, 2] * points[i, 2]
+    p2 = rot[2, 0] * points[i, 0] + rot[2, 1] * points[i, 1] + rot[2, 2] * points[i, 2]
+    z = y[2] + p2
+    frac = min(max(0.5 + z / sizes[i], 0.0), 1.0)
+    if bottom < np.inf:
+        frac = min(frac, min(max(0.5 + (bottom - z) / sizes[i], 0.0), 1.0))
+    if frac <= 0.0:
+        return OK, 0.0
+    n0 = rot[0, 0] * normals[i, 0] + rot[0, 1] * normals[i, 1] + rot[0, 2] * normals[i, 2]
+    n1 = rot[1, 0] * normals[i, 0] + rot[1, 1] * normals[i, 1] + rot[1, 2] * normals[i, 2]
+    n2 = rot[2, 0] * normals[i, 0] + rot[2, 1] * normals[i, 1] + rot[2, 2] * normals[i, 2]
+    u0 = y[7] + omega[1] * p2 - omega[2] * p1
+    u1 = y[8] + omega[2] * p0 - omega[0] * p2
+    u2 = y[9] + omega[0] * p1 - omega[1] * p0
+    vn = u0 * n0 + u1 * n1 + u2 * n2
+    if vn <= scale:
+        return OK, 0.0
+    sigma, status = element_stress(kind, scalars, values, tables, counts, depths,
+                                   max(z, 1e-12), n2, vn, radii, zones)
+    if status == WALK_FAILED:
+        return status, vn
+    load = sigma * areas[i] * frac
+    if contact_ramp > 0.0:
+        load *= min(vn / contact_ramp, 1.0)
+    f0, f1, f2 = -load * n0, -load * n1, -load * n2
+    if mu > 0.0:
+        t0, t1, t2 = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
+        tangential = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+        if tangential > 1e-12:
+            friction = mu * load / tangential
+            f0, f1, f2 = f0 - friction * t0, f1 - friction * t1, f2 - friction * t2
+    out[0], out[1], out[2] = f0, f1, f2
+    out[3] = p1 * f2 - p2 * f1
+    out[4] = p2 * f0 - p0 * f2
+    out[5] = p0 * f1 - p1 * f0
+    out[6] = f0 * u0 + f1 * u1 + f2 * u2
+    if contact_ramp > 0.0 and vn < contact_ramp and load > 0.0:
+        kappa = load / vn  # = A_i w sigma_n / V_r on the ramp
+        a = (n0, n1, n2, p1 * n2 - p2 * n1, p2 * n0 - p0 * n2, p0 * n1 - p1 * n0)
+        b = (-f0 / load, -f1 / load, -f2 / load, -out[3] / load, -out[4] / load,
+             -out[5] / load)
+        for r in range(6):
+            kb = kappa * b[r]
+            for c in range(6):
+                damping[r, c] = kb * a[c]
+    return status, vn
+
+
+@njit(cache=True, error_model="numpy")
+def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
+                  kind, scalars, values, tables, counts, depths):
+    """``(F (3, target frame), M (3, body frame), power, status, V_n of a failed element,
+    C)`` of the surface forces in state ``y`` (module docstring; the law arrays are
+    ``law.data``; ``C = diag(1, R^T) (sum kappa b a^T) diag(1, R)``, the contact damping
+    on ``(v, omega)``). Each element is added
+    together with its mirror image ``partners[i]`` (``theta -> -theta``) first, so that a
+    shot and its mirror shot sum the same numbers in the same order: the mirrored trajectory
+    is mirrored to the last bit."""
+    rot = rotation_matrix(y[3:7])
+    omega = np.empty(3)
+    for r in range(3):
+        omega[r] = rot[r, 0] * y[10] + rot[r, 1] * y[11] + rot[r, 2] * y[12]
+    speed = math.sqrt(y[7] * y[7] + y[8] * y[8] + y[9] * y[9])
+    scale = ROUND_OFF * (speed + length * math.sqrt(omega @ omega))
+    total = np.zeros(7)  # force, moment (target frame), power
+    radii = np.empty((1, max(depths.shape[0], 1)))
+    zones = np.empty((0, 1, 2))
+    one = np.empty(7)
+    other = np.empty(7)
+    damping = np.zeros((6, 6))
+    one_damping = np.empty((6, 6))
+    other_damping = np.empty((6, 6))
+    beyond = 0.0  # largest normal velocity beyond a table's range (0: none)
+    for i in range(areas.shape[0]):
+        j = partners[i]
+        if j < i:
+            continue
+        for second in range(2 if j != i else 1):
+            status, vn = _element_load(j if second else i, y, rot, omega, scale, points,
+                                       normals, areas, sizes, mu, contact_ramp, bottom, kind,
+                                       scalars, values, tables, counts, depths, radii, zones,
+                                       other if second else one,
+                                       other_damping if second else one_damping)
+            if status == BEYOND_TABLE:
+                beyond = max(beyond, vn)
+            elif status != OK:
+                return total[0:3], total[3:6], total[6], status, vn, damping
+        if j != i:
+            one += other
+            one_damping += other_damping
+        total += one
+        damping += one_damping
+    moment = rot.T @ total[3:6]
+    # to the state's frames: omega_t = R omega, body moment R^T M
+    turned = damping.copy()
+    for r in range(6):
+        for c in range(3):
+            turned[r, 3 + c] = (damping[r, 3] * rot[0, c] + damping[r, 4] * rot[1, c]
+                                + damping[r, 5] * rot[2, c])
+    for c in range(6):
+        for r in range(3):
+            damping[3 + r, c] = (rot[0, r] * turned[3, c] + rot[1, r] * turned[4, c]
+                                 + rot[2, r] * turned[5, c])
+        for r in range(3):
+            damping[r, c] = turned[r, c]
+    if beyond > 0.0:
+        return total[0:3], moment, total[6], BEYOND_TABLE, beyond, damping
+    return total[0:3], moment, total[6], OK, 0.0, damping
+
+
+@njit(cache=True, error_model="numpy")
+def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length, mu, contact_ramp,
+               bottom, kind, scalars, values, tables, counts, depths):
+    """``(dy/dt, D, status, V_n of a failed element)`` (module docstring; ``D`` the 6 x 6
+    contact damping block of the Jacobian)."""
+    force, moment, power, status, vn, damping = surface_loads(
+        y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
+        kind, scalars, values, tables, counts, depths)
+    dy = np.empty(14)
+    q0, q1, q2, q3 = y[3], y[4], y[5], y[6]
+    w0, w1, w2 = y[10], y[11], y[12]
+    dy[0:3] = y[7:10]
+    dy[3] = 0.5 * _sum3(-q1 * w0, -q2 * w1, -q3 * w2)
+    dy[4] = 0.5 * _sum3(q0 * w0, q2 * w2, -q3 * w1)
+    dy[5] = 0.5 * _sum3(q0 * w1, -q1 * w2, q3 * w0)
+    dy[6] = 0.5 * _sum3(q0 * w2, q1 * w1, -q2 * w0)
+    dy[7:10] = force / mass
+    i0, i1, i2 = inertia[0], inertia[1], inertia[2]
+    dy[10] = (moment[0] - (w1 * i2 * w2 - w2 * i1 * w1)) / i0
+    dy[11] = (moment[1] - (w2 * i0 * w0 - w0 * i2 * w2)) / i1
+    dy[12] = (moment[2] - (w0 * i1 * w1 - w1 * i0 * w0)) / i2
+    dy[13] = power
+    jac = np.empty((6, 6))
+    for r in range(6):
+        scale = -1.0 / (mass if r < 3 else inertia[r - 3])
+        for c in range(6):
+            jac[r, c] = scale * damping[r, c]
+    # an integrator stage may try a state whose normal velocities exceed a table's (stiff
+    # contact): it gets the table's largest velocity; the accepted states are checked when the
+    # history is sampled (surface_loads reports BEYOND_TABLE there)
+    if status == BEYOND_TABLE:
+        status = OK
+    if status == OK:
+        for k in range(14):
+            if not math.isfinite(dy[k]):
+                return dy, jac, NOT_FINITE, vn
+    return dy, jac, status, vn

@@ -1,0 +1,113 @@
+"""The house stays layered: every import of every package module (function-level ones included,
+read from the source with ``ast``) runs down or sideways within its floor, never up.
+
+Floors, bottom to top (README "Where things are"):
+
+- ``core/`` (``cavex``): errors, materials, config, the spherical problem; imports no other
+  part of cavex;
+- ``analytic/`` and ``fem/`` side by side, each on ``core/`` only; inside ``analytic/`` the
+  closed forms (``cavity``, ``paper_model``, ``geometry``) sit below the penetration feature
+  (``analytic/penetration/``);
+- ``verification/``: ``output/`` (file formats) at the bottom, then ``fedata/`` (FE data
+  production), then ``report/``, ``validation/`` and ``studies/`` (which use ``fedata/`` but
+  not each other), then ``commands/`` (one module per command), then ``cli``.
+"""
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+FOLDERS = {"core": "cavex", "analytic": "cavex.analytic", "fem": "cavex.fem",
+           "verification": "cavex.verification"}
+CORE = ("cavex.__init__", "cavex.errors", "cavex.materials", "cavex.config", "cavex.problem")
+V = "cavex.verification."
+
+# module prefix -> prefixes it may import (the first matching rule, longest prefix first)
+ALLOWED = {
+    "cavex.analytic.__init__": CORE + ("cavex.analytic",),  # the floor's public API
+    "cavex.analytic.penetration": CORE + ("cavex.analytic",),
+    "cavex.analytic": CORE + ("cavex.analytic.cavity", "cavex.analytic.geometry",
+                              "cavex.analytic.paper_model"),
+    "cavex.fem": CORE + ("cavex.fem",),
+    V + "output": CORE + (V + "output",),
+    V + "fedata": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata"),
+    V + "report": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
+                          V + "report"),
+    V + "validation": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
+                              V + "validation"),
+    V + "studies": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
+                           V + "studies"),
+    V + "commands": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
+                            V + "report", V + "validation", V + "studies", V + "commands"),
+    V + "cli": ("cavex",),
+    "cavex": CORE,
+}
+
+
+def package_modules():
+    """``(module name, path)`` of every module of the package, from the folders it maps."""
+    for folder, package in FOLDERS.items():
+        for path in sorted((ROOT / folder).rglob("*.py")):
+            parts = path.relative_to(ROOT / folder).with_suffix("").parts
+            yield ".".join((package, *parts)), path
+
+
+def cavex_imports(module, path):
+    """Every cavex module ``module`` imports (``from cavex.x import y`` names ``cavex.x.y`` when
+    ``y`` is a module, else ``cavex.x``; the package ``cavex`` itself stands for its
+    ``__init__``)."""
+    modules = {name for name, _ in package_modules()}
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.ImportFrom):
+            base = node.module or ""
+            if node.level:
+                parent = module.split(".")[:-node.level]
+                base = ".".join(parent + ([node.module] if node.module else []))
+            if base != "cavex" and not base.startswith("cavex."):
+                continue
+            for alias in node.names:
+                sub = f"{base}.{alias.name}"
+                found.add(sub if sub in modules or f"{sub}.__init__" in modules else base)
+        elif isinstance(node, ast.Import):
+            found |= {a.name for a in node.names
+                      if a.name == "cavex" or a.name.startswith("cavex.")}
+    return {"cavex.__init__" if name == "cavex" else name for name in found}
+
+
+def rule(module):
+    """The ALLOWED entry of ``module``: the longest prefix that matches it."""
+    matches = [p for p in ALLOWED if module == p or module.startswith(p + ".")]
+    return max(matches, key=len)
+
+
+def permitted(target, prefixes):
+    return any(target == p or target.startswith(p + ".") for p in prefixes)
+
+
+MODULES = list(package_modules())
+
+
+def test_the_walk_sees_the_whole_package():
+    names = {name for name, _ in MODULES}
+    assert {"cavex.config", "cavex.problem", "cavex.analytic.cavity", "cavex.fem.expansion",
+            "cavex.analytic.penetration.integrator", "cavex.verification.cli",
+            "cavex.verification.commands.penetrate"} <= names
+    assert len(names) > 60
+
+
+@pytest.mark.parametrize(("module", "path"), MODULES, ids=[m for m, _ in MODULES])
+def test_no_import_runs_upward(module, path):
+    prefixes = ALLOWED[rule(module)]
+    upward = sorted(t for t in cavex_imports(module, path) if not permitted(t, prefixes))
+    assert not upward, f"{module} imports {upward}"
+
+
+def test_the_rule_catches_an_upward_import(tmp_path):
+    """The checker itself: a core module that reaches into verification is caught."""
+    bad = tmp_path / "bad.py"
+    bad.write_text("def f():\n    from cavex.verification.fedata import table\n")
+    prefixes = ALLOWED[rule("cavex.config")]
+    assert not all(permitted(t, prefixes) for t in cavex_imports("cavex.config", bad))

@@ -1,0 +1,346 @@
+"""``cavex trajectory``: one oblique shot through the layered target (docs/oblique.md).
+
+The job runs :func:`cavex.analytic.penetration.oblique.fly` for the runway (and, with
+``compare_homogeneous``, for the first layer alone, as the paper does), writes the histories as
+CSV (9 significant digits) and the figures: side view to scale with the projectile outline at
+intervals, pitch against time, axial and lateral overload against time and depth with the
+interfaces marked, a 3-D view of the path in the layered block (pyvista, off-screen).
+"""
+
+import json
+import math
+import sys
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+
+from cavex.analytic.penetration.oblique import CONTACT_RAMP, Shot, fly, peaks
+from cavex.analytic.penetration.surface_force import rotation_matrix as rotation
+from cavex.errors import is_finite_number, require
+from cavex.verification.fedata.runner import show_progress
+from cavex.verification.output.files import save_figure, write_columns_csv, write_text_atomic
+from cavex.verification.output.paths import check_output_dir, write_staged
+
+DEFAULT_DIR = "results/trajectory"
+# m/s: below it the damping Jacobian frozen over a ROS2 step misjudges the switching contact
+# and the steps explode (1e-4 m/s: 241 823 steps against 419 at 1e-3, docs/oblique.md)
+MIN_CONTACT_RAMP = 0.001
+
+
+def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="dynamic",
+                   free_surface=True, table=None, law_A=None, law_B=None,
+                   compare_homogeneous=False, contact_ramp=None, progress=False):
+    """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``;
+    ``progress``: a tqdm bar per run on stderr (steps, simulated time, speed)."""
+    contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
+    # the command keeps the regularisation on: without it (or far below the default) an
+    # oblique shot's sliding shank needs millions of steps (docs/oblique.md)
+    require(is_finite_number(contact_ramp) and MIN_CONTACT_RAMP <= contact_ramp <= 100.0,
+            "contact_ramp", f"in [{MIN_CONTACT_RAMP:g}, 100] m/s", contact_ramp)
+    options = {"boundary": boundary, "free_surface": free_surface, "table": table,
+               "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp}
+    if table is not None:
+        from cavex.analytic.penetration.tabulated import load_table
+        options["table"] = load_table(table)
+    with _steps("runway", progress) as step:
+        runs = {"runway": fly(target, projectile, shot, resistance, progress=step, **options)}
+    if compare_homogeneous and len(target.layers) > 1:
+        single = target.single(0)
+        if resistance == "table":  # the table belongs to the runway; first layer by closed form
+            options = {**options, "table": None}
+            resistance_single = "derived"
+        else:
+            resistance_single = resistance
+        with _steps("first layer only", progress) as step:
+            runs["first layer only"] = fly(single, projectile, shot, resistance_single,
+                                           progress=step, **options)
+    settings = {"speed_m_s": shot.speed, "obliquity_deg": shot.obliquity,
+                "attack_deg": shot.attack, "attack_plane_deg": shot.attack_plane,
+                "spin_rad_s": shot.spin, "resistance": resistance, "boundary": boundary,
+                "free_surface": free_surface, "contact_ramp_m_s": contact_ramp}
+    return {"runs": runs, "settings": settings, "target": target}
+
+
+@contextmanager
+def _steps(name, enabled):
+    """``callable(t, y)`` advancing a tqdm bar of integrator steps (None when disabled)."""
+    if not enabled:
+        yield None
+        return
+    from tqdm.auto import tqdm
+
+    bar = tqdm(desc=name, unit=" steps", file=sys.stderr, dynamic_ncols=True, leave=False)
+
+    def step(t, y):
+        bar.update()
+        bar.set_postfix_str(f"t = {t * 1e3:.3f} ms, {float(np.linalg.norm(y[7:10])):.1f} m/s",
+                            refresh=False)
+
+    try:
+        yield step
+    finally:
+        bar.close()
+
+
+def summary(result):
+    """End state and phases (JSON-ready), plus the largest pitch rate and overloads."""
+    return {"end": result.end, "phases": result.phases, **peaks(result.history)}
+
+
+def write_outputs(job, runs, out, draw=True):
+    """CSV histories, the summary JSON (``runs``: :func:`summary` of each run) and, if
+    ``draw``, the figures into ``out``; returns the paths written."""
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = [str(write_columns_csv(folder / f"history_{name.replace(' ', '_')}.csv",
+                                     result.history))
+               for name, result in job["runs"].items()]
+    path = folder / "summary.json"
+    text = json.dumps({"settings": job["settings"], "runs": runs}, indent=2)
+    write_text_atomic(path, text + "\n")
+    written.append(str(path))
+    if draw:
+        written += figures(job, folder)
+    return written
+
+
+# --- figures ----------------------------------------------------------------------------------
+
+def figures(job, folder):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    written = [side_view(job, folder / "path_side.png"),
+               pitch_time(job, folder / "pitch_time.png"),
+               overloads(job, folder / "overload.png")]
+    picture = view_3d(job, folder / "path_3d.png")
+    if picture:
+        written.append(picture)
+    return [str(path) for path in written]
+
+
+def _interfaces(ax, target, vertical=True):
+    for H in target.interface_depths:
+        (ax.axhline if vertical else ax.axvline)(H, color="0.5", lw=0.8, ls="--")
+
+
+def _layer_names(ax, target):
+    """Each layer's name at the right edge of a side view, at the middle of its depth range
+    (the last one just below the last interface)."""
+    tops = [0.0, *target.interface_depths]
+    bottom = ax.get_ylim()[0]  # the axis is inverted: ylim = (deepest, shallowest)
+    for k, layer in enumerate(target.layers):
+        low = tops[k + 1] if k + 1 < len(tops) else max(bottom, tops[k] + 0.1)
+        ax.text(1.01, 0.5 * (tops[k] + low), layer.name or f"layer {k + 1}",
+                transform=ax.get_yaxis_transform(), va="center", fontsize=8, color="0.3")
+
+
+def outline_points(result, y):
+    """Closed outline of the projectile (x, z) in the plane of obliquity at state ``y``."""
+    body = result.model.body
+    ax, rad = body.outline[:, 0], body.outline[:, 1]
+    top = np.stack([ax, rad, np.zeros_like(ax)], -1)
+    bottom = np.stack([ax[::-1], -rad[::-1], np.zeros_like(ax)], -1)
+    pts = np.concatenate([top, bottom, top[:1]])
+    rot = rotation(y[3:7])
+    # in the plane that contains the axis and the body e2 axis (the plane of obliquity
+    # for in-plane shots)
+    world = y[0:3] + pts @ rot.T
+    return world[:, 0], world[:, 2]
+
+
+def side_view(job, path):
+    import matplotlib.pyplot as plt
+
+    target = job["target"]
+    fig, ax = plt.subplots(figsize=(7, 6))
+    for k, (name, result) in enumerate(job["runs"].items()):
+        h = result.history
+        color = f"C{k}"
+        ax.plot(h["cg_x_m"], h["cg_z_m"], color=color, lw=1, label=f"{name}: centre of mass")
+        t_end = h["t_s"][-1]
+        for t in np.linspace(0.0, t_end, 9):
+            xs, zs = outline_points(result, result.state(t))
+            ax.plot(xs, zs, color=color, lw=0.8)
+    _interfaces(ax, target)
+    ax.axhline(0.0, color="k", lw=1)
+    ax.set_aspect("equal")
+    ax.invert_yaxis()
+    _layer_names(ax, target)
+    ax.set_xlabel("x (m, horizontal, plane of obliquity)")
+    ax.set_ylabel("z (m, depth)")
+    ax.set_title(_title(job) + "\nprojectile outline at 9 equal time intervals")
+    ax.legend(fontsize=8, loc="upper right")
+    return save_figure(fig, path, dpi=120, bbox_inches="tight")
+
+
+def _title(job):
+    s = job["settings"]
+    law = s["resistance"] + (f" {s['boundary']}" if s["resistance"] == "derived" else "")
+    return (f"V0 = {s['speed_m_s']:g} m/s, obliquity {s['obliquity_deg']:g} deg, attack "
+            f"{s['attack_deg']:g} deg; resistance {law}, contact ramp "
+            f"{s['contact_ramp_m_s']:g} m/s")
+
+
+def pitch_time(job, path):
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for k, (name, result) in enumerate(job["runs"].items()):
+        h = result.history
+        ax.plot(h["t_s"] * 1e3, h["pitch_deg"], color=f"C{k}", label=name)
+        for ph in result.phases[:-1]:
+            ax.axvline(ph["end_time_s"] * 1e3, color=f"C{k}", lw=0.6, ls=":")
+    ax.set_xlabel("t (ms)")
+    ax.set_ylabel("pitch (deg, axis from +z toward +x)")
+    ax.set_title(_title(job) + "\ndotted: phase ends (nose tip crosses an interface, ...)",
+                 fontsize=9)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return save_figure(fig, path, dpi=120, bbox_inches="tight")
+
+
+def overloads(job, path):
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 2, figsize=(10, 7))
+    for k, (name, result) in enumerate(job["runs"].items()):
+        h = result.history
+        for row, key in enumerate(("axial_g", "lateral_g")):
+            axes[row, 0].plot(h["t_s"] * 1e3, h[key] / 1e3, color=f"C{k}", label=name)
+            axes[row, 1].plot(h["tip_z_m"], h[key] / 1e3, color=f"C{k}", label=name)
+    for row, key in enumerate(("axial", "lateral")):
+        axes[row, 0].set_ylabel(f"{key} overload (thousands of g)")
+        axes[row, 0].set_xlabel("t (ms)")
+        axes[row, 1].set_xlabel("nose-tip depth (m); dashed: interfaces")
+        _interfaces(axes[row, 1], job["target"], vertical=False)
+        for a in axes[row]:
+            a.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=8)
+    fig.suptitle(_title(job), fontsize=10)
+    return save_figure(fig, path, dpi=120, bbox_inches="tight")
+
+
+def view_3d(job, path):
+    """The path in the layered block, rendered off-screen with pyvista; None if pyvista
+    cannot render here (no OpenGL)."""
+    try:
+        import pyvista as pv
+        from vtkmodules.vtkCommonCore import vtkLogger
+    except ImportError:  # pragma: no cover
+        return None
+    # no display here: VTK falls back to off-screen rendering but first logs a coloured
+    # "bad X server connection" warning on stderr; the picture is the same
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
+    target = job["target"]
+    result = job["runs"]["runway"]
+    h = result.history
+    x = np.concatenate([h["tip_x_m"], h["cg_x_m"]])
+    lo, hi = min(x.min(), -0.2) - 0.2, max(x.max(), 0.2) + 0.2
+    bottom = max(h["tip_z_m"].max() + 0.3, (target.interface_depths or (0.5,))[-1] + 0.3)
+    ylo = min(h["tip_y_m"].min(), 0.0) - 0.3
+    try:
+        plotter = pv.Plotter(off_screen=True, window_size=(900, 700))
+        tops = [0.0, *target.interface_depths, bottom]
+        colors = ["#bbbbbb", "#a0785a", "#6b8e23", "#777777"]
+        for i in range(len(tops) - 1):
+            box = pv.Box(bounds=(lo, hi, ylo, 0.0, -tops[i + 1], -tops[i]))
+            plotter.add_mesh(box, color=colors[i % len(colors)], opacity=0.25,
+                             show_edges=True)
+        points = np.stack([h["cg_x_m"], h["cg_y_m"], -h["cg_z_m"]], -1)
+        plotter.add_mesh(pv.lines_from_points(points), color="red", line_width=4)
+        for t in np.linspace(0.0, h["t_s"][-1], 6):
+            y = result.state(t)
+            rot = rotation(y[3:7])
+            axis = rot[:, 0]
+            body = result.model.body
+            centre = y[0:3] + axis * (body.cg - body.length / 2.0)
+            cyl = pv.Cylinder(center=(centre[0], centre[1], -centre[2]),
+                              direction=(axis[0], axis[1], -axis[2]), radius=body.radius,
+                              height=body.length)
+            plotter.add_mesh(cyl, color="navy")
+        plotter.add_axes()
+        plotter.camera_position = [(lo - 1.0, ylo - 2.5, 1.0), ((lo + hi) / 2, 0, -bottom / 2),
+                                   (0, 0, 1)]
+        tmp = str(path) + ".tmp.png"
+        plotter.screenshot(tmp)
+        plotter.close()
+        Path(tmp).replace(path)
+    except Exception:  # noqa: BLE001 (no OpenGL context: the 3-D view is optional)
+        return None
+    return str(path)
+
+
+# --- CLI --------------------------------------------------------------------------------------
+
+def trajectory_main(args, target, projectile):
+    """``cavex trajectory``: checks, runs, writes, returns the text to print."""
+    from cavex.errors import CavexInputError, CavexNumericalError
+    from cavex.materials import MAX_VELOCITY
+
+    if (args.resistance == "table") != (args.table is not None):
+        raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
+                              "neither)")
+    law = [args.law_A is not None, args.law_B is not None]
+    if not all(law) if args.resistance == "law" else any(law):
+        raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
+                              "'--resistance law' (all or none)")
+    if args.compare_homogeneous and len(target.layers) < 2:
+        raise CavexInputError("option '--compare-homogeneous' needs a target of two or more "
+                              "layers (this one is its first layer alone already)")
+    folder = check_output_dir(args.out, "out")
+    speed = projectile.V0 if args.velocity is None else args.velocity  # Shot checks it
+    top = MAX_VELOCITY / projectile.r  # the shank's surface speed <= MAX_VELOCITY
+    require(math.isfinite(args.spin) and abs(args.spin) <= top, "spin",
+            f"in [-{top:g}, {top:g}] rad/s (shank surface speed <= {MAX_VELOCITY:g} m/s)",
+            args.spin)
+    shot = Shot(speed, args.obliquity, args.attack, args.attack_plane, args.spin)
+    projectile.body_length  # noqa: B018 (a projectile without a length refuses here)
+    try:  # forces beyond the body's mass and inertia overflow (warnings, then a bogus end)
+        with np.errstate(over="raise", invalid="raise"):
+            job = trajectory_job(target, projectile, shot, args.resistance,
+                                 boundary=args.boundary, free_surface=not args.no_free_surface,
+                                 table=args.table, law_A=args.law_A, law_B=args.law_B,
+                                 compare_homogeneous=args.compare_homogeneous,
+                                 contact_ramp=args.contact_ramp,
+                                 progress=show_progress(args.progress))
+    except FloatingPointError as exc:
+        raise CavexNumericalError(f"the trajectory overflowed ({exc}): forces far beyond the "
+                                  "projectile's mass and inertia") from None
+    for name, result in job["runs"].items():  # nothing but finite numbers is written
+        finite = all(np.all(np.isfinite(v)) for v in result.history.values())
+        if not finite or result.phases[-1]["end_time_s"] <= 0.0:
+            raise CavexNumericalError(
+                f"the {name} trajectory " + ("is not finite" if not finite else
+                "ended at t = 0 s: the integrator could not advance (a shot too slow, or "
+                "forces far beyond the projectile's mass and inertia)"))
+    runs = {k: summary(v) for k, v in job["runs"].items()}
+    try:  # the peaks and rates too (a repeated time sample gives an infinite rate)
+        json.dumps(runs, allow_nan=False)
+    except ValueError:
+        raise CavexNumericalError("the trajectory summary is not finite (peaks, pitch "
+                                  "rate)") from None
+    # every file or none, also on Ctrl-C or kill
+    written = write_staged(folder, lambda stage: write_outputs(job, runs, stage,
+                                                              draw=args.figures))
+    if args.json:
+        main = runs["runway"]
+        return json.dumps({"end": main["end"], "phases": main["phases"],
+                           "settings": job["settings"], "runs": runs, "outputs": written},
+                          indent=2)
+    lines = [_title(job)]
+    for name, s in runs.items():
+        e = s["end"]
+        lines += ["", f"{name}:",
+                  f"{'phase':<10} {'ends at t (ms)':>14} {'tip z (m)':>10} {'pitch':>8} "
+                  f"{'speed':>8}  because"]
+        lines += [f"{p['label']:<10} {p['end_time_s'] * 1e3:14.4f} "
+                  f"{p['end_nose_tip_m'][2]:10.4f} {p['end_pitch_deg']:8.2f} "
+                  f"{p['end_speed_m_s']:8.2f}  {p['end_reason']}" for p in s["phases"]]
+        tip = ", ".join(f"{c:.4f}".replace("-0.0000", "0.0000") for c in e["nose_tip_m"])
+        lines.append(f"end: {e['state']}, nose tip ({tip}) m, pitch "
+                     f"{e['pitch_deg']:.2f} deg; peaks: axial {s['max_axial_g']:.0f} g, "
+                     f"lateral {s['max_lateral_g']:.0f} g")
+    lines += ["", "wrote: " + ", ".join(written)]
+    return "\n".join(lines)

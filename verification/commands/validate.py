@@ -1,0 +1,357 @@
+"""The ``cavex validate`` job: predictions against measurements, written as JSON, CSV, a
+markdown report and two figures.
+
+Files (in ``--out``, default ``results/validation``): ``validation.json`` (what ``--json``
+prints), ``predictions.csv``, ``report.md``, ``predicted_vs_measured.png``,
+``ratio_vs_velocity.png`` and ``tables/`` (the FE tables, one per distinct target, reused by a
+later run with the same folder). Depths and statistics carry 6 significant digits
+(``validation.DEPTH_DIGITS``); the statistics are computed from the written depths, so every
+printed number is a function of the stored ones, and no wall time is written, so a rerun gives
+the same files.
+"""
+
+import csv
+import io
+import json
+import shlex
+import time
+
+import numpy as np
+
+from cavex.errors import CavexInputError
+from cavex.verification.fedata.runner import check_execution
+from cavex.verification.output.files import save_figure, write_text_atomic
+from cavex.verification.output.paths import check_output_dir, write_staged
+from cavex.verification.validation.predict import (
+    CLOSED_FORMS,
+    EMPIRICAL,
+    FE_MODEL,
+    MODELS,
+    TableCache,
+    predictions,
+    summaries,
+    validate,
+)
+from cavex.verification.validation.shots import read_shots
+
+DEFAULT_OUT = "results/validation"
+COMPRESSIBILITY_COLUMN = "FE table, derived dynamic calibration"
+BAND = 0.2  # +-20 % band on the predicted-against-measured figure
+
+
+def validate_main(shots_path, calibration_paths=(), out_dir=None, as_json=False, workers=None,
+                  scheduler=None, progress=None, command=None):
+    """Check every input, run :func:`run`, write the files; return the text to print."""
+    from cavex.verification.validation.calibration import read_calibration
+
+    shot_file = read_shots(shots_path)
+    calibrations = [read_calibration(p) for p in calibration_paths or ()]
+    columns = [c.column for c in calibrations]
+    repeated = sorted({c for c in columns if columns.count(c) > 1})
+    if repeated:
+        raise CavexInputError(f"two calibrations of the same model ({', '.join(repeated)}); "
+                              "give one per model")
+    out = check_output_dir(DEFAULT_OUT if out_dir is None else out_dir, "out")
+    check_execution(workers, scheduler)
+    began = time.monotonic()
+    result = run(shot_file, calibrations, tables_dir=out / "tables", workers=workers,
+                 scheduler=scheduler, progress=progress)
+    seconds = time.monotonic() - began
+    result["command"] = command or command_line(shots_path, calibration_paths, out)
+    # every file or none, also on Ctrl-C or kill
+    written = write_staged(out, lambda stage: write_outputs(result, stage))
+    if as_json:
+        return json.dumps(public(result), indent=2)
+    return summary_text(result, seconds, written)
+
+
+def run(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=None,
+        progress=None):
+    """:func:`cavex.verification.validation.predict.validate` plus the compressibility column and
+    the shots file's description."""
+    from cavex.verification.fedata.runner import show_progress
+
+    tables = TableCache(tables_dir, workers=workers, scheduler=scheduler,
+                        progress=show_progress(progress))
+    result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
+                      progress=progress)
+    dynamic = [c for c in calibrations if c.model == "derived dynamic"]
+    if dynamic:
+        columns = {COMPRESSIBILITY_COLUMN: (FE_MODEL, dynamic[0].mapping)}
+        depths, failures = predictions(shot_file.shots, columns, tables, progress)
+        for row, depth in zip(result["shots"], depths[COMPRESSIBILITY_COLUMN], strict=True):
+            row["predicted_m"][COMPRESSIBILITY_COLUMN] = depth
+            row["ratio"][COMPRESSIBILITY_COLUMN] = None if depth is None else \
+                depth / row["measured_m"]
+        result["failures"].update(failures)
+        result["compressibility_column"] = COMPRESSIBILITY_COLUMN
+        result["summary"] = summaries(result["shots"], list(result["summary"]) +
+                                      [COMPRESSIBILITY_COLUMN])
+        held = [r for r in result["shots"] if r["id"] in result["held_out"]]
+        result["held_out_summary"] = summaries(held, list(result["summary"]))
+        result["models"].append(COMPRESSIBILITY_COLUMN)
+    result["shots_file"] = {"path": shot_file.path, "comments": list(shot_file.comments),
+                            "n": len(shot_file.shots)}
+    result["tables"] = {"built": tables.built, "reused": tables.reused}
+    return result
+
+
+def public(result):
+    """The JSON document: everything but the run's bookkeeping (tables built or reused)."""
+    return {k: v for k, v in result.items() if k != "tables"}
+
+
+# --- files ------------------------------------------------------------------------------------
+
+def write_outputs(result, out):
+    """Write the JSON, CSV, report and figures into ``out``; return the paths."""
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, text in (("validation.json", json.dumps(public(result), indent=2) + "\n"),
+                       ("predictions.csv", predictions_csv(result)),
+                       ("report.md", report_markdown(result))):
+        write_text_atomic(out / name, text)
+        written.append(out / name)
+    written += write_figures(result, out)
+    return [str(p) for p in written]
+
+
+def slug(name):
+    return "".join(ch if ch.isalnum() else "_" for ch in name.lower()).strip("_")
+
+
+def predictions_csv(result):
+    """One row per shot: inputs, measured depth, every model's depth and ratio."""
+    text = io.StringIO(newline="")
+    writer = csv.writer(text, lineterminator="\n")
+    models = result["models"]
+    writer.writerow(["id", "V0_m_s", "fc_Pa", "rho_kg_m3", "measured_m"]
+                    + [f"{slug(m)}_m" for m in models] + [f"{slug(m)}_ratio" for m in models])
+    for row in result["shots"]:
+        writer.writerow([row["id"], _g(row["V0_m_s"]), _g(row["fc_Pa"]), _g(row["rho_kg_m3"]),
+                         _g(row["measured_m"])]
+                        + [_g(row["predicted_m"][m]) for m in models]
+                        + [_g(row["ratio"][m]) for m in models])
+    return text.getvalue()
+
+
+def _g(value, digits=6):
+    return "" if value is None else format(float(value), f".{digits}g")
+
+
+def _f(value, spec):
+    return "n/a" if value is None else format(value, spec)
+
+
+def ranking(summary):
+    """Model names by mean |ln ratio| (models without shots last)."""
+    return sorted(summary, key=lambda m: (summary[m]["mean_abs_log_ratio"] is None,
+                                          summary[m]["mean_abs_log_ratio"] or 0.0))
+
+
+def verdict(summary, calibrations):
+    """One sentence: the best calibrated cavex model against Forrestal 1994 on ``summary``."""
+    calibrated = [c["column"] for c in calibrations
+                  if summary.get(c["column"], {}).get("mean_abs_log_ratio") is not None]
+    empirical = summary.get(EMPIRICAL, {}).get("mean_abs_log_ratio")
+    if not calibrated or empirical is None:
+        return None
+    best = min(calibrated, key=lambda m: summary[m]["mean_abs_log_ratio"])
+    ours = summary[best]["mean_abs_log_ratio"]
+    relation = "no larger than" if ours <= empirical else "LARGER than"
+    return (f"best calibrated cavex model: {best}, mean |ln ratio| {ours:.4f}, {relation} "
+            f"{EMPIRICAL}'s {empirical:.4f}")
+
+
+def _summary_table(summary):
+    lines = ["| model | n | mean ratio | std ratio | mean abs ln ratio |",
+             "|---|---:|---:|---:|---:|"]
+    for m in ranking(summary):
+        s = summary[m]
+        lines.append(f"| {m} | {s['n']} | {_f(s['mean_ratio'], '.3f')} | "
+                     f"{_f(s['std_ratio'], '.3f')} | {_f(s['mean_abs_log_ratio'], '.4f')} |")
+    return lines
+
+
+def compressibility(result, column):
+    """FE over derived dynamic depth per shot, same material: ``(min, median, max)`` or None.
+
+    ``column`` is the FE column; its closed-form partner is ``derived dynamic`` (uncalibrated
+    mapping) or ``derived dynamic calibrated`` (the compressibility column)."""
+    partner = "derived dynamic" if column == FE_MODEL else "derived dynamic calibrated"
+    ratios = [row["predicted_m"][column] / row["predicted_m"][partner]
+              for row in result["shots"]
+              if row["predicted_m"].get(column) and row["predicted_m"].get(partner)]
+    if not ratios:
+        return None
+    return float(np.min(ratios)), float(np.median(ratios)), float(np.max(ratios))
+
+
+def report_markdown(result):
+    """The validation report (markdown); every number is from ``result``."""
+    models, shots = result["models"], result["shots"]
+    info = result["shots_file"]
+    mapping = result["mapping"]
+    lines = ["# Validation against measured penetration depths", ""]
+    if result.get("command"):
+        lines += [f"Generated by `{result['command']}`.", ""]
+    lines += [f"Shots: `{info['path']}`, {info['n']} shots. Its header:", ""]
+    lines += [f"> {c}" for c in info["comments"]] + [""]
+    lines += ["## Models", "",
+              "- `derived quasi-static`, `derived dynamic`, `paper`: cavex's incompressible "
+              "closed forms with the penetration integrator (crater 4.5 r from the nose base);",
+              f"- `{FE_MODEL}`: the FE-tabulated resistance, compressible (nu = "
+              f"{mapping['nu']:g}) and finite-strain, one FE table per distinct target;",
+              f"- `{EMPIRICAL}`: S = 82.6 f_c^-0.544 (f_c in MPa), crater of two calibres "
+              "(Forrestal et al. 1994). Forrestal et al. fitted S to their own shots, so on "
+              "their data it is not an out-of-sample prediction;",
+              "- `<model> calibrated`: the model with the fitted mapping of a calibration file.",
+              "",
+              "Uncalibrated mapping (docs/validation.md): lam = "
+              f"{mapping['lam']:.6g}, sigma_c = {mapping['strength_factor']:.6g} f_c, E = "
+              f"{mapping['modulus_factor']:.6g} x ACI 318, nu = {mapping['nu']:g}.", ""]
+    if result["calibrations"]:
+        lines += ["## Calibrations", "",
+                  "| column | file | fitted | lam | sigma_c / f_c | E / E_ACI | fitted on | "
+                  "fit mean abs ln ratio |", "|---|---|---|---:|---:|---:|---|---:|"]
+        for c in result["calibrations"]:
+            m = c["mapping"]
+            lines.append(f"| {c['column']} | `{c['file']}` | {', '.join(c['params'])} | "
+                         f"{m['lam']:.6g} | {m['strength_factor']:.6g} | "
+                         f"{m['modulus_factor']:.6g} | {len(c['shots'])} shots: "
+                         f"{', '.join(c['shots'])} | "
+                         f"{_f(c.get('mean_abs_log_ratio'), '.4f')} |")
+        lines += ["", f"Held out (in no calibration's fit): {len(result['held_out'])} shots: "
+                  f"{', '.join(result['held_out'])}.", "",
+                  "## How each model does on the held-out shots", ""]
+        lines += _summary_table(result["held_out_summary"]) + [""]
+        sentence = verdict(result["held_out_summary"], result["calibrations"])
+        if sentence:
+            lines += [f"On the held-out shots the {sentence}.", ""]
+    lines += ["## How each model does on all shots", ""]
+    lines += _summary_table(result["summary"]) + [""]
+    lines += ["Ratio = predicted / measured depth; std is the sample standard deviation; "
+              "mean abs ln ratio is the mean of |ln(predicted/measured)|.", ""]
+    lines += ["## Compressibility: the FE table against the incompressible closed forms", ""]
+    for column, what in ((FE_MODEL, "uncalibrated mapping"),
+                         (result.get("compressibility_column"),
+                          "the derived dynamic calibration's mapping")):
+        spread = compressibility(result, column) if column else None
+        if spread:
+            lines.append(f"- {what}: FE table depth / derived dynamic depth, same material, "
+                         f"min {spread[0]:.3f}, median {spread[1]:.3f}, max {spread[2]:.3f}.")
+    lines += ["", "Same E, lam, tau and rho: the FE differs from the derived dynamic closed form "
+              "only by compressibility (nu) and finite strain (docs/validation.md).", ""]
+    lines += ["## Per shot: predicted depth (mm) and predicted / measured", "",
+              "| shot | V0 (m/s) | f_c (MPa) | measured (mm) | "
+              + " | ".join(models) + " |",
+              "|---|---:|---:|---:|" + "---:|" * len(models)]
+    for row in shots:
+        cells = [f"{row['predicted_m'][m] * 1e3:.1f} ({row['ratio'][m]:.3f})"
+                 if row["predicted_m"][m] is not None else "failed" for m in models]
+        lines.append(f"| {row['id']} | {row['V0_m_s']:g} | {row['fc_Pa'] / 1e6:g} | "
+                     f"{row['measured_m'] * 1e3:g} | " + " | ".join(cells) + " |")
+    lines += ["", "![predicted against measured](predicted_vs_measured.png)", "",
+              "![ratio against striking velocity](ratio_vs_velocity.png)", ""]
+    if result["failures"]:
+        lines += ["## Failures", ""]
+        for model, items in result["failures"].items():
+            lines += [f"- {model}, shot {i}: {reason}" for i, reason in items.items()]
+        lines.append("")
+    return "\n".join(lines)
+
+
+def write_figures(result, out):
+    """Predicted against measured (log-log, 1:1, +-20 %) and ratio against striking velocity."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    markers = {"derived quasi-static": "o", "derived dynamic": "s", "paper": "^",
+               FE_MODEL: "D", EMPIRICAL: "*"}
+    colours = dict(zip([*CLOSED_FORMS, FE_MODEL, EMPIRICAL],
+                       ["tab:blue", "tab:orange", "tab:green", "tab:red", "black"], strict=True))
+    measured = np.array([row["measured_m"] for row in result["shots"]])
+    velocity = np.array([row["V0_m_s"] for row in result["shots"]])
+    held = set(result.get("held_out", []))
+    written = []
+    for name, x_of in (("predicted_vs_measured.png", None), ("ratio_vs_velocity.png", velocity)):
+        fig, ax = plt.subplots(figsize=(7.5, 5.5))
+        for model in result["models"]:
+            base = next(b for b in MODELS if model.startswith(b))
+            calibrated = model != base
+            y = np.array([np.nan if row["predicted_m"][model] is None
+                          else row["predicted_m"][model] for row in result["shots"]])
+            style = {"marker": markers[base], "color": colours[base], "linestyle": "none",
+                     "markersize": 7 if base != EMPIRICAL else 10, "label": model,
+                     "markerfacecolor": colours[base] if calibrated or base == EMPIRICAL
+                     else "none"}
+            if model == COMPRESSIBILITY_COLUMN:
+                style.update(markerfacecolor="white", markeredgewidth=2.0, marker="P")
+            if x_of is None:
+                ax.plot(measured * 1e3, y * 1e3, **style)
+            else:
+                ax.plot(x_of, y / measured, **style)
+        if x_of is None:
+            lo, hi = 0.5 * measured.min() * 1e3, 2.0 * measured.max() * 1e3
+            line = np.array([lo, hi])
+            ax.plot(line, line, "k-", linewidth=1, label="1:1")
+            ax.fill_between(line, line * (1 - BAND), line * (1 + BAND), color="grey",
+                            alpha=0.2, label="+-20 %")
+            ax.set(xscale="log", yscale="log", xlim=(lo, hi), ylim=(lo / 2, hi * 1.5),
+                   xlabel="measured depth (mm)", ylabel="predicted depth (mm)",
+                   title="Predicted against measured penetration depth")
+        else:
+            ax.axhline(1.0, color="k", linewidth=1)
+            ax.axhspan(1 - BAND, 1 + BAND, color="grey", alpha=0.2)
+            for v, row in zip(velocity, result["shots"], strict=True):
+                if row["id"] in held:
+                    ax.axvline(v, color="grey", linewidth=0.5, linestyle=":")
+            ax.set(xlabel="striking velocity (m/s)", ylabel="predicted / measured depth",
+                   title="Ratio against striking velocity" + (
+                       " (dotted: held-out shots)" if held else ""))
+        ax.legend(fontsize=7, loc="best", ncol=2)
+        written.append(_save(fig, out / name, plt))
+    return written
+
+
+def _save(fig, path, plt):
+    fig.tight_layout()
+    return save_figure(fig, path, dpi=110)
+
+
+def summary_text(result, seconds, written):
+    """What ``cavex validate`` prints without ``--json``."""
+    lines = [f"{result['shots_file']['n']} shots from {result['shots_file']['path']}; "
+             f"FE tables built {result['tables']['built']}, reused "
+             f"{result['tables']['reused']}; {seconds:.1f} s", ""]
+    parts = [("all shots", result["summary"])]
+    if "held_out_summary" in result:
+        parts.insert(0, (f"held-out shots ({len(result['held_out'])})",
+                         result["held_out_summary"]))
+    for title, summary in parts:
+        lines += [f"{title}:", f"{'model':<40} {'n':>3} {'mean ratio':>10} {'std':>7} "
+                  f"{'mean|ln r|':>10}"]
+        for m in ranking(summary):
+            s = summary[m]
+            lines.append(f"{m:<40} {s['n']:>3} {_f(s['mean_ratio'], '10.3f')} "
+                         f"{_f(s['std_ratio'], '7.3f')} {_f(s['mean_abs_log_ratio'], '10.4f')}")
+        lines.append("")
+    sentence = verdict(result.get("held_out_summary", {}), result["calibrations"])
+    if sentence:
+        lines += [f"held-out: {sentence}", ""]
+    if result["failures"]:
+        count = sum(len(v) for v in result["failures"].values())
+        lines += [f"{count} prediction(s) failed (see report.md)", ""]
+    lines.append("wrote   " + ", ".join(written))
+    return "\n".join(lines)
+
+
+def command_line(shots_path, calibration_paths, out_dir):
+    """The ``cavex validate`` command that makes these outputs (the report's provenance)."""
+    words = ["cavex", "validate", "--shots", str(shots_path)]
+    if calibration_paths:
+        words += ["--calibration", *map(str, calibration_paths)]
+    return " ".join(shlex.quote(w) for w in [*words, "--out", str(out_dir)])
+

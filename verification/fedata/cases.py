@@ -1,0 +1,240 @@
+"""Self-contained, JSON-able FE cases for :func:`cavex.verification.fedata.runner.run_cases`.
+
+An FE case is a plain dict::
+
+    {"id": "v0500.000_L0.30000", "velocity": 500.0, "depth": 0.3,
+     "nu": 0.4999,                        # optional: Poisson's ratio for every layer
+     "numerics": {"elements_per_decade": 10},   # optional: cavex.fem.Numerics settings
+     "error_target": 0.005,               # optional: refine above it (null: never)
+     "target": [{"name": "concrete", "thickness": 0.65, "E": 25e9, ...}, ...],
+     "projectile": {"r": 0.0125, "l": 0.06, "R": 0.075, "m": 0.505, "V0": 1000.0}}
+
+``target`` is the list of ``[[layers]]`` tables and ``projectile`` the ``[projectile]`` table of
+the config TOML schema (``core/data/runway.toml``), so a case carries everything it needs.
+FE cases are run in chunks (:func:`fe_cases`, the work unit of
+:func:`cavex.verification.fedata.runner.run_cases` for processes and Dask): the cases of a chunk
+that share their numerics run together on the one FE solver.
+"""
+
+import json
+import math
+import os
+import time
+import uuid
+from dataclasses import fields
+
+from cavex.config import load_config, parse_projectile, parse_target, projectile_table, target_table
+from cavex.errors import CavexInputError, CavexNumericalError, require
+from cavex.errors import is_finite_number as _finite
+from cavex.fem.estimate import DEFAULT_ERROR_TARGET
+from cavex.fem.settings import Numerics, make_numerics
+from cavex.problem import check_problem
+
+CASE_KEYS = {"id", "velocity", "depth", "nu", "numerics", "error_target", "target",
+             "projectile"}
+#: FE cases per second per worker, measured on table grids at the default settings with
+#: error estimates (docs/fem.md "Throughput": 12-20 per process); used for estimates only.
+CASES_PER_SECOND_PER_WORKER = 15.0
+LARGE_RUN = 20_000  # FE cases above which a run needs an explicit request
+
+
+def check_run_size(n_cases, workers, allow_large, option="allow-large"):
+    """The one-line estimate of an FE run of ``n_cases`` cases on ``workers`` workers; refuses
+    (naming ``option``) more than :data:`LARGE_RUN` cases unless ``allow_large``."""
+    hours = n_cases / (CASES_PER_SECOND_PER_WORKER * max(1, workers)) / 3600.0
+    minutes = hours * 60.0
+    estimate = (f"{n_cases} FE cases, under a minute" if minutes < 1.0
+                else f"{n_cases} FE cases, about {minutes:.0f} min" if hours < 1.0
+                else f"{n_cases} FE cases, about {hours:.1f} h")
+    if n_cases > LARGE_RUN and not allow_large:
+        raise CavexInputError(f"{estimate} on {workers} worker(s): more than {LARGE_RUN} cases "
+                              f"need the option '--{option}'")
+    return f"{estimate} on {workers} worker(s) (at ~{CASES_PER_SECOND_PER_WORKER:g} cases/s " \
+           "per worker)"
+
+
+def fe_cases(chunk):
+    """Run a chunk of FE cases: per case :func:`~cavex.verification.fedata.comparison.
+    compare_at_depth`'s dict plus ``"id"``, or the exception the case failed with.
+
+    The cases that share their numerics and error target run together
+    (:func:`~cavex.verification.fedata.comparison.compare_many`: stacks of the one FE solver); a
+    case computes the same bits in any chunk.
+
+    Parameters
+    ----------
+    chunk : list of dict
+        Cases with keys ``id``, ``velocity`` (m/s), ``depth`` (nose-tip depth, m), optional
+        ``nu``, optional ``numerics`` (dict of :class:`cavex.fem.Numerics` settings), optional
+        ``error_target`` (default :data:`cavex.fem.estimate.DEFAULT_ERROR_TARGET`; None: no
+        refinement), ``target`` (list of layer tables, or ``{"layers": [...]}``) and
+        ``projectile`` (table).
+    """
+    from cavex.verification.fedata.comparison import compare_many
+
+    out = [None] * len(chunk)
+    groups = {}
+    for i, case in enumerate(chunk):
+        try:
+            request, numerics, target = _fe_request(case)
+        except (CavexInputError, KeyError, TypeError, ValueError) as exc:
+            out[i] = exc
+            continue
+        key = json.dumps([numerics, target], sort_keys=True)
+        groups.setdefault(key, (numerics, target, []))[2].append((i, request))
+    for numerics, target, members in groups.values():
+        results = compare_many([request for _, request in members], error_target=target,
+                               **numerics)
+        for (i, _), result in zip(members, results, strict=True):
+            out[i] = result if isinstance(result, Exception) else {**result,
+                                                                  "id": chunk[i]["id"]}
+    return out
+
+
+def _fe_request(case):
+    """``((target, projectile, depth, velocity, nu), numerics, error_target)`` of a case."""
+    from cavex.verification.fedata.comparison import fe_problem
+
+    unknown = sorted(set(case) - CASE_KEYS)
+    if unknown:
+        raise CavexInputError(f"unknown key '{unknown[0]}' in case "
+                              f"(accepted: {', '.join(sorted(CASE_KEYS))})")
+    target = parse_target(_layers(case["target"]))
+    projectile = parse_projectile(case["projectile"])
+    numerics = make_numerics(**case.get("numerics", {})).as_dict()
+    error_target = case.get("error_target", DEFAULT_ERROR_TARGET)
+    require(error_target is None or (_finite(error_target) and 0 < error_target < 1),
+            "error_target", "null or a number in (0, 1)", error_target)
+    request = (target, projectile, case["depth"], case["velocity"], case.get("nu"))
+    check_problem(*fe_problem(*request), "dynamic")  # a bad case fails alone, not its chunk
+    return request, numerics, None if error_target is None else float(error_target)
+
+
+def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, numerics=None,
+                  error_target=DEFAULT_ERROR_TARGET):
+    """FE cases on the grid ``velocities x depths`` (velocity outermost), with stable ids.
+
+    Parameters
+    ----------
+    target_table : list of dict or dict
+        The ``[[layers]]`` tables (or ``{"layers": [...]}``), see :func:`target_table`.
+    projectile_table : dict
+        The ``[projectile]`` table, see :func:`projectile_table`.
+    velocities, depths : sequence of float
+        Expansion velocities (m/s, >= 0; 0 is a quasi-static FE run) and nose-tip depths
+        (m, >= 0).
+    nu : float, optional
+        Poisson's ratio for every layer (default: each layer's own).
+    numerics : dict, optional
+        :class:`cavex.fem.Numerics` settings shared by all cases.
+    error_target : float or None
+        Refine an FE case while its error estimate exceeds this (None: never).
+
+    Returns
+    -------
+    list of dict
+        Cases with ids ``"v0500.000_L0.30000"`` (``"_nu0.499900"`` appended when ``nu`` is
+        given); the ids are unique and depend only on the values.
+
+    Raises
+    ------
+    CavexInputError
+        Invalid target, projectile, numerics, velocities or depths, or two values too close to
+        be told apart by the id format.
+    """
+    layers = [dict(table) for table in _layers(target_table)]
+    projectile = dict(projectile_table)
+    parse_target(layers)
+    parse_projectile(projectile)
+    numerics = dict(numerics or {})
+    make_numerics(**numerics)
+    if nu is not None:
+        require(_finite(nu) and -1.0 < nu < 0.5, "nu", "in (-1, 0.5)", nu)
+    cases = []
+    for i, velocity in enumerate(velocities):
+        require(_finite(velocity) and velocity >= 0, f"velocities[{i}]", "a finite number >= 0",
+                velocity)
+        for j, depth in enumerate(depths):
+            require(_finite(depth) and depth >= 0, f"depths[{j}]", "a finite number >= 0", depth)
+            case = {"id": fe_case_id(velocity, depth, nu), "velocity": float(velocity),
+                    "depth": float(depth)}
+            if nu is not None:
+                case["nu"] = float(nu)
+            if numerics:
+                case["numerics"] = dict(numerics)
+            if error_target != DEFAULT_ERROR_TARGET:
+                case["error_target"] = error_target
+            cases.append({**case, "target": layers, "projectile": projectile})
+    check_unique_ids(cases)
+    return cases
+
+
+def fe_case_id(velocity, depth, nu=None):
+    """``"v0500.000_L0.30000"`` (plus ``"_nu0.499900"`` when ``nu`` is given)."""
+    text = f"v{velocity:08.3f}_L{depth:.5f}"
+    return text if nu is None else f"{text}_nu{nu:.6f}"
+
+
+def check_unique_ids(cases):
+    """Raise ``CavexInputError`` if two cases share an id (values closer than the id format)."""
+    seen = {}
+    for case in cases:
+        if case["id"] in seen:
+            raise CavexInputError(f"cases {seen[case['id']]} and {case} both get id "
+                                  f"'{case['id']}': values too close to tell apart")
+        seen[case["id"]] = {k: v for k, v in case.items() if k not in ("target", "projectile")}
+
+
+def config_tables(path=None):
+    """``(layer tables, projectile table)`` of a config TOML (default: the embedded Table 1)."""
+    target, projectile = load_config(path)
+    return target_table(target), projectile_table(projectile)
+
+
+def numerics_names():
+    """Names of the :class:`cavex.fem.Numerics` settings."""
+    return [f.name for f in fields(Numerics)]
+
+
+def probe_cases(chunk):
+    """:func:`probe_case` on every case of a chunk (the exception in place of a failed one)."""
+    out = []
+    for case in chunk:
+        try:
+            out.append(probe_case(case))
+        except CavexNumericalError as exc:
+            out.append(exc)
+    return out
+
+
+def probe_case(case):
+    """A cheap deterministic case for checking runners and clusters (no FE).
+
+    Keys: ``id``; ``x`` (float); optional ``fail`` (message: raises ``CavexNumericalError``);
+    optional ``sleep`` (seconds); optional ``marker_dir`` (a file is created there for every
+    computation, so that computations can be counted).
+
+    Returns
+    -------
+    dict
+        ``{"x": x, "value": exp(sin(x)) / 3, "values": [x / 7, sqrt(|x|) / 3, |x| ** 0.1]}``.
+    """
+    if case.get("marker_dir"):
+        name = f"{case['id']}.{os.getpid()}.{uuid.uuid4().hex}.done"
+        with open(os.path.join(case["marker_dir"], name), "w", encoding="utf-8"):
+            pass
+    if case.get("sleep"):
+        time.sleep(case["sleep"])
+    if case.get("fail"):
+        raise CavexNumericalError(f"{case['fail']} (x = {case['x']})")
+    x = float(case["x"])
+    return {"x": x, "value": math.exp(math.sin(x)) / 3.0,
+            "values": [x / 7.0, math.sqrt(abs(x)) / 3.0, abs(x) ** 0.1]}
+
+
+def _layers(target):
+    if isinstance(target, dict):
+        require(set(target) == {"layers"}, "target", "a list of layer tables or {'layers': [...]}",
+                sorted(target))
+        return target["layers"]
+    return target

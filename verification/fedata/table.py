@@ -1,0 +1,398 @@
+"""FE-tabulated cavity-wall stress ``sigma_r(V, L)`` for one target and projectile.
+
+The table holds the FE cavity-wall radial stress of the spherical problem at nose-tip depth
+``L`` (:func:`cavex.analytic.geometry.spherical_problem`, ``switch="cavity"``) for expansion
+velocity ``V``, on a grid, as an :class:`xarray.Dataset`:
+
+- coordinates ``velocity`` (m/s; must start at 0, see ``docs/verification.md``) and ``depth``
+  (nose-tip depth, m); the depth grid always contains the wall-layer switch depths
+  ``H_i + l - r`` inside its range, where ``sigma_r`` is continuous but its slope is not;
+- ``sigma_r``, ``S``, ``error_estimate``, ``plastic_radius`` (FE elastic-plastic boundary),
+  ``failed`` on ``(velocity, depth)`` (failed cells NaN), ``wall_layer`` on ``depth``, the
+  analytic ``sigma_r_dynamic`` and ``sigma_r_quasi_static`` for reference, and
+  ``sigma_r_first_layer`` / ``failed_first_layer`` on ``velocity``: the first layer alone,
+  semi-infinite, for the crater stage;
+- attributes: the TOML text of the target and projectile, their fingerprint, the solver
+  settings (JSON), package versions and the creation time; ``Conventions = "CF-1.10"``: every
+  variable and coordinate has ``units`` (UDUNITS spelling,
+  :mod:`cavex.verification.output.cf_metadata`)
+  and ``long_name``, and ``failed``, ``failed_first_layer`` and ``wall_layer`` carry
+  ``flag_values`` / ``flag_meanings``.
+
+The FE cells are run with the shared case runner (:mod:`cavex.verification.fedata.runner`) on cases
+from :func:`cavex.verification.fedata.cases.make_fe_cases`.
+"""
+
+import json
+import math
+import os
+import shutil
+import time
+from datetime import UTC, datetime
+from importlib import metadata
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from cavex.analytic.cavity import cavity_solution
+from cavex.analytic.geometry import spherical_problem, switch_depths, wall_layer
+from cavex.config import config_text, fingerprint, fingerprint_data, projectile_table, target_table
+from cavex.errors import require
+from cavex.fem.estimate import DEFAULT_ERROR_TARGET
+from cavex.materials import MAX_VELOCITY
+from cavex.verification.fedata.cases import fe_cases, make_fe_cases
+from cavex.verification.fedata.runner import check_execution, run_cases
+from cavex.verification.output.cf_metadata import CONVENTIONS, UNITS, boolean_attrs, flag_attrs
+from cavex.verification.output.number_format import round_dataset
+from cavex.verification.output.paths import check_output_file
+
+DEFAULT_VELOCITIES = tuple(np.linspace(0.0, 1200.0, 13))
+DEFAULT_DEPTHS = tuple(np.round(np.linspace(0.10, 1.30, 31), 6))
+FINGERPRINT_SCOPE = "layers (all keys) and projectile r, l: what sigma_r(V, L) depends on"
+VERSIONED = ("cavex", "numpy", "scipy", "scikit-fem", "xarray")
+SWITCH_REFINEMENT = (2.0, 1.0, 0.5, 0.25, 0.125)  # depths L_s - f r added above each switch
+SWITCH_OFFSET = 1e-9  # m: the switch node sits this far below the switch depth
+FIRST_LAYER_DEPTH = 0.0  # the single first-layer problem has no interfaces; any depth will do
+
+#: Deepest nose depth of a table (m): far below any rigid penetration; the grid's depths are
+#: rounded to 1e-12 m, which overflows beyond ~1e296 m.
+MAX_DEPTH = 1e3
+
+
+# --- target and projectile as TOML-schema data ------------------------------------------------
+
+# --- the grid ---------------------------------------------------------------------------------
+
+def switch_nodes(target, projectile):
+    """Grid depths standing for the switch depths: ``L_s + SWITCH_OFFSET``.
+
+    At ``L_s`` itself rounding may keep a zero-thickness shell of the upper layer (the FE mesh
+    then degenerates); ``SWITCH_OFFSET`` past it the upper layer is surely gone. ``sigma_r`` is
+    continuous there, so the node serves both segments.
+    """
+    return tuple(s + SWITCH_OFFSET for s in switch_depths(target, projectile))
+
+
+def grid_depths(depths, target, projectile, refine=SWITCH_REFINEMENT):
+    """Sorted unique ``depths`` plus, for each switch depth ``L_s`` inside their range, its
+    node (:func:`switch_nodes`) and the refinement depths ``L_s - f r`` (``f`` in ``refine``).
+
+    Just above a switch the upper layer is a shell of thickness ``delta = L_s - L`` around the
+    cavity, and ``sigma_r`` changes over ``delta ~ r/4`` (it decays with distance from the wall
+    like the cavity field, on the cavity radius), so the grid is refined there.
+    """
+    d = np.unique(np.asarray(depths, dtype=float))
+    extra = []
+    for s, node in zip(switch_depths(target, projectile), switch_nodes(target, projectile),
+                       strict=True):
+        if d[0] < s < d[-1]:
+            extra += [node] + [s - f * projectile.r for f in refine
+                               if s - f * projectile.r > d[0]]
+    d = d[~np.any(np.abs(d[:, None] - np.asarray(extra)[None, :]) < 1e-6, axis=1)] if extra else d
+    return np.unique(np.round(np.concatenate([d, extra]), 12))
+
+
+def check_grid(velocities, depths):
+    """Raise :class:`CavexInputError` unless the grid can be tabulated and interpolated."""
+    v = np.asarray(velocities, dtype=float)
+    d = np.asarray(depths, dtype=float)
+    shown_v, shown_d = [float(x) for x in v.ravel()], [float(x) for x in d.ravel()]
+    require(v.ndim == 1 and np.all(np.isfinite(v)) and np.all(v >= 0.0)
+            and np.all(v <= MAX_VELOCITY), "velocities", f"values in [0, {MAX_VELOCITY:g}] m/s",
+            shown_v)
+    require(np.unique(v).size >= 2, "velocities", "at least two different values", shown_v)
+    require(v.min() == 0.0, "velocities",
+            "a grid that includes V = 0 (the nose tip sees V cos(phi) -> 0)", shown_v)
+    require(d.ndim == 1 and np.all(np.isfinite(d)) and np.all(d >= 0.0)
+            and np.all(d <= MAX_DEPTH), "depths", f"values in [0, {MAX_DEPTH:g}] m", shown_d)
+    require(np.unique(d).size >= 2, "depths", "at least two different values", shown_d)
+
+
+# --- building ---------------------------------------------------------------------------------
+
+def build_table(target, projectile, velocities, depths, *, nu=None, numerics=None,
+                error_target=DEFAULT_ERROR_TARGET, scheduler=None, workers=None, store=None,
+                progress=None, refine=SWITCH_REFINEMENT):
+    """FE cavity-wall stress on the ``(velocity, depth)`` grid, as an :class:`xarray.Dataset`.
+
+    Parameters
+    ----------
+    target, projectile : Target, Projectile
+    velocities : sequence of float
+        Expansion velocities (m/s); must include 0. Sorted and made unique.
+    depths : sequence of float
+        Nose-tip depths (m); the wall-layer switch depths inside their range are added.
+    nu : float, optional
+        Poisson's ratio for every layer (default: each layer's own).
+    numerics : dict, optional
+        Settings of :class:`cavex.fem.Numerics`.
+    error_target : float or None
+        A cell whose estimated FE error exceeds this is refined (twice the space and time
+        resolution, at most twice; default 0.5 %); None: every cell at ``numerics``.
+    scheduler, workers, store, progress
+        Passed to :func:`cavex.verification.fedata.runner.run_cases`.
+    refine : sequence of float
+        Depths ``L_s - f r`` added above each switch depth (see :func:`grid_depths`).
+
+    Returns
+    -------
+    xarray.Dataset
+        See the module docstring; failed cells are NaN with ``failed`` True and their reasons
+        in the ``failures`` attribute (JSON).
+    """
+    check_grid(velocities, depths)
+    v = np.unique(np.asarray(velocities, dtype=float))
+    d = grid_depths(depths, target, projectile, refine)
+    grid = table_cases(target, projectile, v, d, nu, numerics, error_target)
+    first = [{**case, "id": f"first-layer-{case['id']}"} for case in
+             table_cases(target.single(0), projectile, v, [FIRST_LAYER_DEPTH], nu, numerics,
+                         error_target)]
+    results = run_cases(fe_cases, grid + first, store=store, scheduler=scheduler,
+                        workers=workers, progress=progress)
+    cells = _cells(results[:len(grid)], grid, v, d)
+    crater = _cells(results[len(grid):], first, v, [FIRST_LAYER_DEPTH])
+    return assemble_table(target, projectile, v, d, cells, crater,
+                          settings_json(nu, numerics, error_target))
+
+
+def table_cases(target, projectile, velocities, depths, nu, numerics,
+                error_target=DEFAULT_ERROR_TARGET):
+    """FE cases in the order velocity-major, depth-minor (``V = 0`` is a quasi-static run)."""
+    return make_fe_cases(target_table(target), projectile_table(projectile), velocities,
+                         depths, nu=nu, numerics=numerics, error_target=error_target)
+
+
+def _cells(results, cases, velocities, depths):
+    """Grid arrays ``sigma_r``, ``S``, ``error_estimate``, ``plastic_radius``, ``failed`` and the
+    failure list."""
+    shape = (len(velocities), len(depths))
+    out = {k: np.full(shape, np.nan) for k in ("sigma_r", "S", "error_estimate",
+                                                "plastic_radius")}
+    failed = np.zeros(shape, dtype=bool)
+    failures = []
+    for case, result in zip(cases, results, strict=True):
+        i = int(np.searchsorted(velocities, case["velocity"]))
+        j = int(np.searchsorted(depths, case["depth"]))
+        if result.get("status") != "ok":
+            failed[i, j] = True
+            failures.append({"velocity": float(case["velocity"]), "depth": float(case["depth"]),
+                             "reason": str(result.get("reason", ""))})
+            continue
+        out["sigma_r"][i, j] = result["fe_sigma_r_Pa"]
+        out["S"][i, j] = result["S"]
+        out["plastic_radius"][i, j] = result["fe_plastic_radius_m"]
+        estimate = result.get("error_estimate")
+        out["error_estimate"][i, j] = np.nan if estimate is None else estimate
+    return {**out, "failed": failed, "failures": failures}
+
+
+def settings_json(nu, numerics, error_target=DEFAULT_ERROR_TARGET):
+    """Solver settings (``nu``, every :class:`~cavex.fem.Numerics` value and the error target)
+    as JSON."""
+    from cavex.fem.settings import make_numerics
+
+    return json.dumps({"nu": nu, "numerics": make_numerics(**(numerics or {})).as_dict(),
+                       "error_target": error_target, "switch": "cavity"}, sort_keys=True)
+
+
+def analytic_table(target, projectile, velocities, depths, boundary="dynamic",
+                   refine=SWITCH_REFINEMENT):
+    """A table filled from the closed form instead of the FE (for tests and comparisons).
+
+    ``sigma_r`` and ``plastic_radius`` are the closed form's (:func:`cavex.analytic.cavity_solution`
+    with ``boundary``); the grid is built as :func:`build_table` builds it.
+    """
+    check_grid(velocities, depths)
+    v = np.unique(np.asarray(velocities, dtype=float))
+    d = grid_depths(depths, target, projectile, refine)
+
+    def cells(tgt, ds):
+        sigma, b = _analytic_grid(tgt, projectile, v, ds, boundary, ("stress", "plastic_radius"))
+        tau = np.array([tgt.layers[wall_layer(tgt, projectile, L)].tau for L in ds])
+        return {"sigma_r": sigma, "S": sigma / tau, "error_estimate": np.zeros_like(sigma),
+                "plastic_radius": b,
+                "failed": np.zeros(sigma.shape, dtype=bool), "failures": []}
+
+    return assemble_table(target, projectile, v, d, cells(target, d),
+                          cells(target.single(0), [FIRST_LAYER_DEPTH]),
+                          json.dumps({"analytic": boundary, "switch": "cavity"}))
+
+
+def _analytic_grid(target, projectile, velocities, depths, boundary, fields=None):
+    """Closed-form ``sigma_r`` on the grid, or one array per :class:`CavityState` field."""
+    out = np.empty((len(fields or ("stress",)), len(velocities), len(depths)))
+    for j, L in enumerate(depths):
+        layers, interfaces = spherical_problem(target, projectile, L)
+        for i, V in enumerate(velocities):
+            state = cavity_solution(layers, interfaces, V, projectile.r, boundary=boundary)
+            out[:, i, j] = [getattr(state, f) for f in fields or ("stress",)]
+    return out[0] if fields is None else tuple(out)
+
+
+def assemble_table(target, projectile, velocities, depths, cells, crater, settings):
+    """The Dataset from grid arrays (see :func:`build_table`)."""
+    v, d = np.asarray(velocities, dtype=float), np.asarray(depths, dtype=float)
+    grid = ("velocity", "depth")
+    names = [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]
+    data = {
+        "sigma_r": (grid, cells["sigma_r"], _attrs("Pa", "FE cavity-wall radial stress, "
+                                                   "compression positive")),
+        "S": (grid, cells["S"], _attrs("1", "sigma_r / tau of the wall layer")),
+        "error_estimate": (grid, cells["error_estimate"],
+                           _attrs("1", "FE relative discretisation error (Richardson)")),
+        "plastic_radius": (grid, cells["plastic_radius"],
+                           _attrs("m", "FE elastic-plastic boundary radius b")),
+        "failed": (grid, cells["failed"],
+                   boolean_attrs("FE run failed (cell is NaN)", "ok", "failed")),
+        "wall_layer": ("depth", np.array([wall_layer(target, projectile, L) for L in d],
+                                         dtype=np.int32),
+                       flag_attrs(range(len(names)), names, "index of the layer at the cavity "
+                                  "wall; names in attribute layer_names", np.int32)),
+        "sigma_r_first_layer": ("velocity", cells_first(crater, "sigma_r"),
+                                _attrs("Pa", "FE cavity-wall stress, first layer alone "
+                                             "(crater stage)")),
+        "failed_first_layer": ("velocity", cells_first(crater, "failed"),
+                               boolean_attrs("FE first-layer run failed", "ok", "failed")),
+    }
+    for boundary in ("dynamic", "quasi-static"):
+        data["sigma_r_" + boundary.replace("-", "_")] = (
+            grid, _analytic_grid(target, projectile, v, d, boundary),
+            _attrs("Pa", f"analytic cavity-wall stress, {boundary} boundary (reference)"))
+    coords = {"velocity": ("velocity", v, _attrs(UNITS["velocity"],
+                                                 "cavity expansion velocity V")),
+              "depth": ("depth", d, _attrs(UNITS["length"], "nose-tip depth L"))}
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(table_attrs(target, projectile, settings))
+    ds.attrs["layer_names"] = json.dumps(names)
+    ds.attrs["failures"] = json.dumps(cells["failures"] + crater["failures"])
+    return ds
+
+
+def cells_first(crater, key):
+    """The single-depth column of the first-layer cells."""
+    return crater[key][:, 0]
+
+
+def _attrs(units, long_name):
+    return {"units": units, "long_name": long_name}
+
+
+def table_attrs(target, projectile, settings):
+    """Global attributes: TOML text, fingerprint, settings, versions, creation time."""
+    return {
+        "Conventions": CONVENTIONS,
+        "title": "cavex FE-tabulated cavity-wall stress sigma_r(V, L)",
+        "target": config_text(target, projectile),
+        "fingerprint": fingerprint(target, projectile),
+        "fingerprint_scope": FINGERPRINT_SCOPE,
+        "fingerprint_data": json.dumps(fingerprint_data(target, projectile), sort_keys=True),
+        "solver_settings": settings,
+        "versions": json.dumps({name: _version(name) for name in VERSIONED}),
+        "created": datetime.now(UTC).isoformat(timespec="seconds"),
+    }
+
+
+def _version(name):
+    try:
+        return metadata.version(name)
+    except metadata.PackageNotFoundError:
+        return "unknown"
+
+
+# --- files ------------------------------------------------------------------------------------
+
+# attributes that would make the same table a different file: when it was made, where it was read
+UNREPRODUCIBLE_ATTRS = ("created", "source")
+
+
+def write_table(ds, path, *, reproducible=True):
+    """Write ``ds`` as netCDF3 (scipy engine) atomically: a temporary file, then ``os.replace``.
+
+    ``reproducible`` (default): the same table computed on another CPU gives the same file;
+    float data variables are rounded to the significant digits the numerics support
+    (:func:`cavex.verification.output.number_format.round_dataset`) and the attributes in
+    :data:`UNREPRODUCIBLE_ATTRS` are left out. ``ds`` itself is not changed. False: ``ds`` is
+    written exactly as it is.
+    """
+    path = Path(path)
+    if path.parent != Path(""):
+        path.parent.mkdir(parents=True, exist_ok=True)
+    if reproducible:
+        ds = round_dataset(ds)
+        ds.attrs = {k: v for k, v in ds.attrs.items() if k not in UNREPRODUCIBLE_ATTRS}
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        ds.to_netcdf(tmp, engine="scipy")
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+# --- command-line job -------------------------------------------------------------------------
+
+STORE_SUFFIX = ".cases"  # cavex table's resumable case store: <out>.cases/ until it is written
+
+
+def table_main(config_path=None, velocities=None, depths=None, out_path="results/table.nc",
+               nu=None, workers=None, scheduler=None, numerics=None, progress=None,
+               as_json=False):
+    """The ``cavex table`` job: build, write and summarise a table; returns the summary text
+    (``as_json``: :func:`summary_dict` as JSON).
+
+    The output location, the grid, ``workers`` and ``scheduler`` are checked before any FE
+    work; finished cells are kept in ``<out>.cases/`` while the table is built, so that a killed
+    run resumes where it stopped (the folder is removed once the table is written).
+
+    Defaults: velocities 0, 100, ..., 1200 m/s (13), depths 0.10 ... 1.30 m every 0.04 m (31,
+    plus the two wall-layer switch depths): concrete, macadam and into the soil.
+    """
+    from cavex.config import load_config
+
+    target, projectile = load_config(config_path)
+    velocities = DEFAULT_VELOCITIES if velocities is None else velocities
+    depths = DEFAULT_DEPTHS if depths is None else depths
+    check_grid(velocities, depths)
+    out_path = check_output_file(out_path, "out")
+    check_execution(workers, scheduler)
+    store = out_path.with_name(out_path.name + STORE_SUFFIX)
+    start = time.perf_counter()
+    ds = build_table(target, projectile, velocities, depths, nu=nu, numerics=numerics,
+                     scheduler=scheduler, workers=workers, progress=progress, store=store)
+    seconds = time.perf_counter() - start
+    written = write_table(ds, out_path)
+    shutil.rmtree(store, ignore_errors=True)  # the table holds every cell now
+    if as_json:
+        return json.dumps(summary_dict(ds, seconds, written), indent=2)
+    return summary_text(ds, seconds, written)
+
+
+def summary_dict(ds, seconds, path):
+    """What ``cavex table --json`` prints: FE cases (the grid plus the first layer alone),
+    the grid's axes, failed cells, the largest error estimate (None: none estimated), the wall
+    time and the file written."""
+    estimate = float(np.nanmax(ds["error_estimate"])) if np.any(
+        np.isfinite(ds["error_estimate"])) else None
+    return {"cases": ds.sizes["velocity"] * (ds.sizes["depth"] + 1),
+            "velocities_m_s": [float(x) for x in ds["velocity"].values],
+            "depths_m": [float(x) for x in ds["depth"].values],
+            "failed": int(ds["failed"].sum()) + int(ds["failed_first_layer"].sum()),
+            "max_error_estimate": estimate, "wall_time_s": float(seconds),
+            "output": str(path)}
+
+
+def summary_text(ds, seconds, path):
+    """Cases, failed cells, time and path of a built table, one item per line."""
+    s = summary_dict(ds, seconds, path)
+    v, d = s["velocities_m_s"], s["depths_m"]
+    estimate = math.nan if s["max_error_estimate"] is None else s["max_error_estimate"]
+    return "\n".join([
+        f"cases   {s['cases']} ({len(v)} velocities {v[0]:g}..{v[-1]:g} m/s x "
+        f"{len(d)} depths {d[0]:g}..{d[-1]:g} m, + first layer alone)",
+        f"failed  {s['failed']}",
+        f"largest FE error estimate {estimate:.3%}",
+        f"time    {seconds:.1f} s",
+        f"wrote   {path}",
+    ])

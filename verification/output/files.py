@@ -1,0 +1,49 @@
+"""Files every command writes: atomically (a temporary file, then ``os.replace``), so that a
+killed run never leaves a partial file: text, CSV columns of numbers, matplotlib figures."""
+
+import csv
+import io
+import os
+
+
+def write_text_atomic(path, text):
+    """Write ``text`` so that no reader (or a run resumed after ``kill -9``) sees a partial file.
+
+    The text goes to ``<path>.tmp``, is flushed and fsynced, then ``os.replace``-d onto ``path``.
+    """
+    tmp = os.fspath(path) + ".tmp"
+    with open(tmp, "w", encoding="utf-8", newline="") as handle:
+        handle.write(text)
+        handle.flush()
+        os.fsync(handle.fileno())
+    os.replace(tmp, path)
+
+
+def write_columns_csv(path, columns):
+    """``columns`` (name -> sequence) as CSV, atomically, every number through
+    :func:`~cavex.verification.output.number_format.format_number`; returns ``path``."""
+    from cavex.verification.output.number_format import format_number
+
+    text = io.StringIO(newline="")
+    writer = csv.writer(text)
+    writer.writerow(columns)
+    writer.writerows([format_number(x) for x in row]
+                     for row in zip(*columns.values(), strict=True))
+    write_text_atomic(path, text.getvalue())
+    return path
+
+
+def save_figure(fig, path, **savefig):
+    """Save a matplotlib figure atomically (a temporary file, then ``os.replace``: a killed run
+    never leaves a partial PNG) and close it; returns ``path``."""
+    import matplotlib.pyplot as plt
+
+    tmp = os.fspath(path) + f".{os.getpid()}.tmp.png"
+    try:
+        fig.savefig(tmp, **savefig)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        plt.close(fig)
+    return path

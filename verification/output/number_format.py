@@ -1,0 +1,141 @@
+"""How many significant digits the committed result files carry, and the one place that rounds.
+
+Regenerating ``results/`` on another CPU must not change a committed file. The numbers differ
+between CPUs in their last bits: numpy's SIMD ``exp``/``log``/``sin`` (AVX-512) and libm differ
+by an ulp, and the solvers amplify that (FE wall stresses about 1e-11 relative, FE error
+estimates about 1e-9, integrated trajectories about 1e-8 through the adaptive step
+selection). Every writer of a result file
+therefore writes a number with only the digits the numerics support, through this module:
+
+- text (CSV, JSON attributes): :func:`format_number` / :func:`round_nested`;
+- netCDF data variables: :func:`round_dataset`, which takes the digits of each variable from
+  :data:`VARIABLE_DIGITS` (``cavex.verification.fedata.table.write_table`` applies it to every FE
+  table and report grid it writes; a batch sweep's ``results.nc``, which holds wall times, is
+  written exactly; the report rounds its grid before analysing it, so that the relative
+  errors, validity codes and medians it prints are functions of the stored numbers).
+
+Digits per quantity (:data:`VARIABLE_DIGITS` maps variable names to them), one line of
+justification each:
+
+- trajectories and phase ends (integrator): 6. ``solve_ivp`` runs at ``rtol = 1e-9``, but its
+  adaptive step selection amplifies a last-bit change of the force into ~1e-8 of the
+  trajectory (measured: when the closed form's summation order changed, the soil stage of the
+  default run moved by 7e-9 relative); libm's CPU-dependent variants (FMA) make such changes
+  across CPUs. 6 digits leave two orders between that spread and the rounding unit.
+- FE wall stress ``sigma_r``, FE ``S``, FE plastic radius: 6. Newton tolerance 1e-8 and a
+  discretisation error of 1e-4..1e-3 (the error estimate); cross-CPU spread ~1e-11.
+- FE error estimate (Richardson): 3. A difference of two FE runs, good to a digit or two;
+  cross-CPU spread ~1e-9.
+- closed forms (analytic ``sigma_r``, plastic radius ``b``): 10. Scalar libm and Newton to
+  4e-16: a few ulps (~1e-15), 5 orders below the 10th digit.
+- the report's relative errors, error parts and closed-form ``S`` (``rel_err_*``, ``part_*``,
+  ``S_*``): kept as computed. The report computes them from the rounded values, so they are
+  the same on every CPU; rounding them again would part them from the percentages it prints.
+- other relative differences against FE (``relative_difference_*``): 6, the FE's digits.
+- any other float variable: 6 (unknown provenance, treated as FE output).
+
+Coordinates (velocity, depth) are inputs, not results, and are never rounded (the switch nodes
+sit 1e-9 m past the switch depths); integer, boolean and string variables are written as they
+are.
+
+Rounding goes through Python's float-to-decimal conversion (``format(x, ".{n}e")``), which is
+correctly rounded in software: no libm call, so it is the same on every CPU, and rounding a
+rounded number again returns it unchanged. A value lying on a rounding boundary (within the
+cross-CPU spread of it) can still round differently on another CPU; the digits above make that
+unlikely (about spread x 10**digits per value), not impossible.
+"""
+
+import fnmatch
+import numbers
+
+import numpy as np
+
+TRAJECTORY_DIGITS = 6
+FE_DIGITS = 6
+ESTIMATE_DIGITS = 3
+CLOSED_FORM_DIGITS = 10
+RELATIVE_DIGITS = FE_DIGITS
+DEFAULT_DIGITS = FE_DIGITS
+KEPT = None  # derived by the report from rounded values: written as computed
+
+# (variable-name pattern, significant digits or KEPT); the first matching pattern decides.
+# Names of the FE tables and report grids (cavex.verification.fedata.table, report_analysis) and of
+# the batch sweeps (cavex.verification.fedata.batch.VARIABLES).
+VARIABLE_DIGITS = (
+    ("error_estimate", ESTIMATE_DIGITS),
+    ("sigma_r_dynamic", CLOSED_FORM_DIGITS),
+    ("sigma_r_quasi_static", CLOSED_FORM_DIGITS),
+    ("sigma_r_paper", CLOSED_FORM_DIGITS),
+    ("analytic_*", CLOSED_FORM_DIGITS),
+    ("b_dynamic", CLOSED_FORM_DIGITS),
+    ("b_quasi_static", CLOSED_FORM_DIGITS),
+    ("sigma_r", FE_DIGITS),
+    ("fe_sigma_r", FE_DIGITS),
+    ("sigma_r_first_layer", FE_DIGITS),
+    ("S", FE_DIGITS),
+    ("plastic_radius", FE_DIGITS),
+    ("fe_plastic_radius", FE_DIGITS),
+    ("rel_err_*", KEPT),
+    ("part_*", KEPT),
+    ("S_*", KEPT),
+    ("relative_difference_*", RELATIVE_DIGITS),
+)
+
+
+def _round_scalar(x, digits):
+    return float(format(x, f".{digits - 1}e"))
+
+
+def round_significant(values, digits):
+    """``values`` rounded to ``digits`` significant decimal digits.
+
+    NaN, infinities and zeros (of either sign) are returned unchanged. A scalar gives a
+    ``float``, anything else an array of floats of the same shape.
+    """
+    if digits < 1:
+        raise ValueError(f"digits must be >= 1, got {digits}")
+    if np.ndim(values) == 0:
+        return _round_scalar(float(values), digits)
+    array = np.asarray(values, dtype=float)
+    flat = [_round_scalar(x, digits) for x in array.ravel().tolist()]
+    return np.array(flat, dtype=float).reshape(array.shape)
+
+
+def format_number(value, digits=TRAJECTORY_DIGITS):
+    """Text of one value for a CSV cell: floats with ``digits`` significant digits (``%g``
+    style), integers, booleans and strings as they are."""
+    if isinstance(value, (str, bool, np.bool_, numbers.Integral)):
+        return str(value)
+    if isinstance(value, numbers.Real):
+        return format(float(value), f".{digits}g")
+    return str(value)
+
+
+def round_nested(value, digits=TRAJECTORY_DIGITS):
+    """Every float in nested dicts, lists and tuples rounded (for JSON attributes)."""
+    if isinstance(value, dict):
+        return {k: round_nested(v, digits) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [round_nested(v, digits) for v in value]
+    if isinstance(value, (float, np.floating)):
+        return round_significant(value, digits)
+    return value
+
+
+def variable_digits(name):
+    """Significant digits of the float variable ``name`` (see :data:`VARIABLE_DIGITS`), or
+    ``None``: written as computed."""
+    return next((digits for pattern, digits in VARIABLE_DIGITS
+                 if fnmatch.fnmatchcase(name, pattern)), DEFAULT_DIGITS)
+
+
+def round_dataset(ds):
+    """A copy of ``ds`` with every float data variable rounded to :func:`variable_digits`;
+    coordinates and non-float variables unchanged, attributes kept."""
+    out = ds.copy()
+    for name, variable in ds.data_vars.items():
+        digits = variable_digits(str(name))
+        if variable.dtype.kind == "f" and digits is not KEPT:
+            rounded = round_significant(variable.values, digits)
+            out[name] = variable.copy(data=rounded.astype(variable.dtype))
+    return out

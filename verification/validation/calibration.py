@@ -1,0 +1,339 @@
+r"""Fitting a model's free material parameters to measured depths, and calibration files.
+
+``fit`` minimises ``sum_i ln(predicted_i / measured_i)^2`` over the shots by
+:func:`scipy.optimize.least_squares` (trust-region reflective, bounds of
+:data:`cavex.verification.validation.concrete.BOUNDS`) in the variables ``lam``, ``ln
+strength_factor``,
+``ln modulus_factor`` (the factors are scales: their logarithms make the problem better
+conditioned); the other parameters keep the starting mapping's values (default: the sources'
+mapping, :class:`cavex.verification.validation.concrete.Mapping`). The Jacobian is by forward
+differences: a step of 1e-6 for the closed forms (the integrator's ``rtol`` is 1e-9) and 2e-2
+for the FE table (its wall stresses carry a discretisation error of about 1e-3, so a smaller
+step would difference noise).
+
+A calibration file (``cavex calibrate --out CAL.toml``) is a cavex configuration: its
+``[projectile]`` and ``[[layers]]`` are the calibrated target of a reference shot (the first
+fitted one), so ``cavex penetrate --config CAL.toml`` (and every command that takes
+``--config``) runs it; its ``[calibration]`` table holds the model, the fitted parameters
+(6 significant digits, the values every later prediction uses), the fitted shot ids and the fit
+statistics, and is what ``cavex validate --calibration CAL.toml`` reads.
+"""
+
+import math
+import shlex
+import sys
+import time
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from cavex.errors import CavexInputError, CavexNumericalError, check_keys, require
+from cavex.verification.output.number_format import round_significant
+from cavex.verification.validation.concrete import BOUNDS, FREE_PARAMETERS, Mapping, shot_target
+from cavex.verification.validation.predict import FE_MODEL, MODEL_OPTIONS, TableCache, predict
+from cavex.verification.validation.shots import read_shots, shot_projectile
+
+PARAMETER_DIGITS = 6
+DEFAULT_PARAMETERS = ("lam", "strength_factor")
+LOG_PARAMETERS = ("strength_factor", "modulus_factor")
+DIFF_STEP = {"closed form": 1e-6, FE_MODEL: 2e-2}
+TOLERANCE = {"closed form": 1e-12, FE_MODEL: 1e-3}  # FE: its depths carry ~1e-3 noise
+CALIBRATION_KEYS = {"model", "params", "lam", "strength_factor", "modulus_factor", "nu",
+                    "shots", "shots_file", "reference_shot", "n", "mean_abs_log_ratio",
+                    "rms_log_ratio", "evaluations"}
+CALIBRATION_REQUIRED = {"model", "params", "lam", "strength_factor", "modulus_factor", "nu",
+                        "shots"}
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """A fitted model: its command-line name, mapping, fitted parameter names and shot ids."""
+
+    option: str
+    mapping: Mapping
+    params: tuple
+    shots: tuple
+    source: str = ""
+    statistics: tuple = ()
+
+    @property
+    def model(self):
+        return MODEL_OPTIONS[self.option]
+
+    @property
+    def column(self):
+        return f"{self.model} calibrated"
+
+    def describe(self):
+        return {"column": self.column, "model": self.model, "file": self.source,
+                "params": list(self.params), "mapping": self.mapping.as_dict(),
+                "shots": list(self.shots), **dict(self.statistics)}
+
+
+def check_parameters(params):
+    """The free parameter names: known, not repeated, at least one."""
+    params = tuple(params or DEFAULT_PARAMETERS)
+    for name in params:
+        if name not in FREE_PARAMETERS:
+            raise CavexInputError(f"unknown calibration parameter '{name}' (accepted: "
+                                  f"{', '.join(FREE_PARAMETERS)})")
+    require(len(set(params)) == len(params), "params", "names without repeats", list(params))
+    return params
+
+
+def check_option(option):
+    if option not in MODEL_OPTIONS:
+        raise CavexInputError(f"parameter 'model' must be one of {', '.join(MODEL_OPTIONS)} "
+                              f"(got {option!r})")
+    return option
+
+
+def _to_variables(mapping, params):
+    return np.array([math.log(getattr(mapping, p)) if p in LOG_PARAMETERS
+                     else getattr(mapping, p) for p in params])
+
+
+def _to_values(x, params):
+    return [math.exp(v) if p in LOG_PARAMETERS else v for p, v in zip(params, x, strict=True)]
+
+
+def _bounds(params):
+    lower = [math.log(BOUNDS[p][0]) if p in LOG_PARAMETERS else BOUNDS[p][0] for p in params]
+    upper = [math.log(BOUNDS[p][1]) if p in LOG_PARAMETERS else BOUNDS[p][1] for p in params]
+    return lower, upper
+
+
+def log_ratios(shots, model, mapping, tables=None):
+    """``ln(predicted / measured)`` per shot for ``model`` (a :data:`MODELS` name)."""
+    return np.array([math.log(predict(s, model, mapping, tables) / s.depth) for s in shots])
+
+
+def fit(shots, option="derived-dynamic", params=None, start=None, tables=None,
+        progress=False):
+    """Least-squares fit of ``params`` of the mapping for model ``option`` to ``shots``.
+
+    Parameters
+    ----------
+    shots : sequence of Shot
+    option : str
+        A key of :data:`cavex.verification.validation.predict.MODEL_OPTIONS`.
+    params : sequence of str, optional
+        Free parameters (default ``lam``, ``strength_factor``).
+    start : Mapping, optional
+        Starting point and the fixed parameters (default :class:`Mapping`).
+    tables : TableCache, optional
+        FE tables (``fe-table`` only; default an in-memory cache).
+    progress : bool
+        One line per evaluation on stderr.
+
+    Returns
+    -------
+    Calibration
+        Fitted parameters rounded to :data:`PARAMETER_DIGITS` significant digits; statistics
+        (``n``, ``mean_abs_log_ratio``, ``rms_log_ratio``, ``evaluations``) at the rounded
+        parameters.
+    """
+    option, params = check_option(option), check_parameters(params)
+    require(len(shots) >= len(params), "shots",
+            f"at least as many shots as free parameters ({len(params)})", len(shots))
+    model = MODEL_OPTIONS[option]
+    start = start or Mapping()
+    kind = FE_MODEL if model == FE_MODEL else "closed form"
+    tables = tables or TableCache(progress=False)
+    tables.velocities_for(shots)
+    count = [0]
+    began = time.monotonic()
+
+    def residuals(x):
+        mapping = start.with_values(params, _to_values(x, params))
+        r = log_ratios(shots, model, mapping, tables)
+        count[0] += 1
+        if progress:
+            values = ", ".join(f"{p} = {v:.6g}" for p, v in zip(params, _to_values(x, params),
+                                                               strict=True))
+            print(f"cavex: calibrate {option} evaluation {count[0]}: {values}: mean |ln ratio| "
+                  f"{np.abs(r).mean():.4f} ({time.monotonic() - began:.0f} s)", file=sys.stderr,
+                  flush=True)
+        return r
+
+    lower, upper = _bounds(params)
+    x0 = np.clip(_to_variables(start, params), lower, upper)
+    jacobian = _ForwardDifferences(residuals, DIFF_STEP[kind], upper)
+    tol = TOLERANCE[kind]
+    try:
+        solution = least_squares(jacobian.residuals, x0, jac=jacobian, bounds=(lower, upper),
+                                 method="trf", xtol=tol, ftol=tol, gtol=tol)
+    except CavexInputError as exc:
+        raise CavexNumericalError(f"calibration of {option} left the models' range: {exc}") \
+            from None
+    values = [round_significant(v, PARAMETER_DIGITS) for v in _to_values(solution.x, params)]
+    mapping = start.with_values(params, values)
+    r = log_ratios(shots, model, mapping, tables)
+    statistics = (("n", len(shots)),
+                  ("mean_abs_log_ratio", round_significant(float(np.abs(r).mean()), 6)),
+                  ("rms_log_ratio", round_significant(float(np.sqrt((r ** 2).mean())), 6)),
+                  ("evaluations", count[0]))
+    return Calibration(option, mapping, params, tuple(s.id for s in shots),
+                       statistics=statistics)
+
+
+class _ForwardDifferences:
+    """Forward-difference Jacobian with an absolute step ``h`` in every variable (backward at
+    the upper bound), reusing the residuals ``least_squares`` has just evaluated at ``x``.
+
+    (``least_squares``' own ``diff_step`` is relative to ``|x|`` and falls back to ~1e-8 at
+    ``x = 0``, i.e. at a factor of 1: far too small for the FE table's noise.)
+    """
+
+    def __init__(self, function, h, upper):
+        self.function, self.h, self.upper = function, h, np.asarray(upper)
+        self._last = None
+
+    def residuals(self, x):
+        r = self.function(x)
+        self._last = (np.array(x, dtype=float), r)
+        return r
+
+    def __call__(self, x, *args):
+        x = np.asarray(x, dtype=float)
+        r0 = self._last[1] if self._last is not None and np.array_equal(self._last[0], x) \
+            else self.function(x)
+        columns = []
+        for j in range(x.size):
+            step = self.h if x[j] + self.h <= self.upper[j] else -self.h
+            shifted = x.copy()
+            shifted[j] += step
+            columns.append((self.function(shifted) - r0) / step)
+        return np.column_stack(columns)
+
+
+# --- files ------------------------------------------------------------------------------------
+
+def calibration_text(calibration, shots_file, reference, command=None):
+    """The TOML text of a calibration file (see the module docstring)."""
+    from cavex.config import config_text
+
+    stats = dict(calibration.statistics)
+    m = calibration.mapping
+    lines = ["# cavex calibration, written by `cavex calibrate`.",
+             *([f"# command: {command}"] if command else []),
+             f"# [projectile] and [[layers]]: the calibrated target of shot '{reference.id}', so",
+             "# `cavex penetrate --config THIS_FILE` runs it (derived-quasi-static: add",
+             "# --boundary quasi-static; paper: --model paper). `cavex validate --calibration",
+             "# THIS_FILE` reads [calibration] and applies its mapping to every shot.",
+             "", "[calibration]",
+             f"model = {_toml_string(calibration.option)}",
+             f"params = [{', '.join(_toml_string(p) for p in calibration.params)}]",
+             *(f"{name} = {getattr(m, name)!r}" for name in ("lam", "strength_factor",
+                                                              "modulus_factor", "nu")),
+             f"shots_file = {_toml_string(str(shots_file))}",
+             f"shots = [{', '.join(_toml_string(i) for i in calibration.shots)}]",
+             f"reference_shot = {_toml_string(reference.id)}",
+             *(f"{k} = {v!r}" for k, v in stats.items()), "", ""]
+    target, projectile = shot_target(reference, m), shot_projectile(reference)
+    return "\n".join(lines) + config_text(target, projectile)
+
+
+def _toml_string(text):
+    import json
+
+    return json.dumps(str(text))
+
+
+def read_calibration(path):
+    """A :class:`Calibration` from a calibration file; a bad file is a one-line input error."""
+    from cavex.config import parse_config
+
+    try:
+        with open(path, encoding="utf-8") as handle:
+            data = tomllib.loads(handle.read())
+    except OSError as exc:
+        raise CavexInputError(f"calibration '{path}' cannot be read: {exc.strerror}") from None
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise CavexInputError(f"calibration '{path}' is not valid TOML: {exc}") from None
+    try:
+        parse_config(data)
+        table = data.get("calibration")
+        if not isinstance(table, dict):
+            raise CavexInputError("missing table [calibration] (write it with `cavex "
+                                  "calibrate`)")
+        check_keys(table, CALIBRATION_KEYS, "calibration.", required=CALIBRATION_REQUIRED)
+        option = check_option(table["model"])
+        require(isinstance(table["params"], list) and all(isinstance(p, str)
+                                                          for p in table["params"]),
+                "calibration.params", "an array of names", table["params"])
+        params = check_parameters(table["params"])
+        mapping = Mapping(**{k: table[k] for k in ("lam", "strength_factor", "modulus_factor",
+                                                   "nu")})
+        shots = table["shots"]
+        require(isinstance(shots, list) and shots and all(isinstance(s, str) for s in shots),
+                "calibration.shots", "a non-empty array of shot ids", shots)
+    except CavexInputError as exc:
+        raise CavexInputError(f"calibration '{path}': {exc}") from None
+    statistics = tuple((k, table[k]) for k in ("n", "mean_abs_log_ratio", "rms_log_ratio",
+                                               "evaluations") if k in table)
+    return Calibration(option, mapping, params, tuple(shots), source=str(path),
+                       statistics=statistics)
+
+
+# --- command-line job -------------------------------------------------------------------------
+
+def calibrate_main(shots_path, out_path, params=None, option="derived-dynamic", ids=None,
+                   workers=None, scheduler=None, progress=None, command=None, as_json=False):
+    """The ``cavex calibrate`` job: read and check everything, fit, write ``out_path``.
+
+    Returns the summary text (``as_json``: :func:`summary_dict` as JSON). Nothing is written
+    when an input is refused or the fit fails.
+    """
+    from cavex.verification.fedata.runner import check_execution, show_progress
+    from cavex.verification.output.files import write_text_atomic
+    from cavex.verification.output.paths import check_output_file
+
+    shot_file = read_shots(shots_path)
+    shots = shot_file.by_id(ids) if ids else shot_file.shots
+    option, params = check_option(option), check_parameters(params)
+    out = check_output_file(out_path, "out")
+    check_execution(workers, scheduler)
+    require(out.suffix == ".toml", "out", "a path ending in .toml", str(out_path))
+    show = show_progress(progress)
+    tables = TableCache(workers=workers, scheduler=scheduler, progress=show)
+    began = time.monotonic()
+    calibration = fit(shots, option, params, tables=tables, progress=show)
+    seconds = time.monotonic() - began
+    if command is None:
+        words = ["cavex", "calibrate", "--shots", str(shots_path), "--out", str(out_path),
+                 "--model", option, "--params", *params, *(["--ids", *ids] if ids else [])]
+        command = " ".join(shlex.quote(w) for w in words)
+    text = calibration_text(calibration, shots_path, shots[0], command)
+    if out.parent != Path(""):
+        out.parent.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(out, text)
+    summary = summary_dict(calibration, seconds, out)
+    if as_json:
+        import json
+
+        return json.dumps(summary, indent=2)
+    values = ", ".join(f"{p} = {v:.6g}" for p, v in summary["fitted"].items())
+    return "\n".join([
+        f"model   {option} ({calibration.model}), {len(shots)} shots: "
+        f"{', '.join(calibration.shots)}",
+        f"fitted  {values}",
+        f"fit     mean |ln(predicted/measured)| {summary['mean_abs_log_ratio']:.4f}, rms "
+        f"{summary['rms_log_ratio']:.4f}, {summary['evaluations']} evaluations, "
+        f"{seconds:.1f} s",
+        f"wrote   {out}",
+    ])
+
+
+def summary_dict(calibration, seconds, out):
+    """What ``cavex calibrate --json`` prints: the model, the fitted parameters (all
+    dimensionless), the mapping, the shots fitted, the fit statistics, the wall time and the
+    file written."""
+    return {"model": calibration.option, "params": list(calibration.params),
+            "fitted": {p: getattr(calibration.mapping, p) for p in calibration.params},
+            "mapping": calibration.mapping.as_dict(), "shots": list(calibration.shots),
+            **dict(calibration.statistics), "wall_time_s": float(seconds),
+            "output": str(out)}

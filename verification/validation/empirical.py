@@ -1,0 +1,96 @@
+r"""The empirical penetration model of Forrestal, Altman, Cargile and Hanchak (1994).
+
+Forrestal, M.J., Altman, B.S., Cargile, J.D., Hanchak, S.J. (1994), "An empirical equation for
+penetration depth of ogive-nose projectiles into concrete targets", Int. J. Impact Eng. 15(4),
+395-405; in the dimensionless form of Li, Q.M., Chen, X.W. (2003), "Dimensionless formulae for
+penetration depth of concrete target impacted by a non-deformable projectile", Int. J. Impact
+Eng. 28, 93-116.
+
+A rigid projectile of mass ``m``, shank radius ``a = d/2`` and a tangent-ogive nose of
+calibre-radius-head ``psi`` strikes a semi-infinite concrete target (strength ``f_c``, density
+``rho``) normally at ``V_s``. The axial force is
+
+- crater, ``0 <= z <= k d`` (``k = 2``: two calibres, ``4a``): ``F = c z``;
+- tunnel, ``z > k d``: ``F = pi a^2 (S f_c + N* rho V^2)``, the normal stress
+  ``sigma_n = S f_c + rho V_n^2`` integrated over the ogive, ``N* = (8 psi - 1)/(24 psi^2)``;
+
+with the empirical strength factor ``S = 82.6 f_c^-0.544`` (``f_c`` in MPa; Forrestal et al.
+fitted it to their shots). ``c`` and the velocity ``V_1`` at ``z = k d`` follow from continuity
+of the force, ``c k d = pi a^2 (S f_c + N* rho V_1^2)``, and energy,
+``m (V_s^2 - V_1^2) = c (k d)^2``:
+
+.. math:: V_1^2 = \frac{m V_s^2 - k d\, \pi a^2 S f_c}{m + k d\, \pi a^2 N^* \rho},\qquad
+          P = \frac{m}{2\pi a^2 \rho N^*}\ln\Big(1 + \frac{N^*\rho V_1^2}{S f_c}\Big) + k d .
+
+With ``I = m V_s^2 / (S f_c d^3)`` (impact function) and ``N = m / (N* rho d^3)`` (geometry
+function) this is Li and Chen's (2003) Eq. for ``X/d > k``,
+``X/d = (2N/pi) ln[(1 + I/N)/(1 + k pi/(4N))] + k``, and a projectile that stops inside the
+crater (``V_1^2 <= 0``) reaches ``X/d = sqrt(I (4k/pi)(1 + k pi/(4N))/(1 + I/N))`` (the same
+``c``, continuous at ``X = k d``). Li and Chen's worked example (their Table, Forrestal's shot
+of 0.906 kg, 26.9 mm, CRH 2, 277 m/s into 35.2 MPa, 2370 kg/m^3 concrete) prints
+``X/d = 6.21`` with ``S = 12``; ``tests/test_validation.py`` reproduces it.
+"""
+
+import math
+
+from cavex.errors import require
+
+S_COEFFICIENT = 82.6  # S = 82.6 f_c^-0.544, f_c in MPa (Forrestal et al. 1994)
+S_EXPONENT = -0.544
+CRATER_CALIBRES = 2.0  # crater depth k d with k = 2 (4 shank radii), Forrestal et al. 1994
+
+
+def strength_factor(fc):
+    """Forrestal et al.'s empirical ``S = 82.6 f_c^-0.544`` for ``fc`` in Pa (fitted in MPa)."""
+    require(math.isfinite(fc) and fc > 0.0, "fc", "a finite number > 0 (Pa)", fc)
+    return S_COEFFICIENT * (fc / 1e6) ** S_EXPONENT
+
+
+def ogive_factor(crh):
+    """Nose factor ``N* = (8 psi - 1)/(24 psi^2)`` of a tangent ogive, ``psi`` = CRH."""
+    require(math.isfinite(crh) and crh >= 0.5, "crh", "a finite number >= 0.5", crh)
+    return (8.0 * crh - 1.0) / (24.0 * crh ** 2)
+
+
+def li_chen_functions(mass, diameter, crh, velocity, fc, rho, S=None):
+    """Li and Chen's impact function ``I`` and geometry function ``N`` (dimensionless)."""
+    S = strength_factor(fc) if S is None else S
+    I = mass * velocity ** 2 / (S * fc * diameter ** 3)  # noqa: E741 (Li and Chen's name)
+    N = mass / (ogive_factor(crh) * rho * diameter ** 3)
+    return I, N
+
+
+def penetration_calibres(mass, diameter, crh, velocity, fc, rho, *, S=None,
+                         crater_calibres=CRATER_CALIBRES):
+    """Depth over diameter ``X/d`` (Li and Chen's dimensionless form of Forrestal et al. 1994).
+
+    Parameters
+    ----------
+    mass, diameter, crh, velocity, fc, rho : float
+        kg, m, 1, m/s, Pa, kg/m^3.
+    S : float, optional
+        Strength factor; default :func:`strength_factor` of ``fc``.
+    crater_calibres : float
+        Crater depth ``k`` in calibres (Forrestal et al.: 2).
+    """
+    for name, value in (("mass", mass), ("diameter", diameter), ("velocity", velocity),
+                        ("rho", rho), ("crater_calibres", crater_calibres)):
+        require(math.isfinite(value) and value > 0.0, name, "a finite number > 0", value)
+    I, N = li_chen_functions(mass, diameter, crh, velocity, fc, rho, S)  # noqa: E741
+    k = crater_calibres
+    crater = 1.0 + k * math.pi / (4.0 * N)
+    if I / N <= crater - 1.0:  # V_1^2 <= 0: stops inside the crater
+        return math.sqrt(I * (4.0 * k / math.pi) * crater / (1.0 + I / N))
+    return 2.0 * N / math.pi * math.log((1.0 + I / N) / crater) + k
+
+
+def forrestal_depth(mass, diameter, crh, velocity, fc, rho, *, S=None,
+                    crater_calibres=CRATER_CALIBRES):
+    """Penetration depth (m) of Forrestal et al. (1994); see :func:`penetration_calibres`."""
+    return diameter * penetration_calibres(mass, diameter, crh, velocity, fc, rho, S=S,
+                                           crater_calibres=crater_calibres)
+
+
+def shot_depth(shot, S=None):
+    """Forrestal et al.'s depth (m) for a :class:`~cavex.verification.validation.shots.Shot`."""
+    return forrestal_depth(shot.mass, shot.diameter, shot.crh, shot.V0, shot.fc, shot.rho, S=S)

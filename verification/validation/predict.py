@@ -1,0 +1,277 @@
+"""Predicted against measured penetration depth: every resistance cavex has, and Forrestal's.
+
+For each shot (:mod:`cavex.verification.validation.shots`) the target is one semi-infinite concrete
+layer from the shot's ``(f_c, rho)`` (:mod:`cavex.verification.validation.concrete`) and the
+projectile the shot's (:func:`~cavex.verification.validation.shots.shot_projectile`). The models
+(:data:`MODELS`):
+
+- ``derived quasi-static``, ``derived dynamic``, ``paper``: the closed forms
+  (:class:`cavex.analytic.penetration.resistance.ClosedFormResistance`), incompressible;
+- ``FE table``: the FE-tabulated resistance
+  (:class:`cavex.analytic.penetration.tabulated.TabulatedResistance`) of a table built by
+  :func:`cavex.verification.fedata.table.build_table` for the shot's target with the mapping's
+  Poisson's ratio (0.2): compressible, finite strain, which no closed form gives;
+- ``Forrestal 1994``: the empirical model (:mod:`cavex.verification.validation.empirical`).
+
+cavex's models run the penetration integrator
+(:func:`cavex.analytic.penetration.integrator.penetrate`,
+crater of ``4.5 r`` from the nose base, as ``cavex penetrate``); the predicted depth is the nose
+tip's final depth. A projectile that the crater stage would stop (``m V0^2 <= L_c F(0)``, which
+the integrator refuses) reaches ``sqrt(m V0^2 L_c / F(0))``: the crater's ``K L`` force with
+``K L_c = F(0)``, continuous with the integrator's depth at the threshold.
+
+A calibrated model (:mod:`cavex.verification.validation.calibration`) is one of cavex's models with
+the fitted mapping parameters, named ``"<model> calibrated"``.
+"""
+
+import hashlib
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from cavex.analytic.penetration.integrator import crater_depth, penetrate
+from cavex.analytic.penetration.nose import nose_rule
+from cavex.analytic.penetration.resistance import ClosedFormResistance
+from cavex.errors import CavexInputError, CavexNumericalError, require_choice
+from cavex.verification.output.number_format import FE_DIGITS, round_dataset, round_significant
+from cavex.verification.validation import empirical
+from cavex.verification.validation.concrete import Mapping, shot_target
+from cavex.verification.validation.shots import shot_projectile
+
+CLOSED_FORMS = {"derived quasi-static": ("derived", "quasi-static"),
+                "derived dynamic": ("derived", "dynamic"),
+                "paper": ("paper", "quasi-static")}
+FE_MODEL = "FE table"
+EMPIRICAL = "Forrestal 1994"
+CAVEX_MODELS = (*CLOSED_FORMS, FE_MODEL)
+MODELS = (*CAVEX_MODELS, EMPIRICAL)
+# command-line names of the models a calibration can fit
+MODEL_OPTIONS = {"derived-quasi-static": "derived quasi-static",
+                 "derived-dynamic": "derived dynamic", "paper": "paper", "fe-table": FE_MODEL}
+DEPTH_DIGITS = FE_DIGITS  # predicted depths and statistics in the result files
+TABLE_VELOCITY_STEP = 50.0  # m/s between FE table velocities (interpolated by PCHIP in V^2)
+TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on depth
+
+
+# --- one prediction ---------------------------------------------------------------------------
+
+def penetration_depth(target, projectile, resistance):
+    """Final nose-tip depth (m) of the integrator, or the crater-stage stop (module docstring)."""
+    crater = crater_depth(projectile)
+    energy = projectile.m * projectile.V0 ** 2
+    static = resistance.crater_force(0.0)
+    if energy <= crater * static:
+        return math.sqrt(energy * crater / static)
+    return float(penetrate(target, projectile, resistance).depth[-1])
+
+
+def closed_form_depth(shot, model, mapping=None):
+    """Depth (m) of a closed-form model for ``shot`` under ``mapping``."""
+    require_choice(model, tuple(CLOSED_FORMS), "model")
+    target, projectile = shot_target(shot, mapping), shot_projectile(shot)
+    kind, boundary = CLOSED_FORMS[model]
+    return penetration_depth(target, projectile,
+                             ClosedFormResistance(target, projectile, kind, boundary))
+
+
+def table_depth(shot, table, mapping=None):
+    """Depth (m) with the FE-tabulated resistance of ``table`` (built for the shot's target)."""
+    from cavex.analytic.penetration.tabulated import TabulatedResistance
+
+    target, projectile = shot_target(shot, mapping), shot_projectile(shot)
+    return penetration_depth(target, projectile, TabulatedResistance(table, target, projectile))
+
+
+def predict(shot, model, mapping=None, tables=None):
+    """Predicted depth (m) of ``model`` (one of :data:`MODELS`) for ``shot``.
+
+    ``tables`` (a :class:`TableCache`) gives the FE tables of the ``FE table`` model.
+    """
+    require_choice(model, MODELS, "model")
+    if model == EMPIRICAL:
+        return empirical.shot_depth(shot)
+    if model == FE_MODEL:
+        tables = tables or TableCache()
+        return table_depth(shot, tables.table(shot, mapping), mapping)
+    return closed_form_depth(shot, model, mapping)
+
+
+# --- FE tables --------------------------------------------------------------------------------
+
+def table_velocities(shots, step=TABLE_VELOCITY_STEP):
+    """Velocity grid ``0, step, ...`` reaching the largest ``V0 cos(phi_1)`` any of ``shots``'
+    noses sees (the table's upper end must cover it; nothing is extrapolated)."""
+    top = max(shot.V0 * float(nose_rule(shot_projectile(shot))[0].max()) for shot in shots)
+    count = max(2, math.ceil(top / step * (1.0 + 1e-12)) + 1)
+    return tuple(step * i for i in range(count))
+
+
+class TableCache:
+    """FE tables of one-layer targets, built once per distinct target and reused.
+
+    Parameters
+    ----------
+    directory : str or Path, optional
+        Tables are written there (``table_<key>.nc``, rounded as ``write_table`` stores them)
+        and read back on a later run with the same target, grid and FE settings.
+    numerics : dict, optional
+        FE settings (:class:`cavex.fem.Numerics`); default the solver's.
+    workers, scheduler : passed to :func:`cavex.verification.fedata.table.build_table`.
+    progress : bool, optional
+        A line on stderr per table built.
+    """
+
+    def __init__(self, directory=None, numerics=None, workers=None, scheduler=None,
+                 progress=False):
+        self.directory = None if directory is None else Path(directory)
+        self.numerics, self.workers, self.scheduler = numerics, workers, scheduler
+        self.progress = progress
+        self._tables = {}
+        self._velocities = None
+        self.built = 0
+        self.reused = 0
+
+    def velocities_for(self, shots):
+        """Set the velocity grid to cover ``shots`` (call before :meth:`table`)."""
+        self._velocities = table_velocities(shots)
+
+    def key(self, target, projectile, velocities):
+        from cavex.config import fingerprint
+        from cavex.verification.fedata.table import settings_json
+
+        text = json.dumps([fingerprint(target, projectile), list(velocities), list(TABLE_DEPTHS),
+                           settings_json(None, self.numerics)])
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+    def table(self, shot, mapping=None):
+        """The FE table of ``shot``'s target (velocities: :meth:`velocities_for`, else the
+        shot's own)."""
+        from cavex.analytic.penetration.tabulated import load_table
+        from cavex.verification.fedata.table import build_table, write_table
+
+        target, projectile = shot_target(shot, mapping), shot_projectile(shot)
+        velocities = self._velocities or table_velocities([shot])
+        key = self.key(target, projectile, velocities)
+        if key in self._tables:
+            return self._tables[key]
+        path = None if self.directory is None else self.directory / f"table_{key}.nc"
+        if path is not None and path.exists():
+            table = load_table(path)
+            self.reused += 1
+        else:
+            if self.progress:
+                print(f"cavex: FE table for f_c = {shot.fc / 1e6:.4g} MPa, rho = {shot.rho:g} "
+                      f"kg/m^3 ({len(velocities)} velocities)", file=sys.stderr, flush=True)
+            table = build_table(target, projectile, velocities, TABLE_DEPTHS,
+                                numerics=self.numerics, workers=self.workers,
+                                scheduler=self.scheduler, progress=False)
+            self.built += 1
+            if path is None:
+                table = round_dataset(table)
+            else:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                write_table(table, path)
+                table = load_table(path)
+            failed = int(table["failed"].sum()) + int(table["failed_first_layer"].sum())
+            if failed:
+                raise CavexNumericalError(f"{failed} FE cell(s) failed building the table for "
+                                          f"shot '{shot.id}': {table.attrs['failures'][:300]}")
+        self._tables[key] = table
+        return table
+
+
+# --- many shots -------------------------------------------------------------------------------
+
+def predictions(shots, models, tables=None, progress=None):
+    """``{model: [depth or None]}`` and ``{model: {shot id: reason}}`` for the failures.
+
+    ``models`` maps a column name to ``(model, mapping)`` (``mapping`` None: default).
+    """
+    from cavex.verification.fedata.runner import Progress, show_progress
+
+    tables = tables or TableCache()
+    depths = {name: [] for name in models}
+    failures = {}
+    bar = Progress(len(shots) * len(models), 0, show_progress(progress), unit="prediction")
+    for name, (model, mapping) in models.items():
+        for shot in shots:
+            try:
+                value = round_significant(predict(shot, model, mapping, tables), DEPTH_DIGITS)
+            except (CavexInputError, CavexNumericalError) as exc:
+                value = None
+                failures.setdefault(name, {})[shot.id] = str(exc).splitlines()[0]
+            depths[name].append(value)
+            bar.update()
+    bar.close()
+    return depths, failures
+
+
+def ratio_statistics(ratios):
+    """``n``, mean and sample standard deviation of ``ratios`` and their mean ``|ln ratio|``
+    (None where undefined), rounded to :data:`DEPTH_DIGITS` significant digits."""
+    r = np.array([x for x in ratios if x is not None], dtype=float)
+    n = int(r.size)
+
+    def rounded(value):
+        return None if not math.isfinite(value) else round_significant(float(value),
+                                                                       DEPTH_DIGITS)
+
+    return {"n": n,
+            "mean_ratio": rounded(r.mean()) if n else None,
+            "std_ratio": rounded(r.std(ddof=1)) if n > 1 else None,
+            "mean_abs_log_ratio": rounded(np.abs(np.log(r)).mean()) if n else None}
+
+
+def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None):
+    """Per-shot predictions of every model and their statistics.
+
+    Parameters
+    ----------
+    shots : sequence of Shot
+    calibrations : sequence of Calibration
+        Each adds the column ``"<model> calibrated"`` (its model with its fitted mapping).
+    tables : TableCache, optional
+    mapping : Mapping, optional
+        The uncalibrated mapping (default :class:`~cavex.verification.validation.concrete.Mapping`).
+
+    Returns
+    -------
+    dict
+        ``shots`` (``id``, ``V0_m_s``, ``fc_Pa``, ``rho_kg_m3``, ``measured_m``,
+        ``predicted_m`` and ``ratio`` per model), ``summary`` (per model, all shots),
+        ``held_out`` (ids in no calibration's fit) and ``held_out_summary`` (with
+        calibrations), ``failures``, ``models``, ``calibrations``.
+    """
+    mapping = mapping or Mapping()
+    columns = {name: (name, mapping) for name in MODELS}
+    for calibration in calibrations:
+        columns[calibration.column] = (calibration.model, calibration.mapping)
+    tables = tables or TableCache()
+    tables.velocities_for(shots)
+    depths, failures = predictions(shots, columns, tables, progress)
+    rows = []
+    for i, shot in enumerate(shots):
+        predicted = {name: depths[name][i] for name in columns}
+        ratio = {name: None if d is None else d / shot.depth for name, d in predicted.items()}
+        rows.append({"id": shot.id, "V0_m_s": shot.V0, "fc_Pa": shot.fc,
+                     "rho_kg_m3": shot.rho, "measured_m": shot.depth, "predicted_m": predicted,
+                     "ratio": ratio})
+    fitted = {i for c in calibrations for i in c.shots}
+    held_out = [row["id"] for row in rows if row["id"] not in fitted]
+    result = {"models": list(columns), "mapping": mapping.as_dict(),
+              "calibrations": [c.describe() for c in calibrations], "shots": rows,
+              "summary": summaries(rows, columns), "failures": failures}
+    if calibrations:
+        result["held_out"] = held_out
+        result["held_out_summary"] = summaries(
+            [row for row in rows if row["id"] in held_out], columns)
+    return result
+
+
+def summaries(rows, columns):
+    """:func:`ratio_statistics` per column over ``rows``."""
+    return {name: ratio_statistics([row["ratio"][name] for row in rows]) for name in columns}
+

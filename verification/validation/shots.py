@@ -1,0 +1,203 @@
+"""Shot files: published penetration tests of rigid ogive-nose projectiles into thick concrete.
+
+A shot file is CSV with a header row naming at least the columns :data:`REQUIRED_COLUMNS`
+(any order; ``length_m``, the projectile's overall length, may be absent or empty), SI units,
+lines starting with ``#`` are comments (the attribution of the data goes there) and blank lines
+are skipped. Extra columns are kept, as text, in :attr:`Shot.extra`.
+
+Every value is checked before anything is computed; a bad value is a one-line
+:class:`~cavex.errors.CavexInputError` naming the file, the line, the shot and the column, e.g.
+``shots file 'x.csv', line 12 (shot 'F94-45'), column 'fc_Pa': must be a compressive strength
+in Pa in [1e+06, 1e+09] (is it in MPa?) (got '35.4')``.
+
+From a shot to cavex's objects: :func:`shot_projectile` (the ``[projectile]`` table) here, the
+concrete in :mod:`cavex.verification.validation.concrete`.
+"""
+
+import csv
+import io
+import math
+from dataclasses import dataclass, field
+
+from cavex.errors import CavexInputError
+from cavex.materials import Projectile
+
+REQUIRED_COLUMNS = ("id", "mass_kg", "diameter_m", "crh", "V0_m_s", "fc_Pa", "rho_kg_m3",
+                    "depth_m")
+OPTIONAL_COLUMNS = ("length_m",)
+COLUMNS = ("id", "mass_kg", "diameter_m", "length_m", "crh", "V0_m_s", "fc_Pa", "rho_kg_m3",
+           "depth_m")
+# column -> (attribute, lower, upper, accepted range as said in a message)
+NUMBER_COLUMNS = {
+    "mass_kg": ("mass", 0.0, math.inf, "a finite number > 0"),
+    "diameter_m": ("diameter", 0.0, math.inf, "a finite number > 0"),
+    "length_m": ("length", 0.0, math.inf, "empty or a finite number > 0"),
+    # a tangent ogive needs R = crh d >= d/2 (crh 0.5 is a hemisphere)
+    "crh": ("crh", 0.5, math.inf, "a finite number >= 0.5 (ogive radius R = crh d >= d/2)"),
+    "V0_m_s": ("V0", 0.0, math.inf, "a finite number > 0"),
+    "fc_Pa": ("fc", 1e6, 1e9, "a compressive strength in Pa in [1e+06, 1e+09] (is it in MPa?)"),
+    "rho_kg_m3": ("rho", 1000.0, 4000.0,
+                  "a concrete density in kg/m^3 in [1000, 4000] (is it in g/cm^3?)"),
+    "depth_m": ("depth", 0.0, math.inf, "a finite number > 0"),
+}
+INCLUSIVE_LOWER = {"crh", "fc_Pa", "rho_kg_m3"}
+
+
+@dataclass(frozen=True)
+class Shot:
+    """One test: projectile, striking velocity, concrete and the measured depth (SI units).
+
+    Attributes
+    ----------
+    id : str
+    mass, diameter : float
+        Projectile mass (kg) and shank diameter (m).
+    length : float or None
+        Overall projectile length (m); not used by the rigid-projectile models.
+    crh : float
+        Calibre-radius-head ``R / d`` of the tangent ogive nose.
+    V0 : float
+        Striking velocity (m/s), normal incidence.
+    fc, rho : float
+        Unconfined compressive strength (Pa) and density (kg/m^3) of the concrete.
+    depth : float
+        Measured penetration depth of the nose tip (m).
+    extra : dict
+        Any further columns of the file, as text.
+    line : int
+        Line of the file the shot was read from (1-based).
+    """
+
+    id: str
+    mass: float
+    diameter: float
+    length: float | None
+    crh: float
+    V0: float
+    fc: float
+    rho: float
+    depth: float
+    extra: dict = field(default_factory=dict, compare=False)
+    line: int = field(default=0, compare=False)
+
+
+@dataclass(frozen=True)
+class ShotFile:
+    """The shots of a file, its comment lines (attribution) and its column names."""
+
+    path: str
+    shots: tuple
+    comments: tuple
+    columns: tuple
+
+    def by_id(self, ids):
+        """The shots with ``ids``, in the order given; an unknown id is an input error."""
+        known = {s.id: s for s in self.shots}
+        missing = [i for i in ids if i not in known]
+        if missing:
+            raise CavexInputError(f"shot id(s) {', '.join(map(repr, missing))} not in shots file "
+                                  f"'{self.path}' (it has {', '.join(known)})")
+        return tuple(known[i] for i in ids)
+
+
+def read_shots(path):
+    """Read and check a shot file; see the module docstring for the format.
+
+    Raises
+    ------
+    CavexInputError
+        Unreadable file, missing header or column, a row with the wrong number of cells, a
+        value out of range (the line, shot and column named), repeated ids, no shots.
+    """
+    try:
+        with open(path, encoding="utf-8", newline="") as handle:
+            text = handle.read()
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = getattr(exc, "strerror", None) or str(exc)
+        raise CavexInputError(f"shots file '{path}' cannot be read: {reason}") from None
+    return parse_shots(text, str(path))
+
+
+def parse_shots(text, path="<text>"):
+    """Shots from the text of a shot file (``path`` only names it in messages)."""
+    comments, rows = [], []
+    for number, line in enumerate(io.StringIO(text, newline=None), start=1):
+        stripped = line.strip()
+        if stripped.startswith("#"):
+            comments.append(stripped[1:].strip())
+        elif stripped:
+            rows.append((number, line))
+    if not rows:
+        raise CavexInputError(f"shots file '{path}' has no header row (and no shots)")
+    (header_line, header_text), data = rows[0], rows[1:]
+    header = [c.strip() for c in _cells(header_text)]
+    where = f"shots file '{path}', line {header_line} (header)"
+    for column in REQUIRED_COLUMNS:
+        if column not in header:
+            raise CavexInputError(f"{where}: missing column '{column}' (required: "
+                                  f"{', '.join(REQUIRED_COLUMNS)})")
+    repeated = sorted({c for c in header if header.count(c) > 1})
+    if repeated or "" in header:
+        raise CavexInputError(f"{where}: column names must be unique and non-empty "
+                              f"(got {header})")
+    if not data:
+        raise CavexInputError(f"shots file '{path}' has a header but no shots")
+    shots, seen = [], {}
+    for number, line in data:
+        shot = _parse_row(number, _cells(line), header, path)
+        if shot.id in seen:
+            raise CavexInputError(f"shots file '{path}', line {number}, column 'id': shot "
+                                  f"'{shot.id}' repeats line {seen[shot.id]}")
+        seen[shot.id] = number
+        shots.append(shot)
+    return ShotFile(path, tuple(shots), tuple(comments), tuple(header))
+
+
+def _cells(line):
+    return next(csv.reader([line]))
+
+
+def _parse_row(number, cells, header, path):
+    where = f"shots file '{path}', line {number}"
+    if len(cells) != len(header):
+        raise CavexInputError(f"{where}: has {len(cells)} cells, the header has {len(header)}")
+    row = {name: cell.strip() for name, cell in zip(header, cells, strict=True)}
+    shot_id = row["id"]
+    if not shot_id:
+        raise CavexInputError(f"{where}, column 'id': must be a non-empty shot name (got '')")
+    where = f"{where} (shot '{shot_id}')"
+    values = {}
+    for column, (attribute, lower, upper, accepted) in NUMBER_COLUMNS.items():
+        text = row.get(column, "")
+        if column in OPTIONAL_COLUMNS and text == "":
+            values[attribute] = None
+            continue
+        value = _number(text)
+        low_ok = value >= lower if column in INCLUSIVE_LOWER else value > lower
+        if not (math.isfinite(value) and low_ok and value <= upper):
+            raise CavexInputError(f"{where}, column '{column}': must be {accepted} "
+                                  f"(got {text!r})")
+        values[attribute] = value
+    extra = {k: v for k, v in row.items() if k not in COLUMNS}
+    return Shot(id=shot_id, extra=extra, line=number, **values)
+
+
+def _number(text):
+    try:
+        return float(text)
+    except ValueError:
+        return math.nan
+
+
+def nose_length(shot):
+    """Length of the tangent-ogive nose, ``r sqrt(4 crh - 1)`` (m), ``r = d/2``."""
+    return 0.5 * shot.diameter * math.sqrt(4.0 * shot.crh - 1.0)
+
+
+def shot_projectile(shot):
+    """cavex's projectile for a shot: ``r = d/2``, ``R = crh d``, ``l`` = the tangent ogive's
+    nose length (:func:`nose_length`; it places the cavity centre at the nose base), ``m``,
+    ``V0``. The overall length does not enter a rigid-projectile model."""
+    r = 0.5 * shot.diameter
+    return Projectile(r=r, l=nose_length(shot), m=shot.mass, V0=shot.V0,
+                      R=shot.crh * shot.diameter)
