@@ -7,6 +7,7 @@ import tomllib
 from importlib import resources
 
 from cavex.errors import CavexInputError, check_keys, prefixed, require
+from cavex.input_files import in_file, read_toml
 from cavex.materials import Material, Projectile, Target
 
 LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c"}
@@ -28,25 +29,12 @@ def load_config(path=None):
     Raises
     ------
     CavexInputError
-        Unreadable or malformed TOML, unknown or missing keys, wrong types or out-of-range values.
+        ``'<path>': <where> <what>`` (:mod:`cavex.input_files`): an unreadable, non-UTF-8 or
+        malformed file, unknown or missing keys, wrong types or out-of-range values.
     """
-    text = default_config_text() if path is None else _read(path)
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise CavexInputError(f"config '{path}' is not valid TOML: {exc}") from None
-    return parse_config(data)
-
-
-def _read(path):
-    try:
-        with open(path, encoding="utf-8") as handle:
-            return handle.read()
-    except OSError as exc:
-        raise CavexInputError(f"config '{path}' cannot be read: {exc.strerror}") from None
-    except UnicodeDecodeError as exc:
-        raise CavexInputError(f"config '{path}' is not UTF-8 text (byte {exc.start}: "
-                              f"{exc.reason})") from None
+    if path is None:
+        return parse_config(tomllib.loads(default_config_text()))
+    return in_file(path, parse_config, read_toml(path))
 
 
 def parse_config(data):
@@ -69,8 +57,8 @@ def parse_target(layers):
         required = {"E", "nu", "rho", "lam"} | (set() if last else {"thickness"})
         check_keys(table, LAYER_KEYS, where, required=required)
         if last and "thickness" in table:
-            raise CavexInputError(f"parameter '{where}thickness' must be absent: "
-                                  "the last layer is semi-infinite")
+            raise CavexInputError("must be absent (the last layer is semi-infinite)",
+                                  f"{where}thickness")
         numbers = {k: _number(table[k], where + k) for k in table if k != "name"}
         thickness = numbers.pop("thickness", None)
         materials.append(prefixed(Material, where, name=table.get("name", ""), **numbers))

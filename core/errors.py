@@ -1,11 +1,28 @@
 """Errors that cavex reports to its users, and the checks that raise them."""
 
 import math
-import re
 
 
 class CavexInputError(ValueError):
-    """Bad input: the message names the parameter and its accepted range, on one line."""
+    """Bad input: the message names the parameter and its accepted range, on one line.
+
+    Parameters
+    ----------
+    problem : str
+        What is wrong, e.g. ``"must be a finite number > 0 (got -1.0)"``; the whole message
+        when ``where`` is None.
+    where : str, optional
+        The parameter or key path it is wrong in, e.g. ``"layers[1].E"``. The message is then
+        ``parameter '<where>' <problem>``; :func:`prefixed` extends ``where``, and an input file
+        reader (:func:`cavex.input_files.in_file`) words it ``'<path>': <where> <problem>``.
+    """
+
+    #: the input file the message names (set by :func:`cavex.input_files.file_error`)
+    path = None
+
+    def __init__(self, problem, where=None):
+        super().__init__(problem if where is None else f"parameter '{where}' {problem}")
+        self.problem, self.where = problem, where
 
 
 class CavexNumericalError(RuntimeError):
@@ -27,7 +44,7 @@ def require(condition, parameter, accepted, value):
         The value that was given.
     """
     if not condition:
-        raise CavexInputError(f"parameter '{parameter}' must be {accepted} (got {value!r})")
+        raise CavexInputError(f"must be {accepted} (got {value!r})", parameter)
 
 
 def require_choice(value, choices, parameter):
@@ -42,17 +59,27 @@ def is_finite_number(value):
 
 
 def check_keys(table, allowed, where, required=()):
-    """Reject unknown keys and report the first missing required key of a TOML table.
+    """Refuse unknown keys of a TOML table (naming every one, and the accepted keys), then
+    missing required keys (naming every one).
 
-    ``where`` prefixes the key in the message, e.g. ``"layers[0]."``.
+    ``where`` prefixes the key path, e.g. ``"layers[0]."``; the error's ``where`` is the first
+    offending key, e.g. ``layers[0].Young is not a known key, nor is colour (accepted: ...)``.
     """
-    for key in table:
-        if key not in allowed:
-            accepted = ", ".join(sorted(allowed))
-            raise CavexInputError(f"unknown key '{where}{key}' (accepted: {accepted})")
-    for key in sorted(required):
-        if key not in table:
-            raise CavexInputError(f"missing key '{where}{key}'")
+    unknown = [key for key in table if key not in allowed]
+    if unknown:
+        raise CavexInputError(f"is not a known key{_others('nor', unknown[1:])} (accepted: "
+                              f"{', '.join(sorted(allowed))})", f"{where}{unknown[0]}")
+    missing = [key for key in sorted(required) if key not in table]
+    if missing:
+        raise CavexInputError(f"is missing{_others('as', missing[1:])} (required)",
+                              f"{where}{missing[0]}")
+
+
+def _others(word, keys):
+    """``", nor is b"``, ``", as are b, c"``: the further keys of a :func:`check_keys` error."""
+    if not keys:
+        return ""
+    return f", {word} {'is' if len(keys) == 1 else 'are'} {', '.join(map(str, keys))}"
 
 
 def prefixed(factory, where, *args, **kwargs):
@@ -60,6 +87,6 @@ def prefixed(factory, where, *args, **kwargs):
     try:
         return factory(*args, **kwargs)
     except CavexInputError as exc:
-        message = re.sub(r"(parameter|key) '", lambda m: f"{m.group(1)} '{where}", str(exc),
-                         count=1)
-        raise CavexInputError(message) from None
+        if exc.where is None:
+            raise
+        raise CavexInputError(exc.problem, where + exc.where) from None

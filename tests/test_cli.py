@@ -200,9 +200,9 @@ BAD_INPUTS = [
     (["penetrate", "--out", "OUT", "--foo"], "--foo"),
     (["penetrate", "--out", "OUT", "--model", "paper", "--boundary", "dynamic"], "'boundary'"),
     (["penetrate", "--out", "OUT", "--config", "CONFIG:malformed"], "malformed.toml"),
-    (["penetrate", "--out", "OUT", "--config", "CONFIG:unknown_key"], "'layers[0].foo'"),
-    (["penetrate", "--out", "OUT", "--config", "CONFIG:lam"], "'layers[0].lam'"),
-    (["penetrate", "--out", "OUT", "--config", "CONFIG:negative_V0"], "'projectile.V0'"),
+    (["penetrate", "--out", "OUT", "--config", "CONFIG:unknown_key"], "': layers[0].foo "),
+    (["penetrate", "--out", "OUT", "--config", "CONFIG:lam"], "': layers[0].lam "),
+    (["penetrate", "--out", "OUT", "--config", "CONFIG:negative_V0"], "': projectile.V0 "),
     (["penetrate", "--out", "OUT", "--config", "missing.toml"], "missing.toml"),
     # BUG: `--velocity inf` passes the `>= 0` check of the paper path of stress_at_depth and
     # prints "Infinity" (not JSON) with exit code 0.

@@ -127,30 +127,32 @@ def test_bad_table_grids(capsys, tmp_path, argv, name):
 def test_config_not_utf8_or_with_a_numeric_name(capsys, tmp_path):
     latin = tmp_path / "latin1.toml"
     latin.write_bytes(default_config_text().replace("concrete", "b\u00e9ton").encode("latin-1"))
-    refused(capsys, tmp_path, ["penetrate", "--config", latin, "--out", tmp_path / "o"],
-            "not UTF-8")
+    line = refused(capsys, tmp_path, ["penetrate", "--config", latin, "--out", tmp_path / "o"],
+                   "is not UTF-8 text (byte 0xe9)")
+    assert line.startswith(f"cavex: error: '{latin}': line ")
     noise = tmp_path / "noise.toml"
     noise.write_bytes(bytes(range(128, 256)) * 4)
     refused(capsys, tmp_path, ["penetrate", "--config", noise, "--out", tmp_path / "o"],
-            "not UTF-8")
+            f"'{noise}': line 1, column 1 is not UTF-8 text (byte 0x80)")
     named = tmp_path / "named.toml"
     named.write_text(default_config_text().replace('name = "concrete"', "name = 5"))
     refused(capsys, tmp_path, ["penetrate", "--config", named, "--out", tmp_path / "o"],
-            "'layers[0].name'")
+            f"'{named}': layers[0].name must be a string (got 5)")
 
 
 def test_sweep_not_utf8_or_named_outside_its_folder(capsys, tmp_path):
     noise = tmp_path / "noise.toml"
     noise.write_bytes(b"[grid]\nvelocities = [\xff\xfe]\n")
-    refused(capsys, tmp_path, ["batch", noise, "--out", tmp_path / "b"], "not UTF-8")
+    refused(capsys, tmp_path, ["batch", noise, "--out", tmp_path / "b"],
+            f"'{noise}': line 2, column 15 is not UTF-8 text (byte 0xff)")
     escape = tmp_path / "escape.toml"
     escape.write_text(SMALL_SWEEP.replace('name = "small"', 'name = "/tmp/elsewhere"'))
-    refused(capsys, tmp_path, ["batch", escape], "'sweep.name'")
+    refused(capsys, tmp_path, ["batch", escape], f"'{escape}': sweep.name must be a plain")
     numerics = tmp_path / "coarse.toml"
     numerics.write_text(SMALL_SWEEP.replace("elements_per_decade = 8",
                                             "elements_per_decade = 0.6"))
     refused(capsys, tmp_path, ["batch", numerics, "--out", tmp_path / "b"],
-            "'numerics.elements_per_decade'")
+            f"'{numerics}': numerics.elements_per_decade must be")
 
 
 # --- damaged tables --------------------------------------------------------------------------
@@ -411,16 +413,16 @@ def test_trajectory_law_options(capsys, tmp_path, law, name):
 
 
 @pytest.mark.parametrize(("name", "old", "new", "parameter"), [
-    ("short", PROJECTILE_LINE, PROJECTILE_LINE + "\nlength = 0.03", "'projectile.length'"),
-    ("long", PROJECTILE_LINE, PROJECTILE_LINE + "\nlength = 1e300", "'projectile.length'"),
+    ("short", PROJECTILE_LINE, PROJECTILE_LINE + "\nlength = 0.03", "': projectile.length "),
+    ("long", PROJECTILE_LINE, PROJECTILE_LINE + "\nlength = 1e300", "': projectile.length "),
     ("heavy", "m = 0.505", "m = 1e300", "'length'"),  # a 1e299 m steel rod: y0 not finite
     ("light", "m = 0.505", "m = 0.01", "'length'"),  # the steel body is shorter than its nose
-    ("cg", PROJECTILE_LINE, PROJECTILE_LINE + "\nlength = 0.15\ncg = 0.2", "'projectile.cg'"),
-    ("inertia", PROJECTILE_LINE, PROJECTILE_LINE + "\ninertia = 0", "'projectile.inertia'"),
+    ("cg", PROJECTILE_LINE, PROJECTILE_LINE + "\nlength = 0.15\ncg = 0.2", "': projectile.cg "),
+    ("inertia", PROJECTILE_LINE, PROJECTILE_LINE + "\ninertia = 0", "': projectile.inertia "),
     ("inertia_nan", PROJECTILE_LINE, PROJECTILE_LINE + "\ninertia = nan",
-     "'projectile.inertia'"),
-    ("mu", PROJECTILE_LINE, PROJECTILE_LINE + "\nmu = 1e300", "'projectile.mu'"),
-    ("mu_neg", PROJECTILE_LINE, PROJECTILE_LINE + "\nmu = -0.1", "'projectile.mu'"),
+     "': projectile.inertia "),
+    ("mu", PROJECTILE_LINE, PROJECTILE_LINE + "\nmu = 1e300", "': projectile.mu "),
+    ("mu_neg", PROJECTILE_LINE, PROJECTILE_LINE + "\nmu = -0.1", "': projectile.mu "),
 ])
 def test_trajectory_projectile_out_of_range(capsys, tmp_path, name, old, new, parameter):
     config = _config(tmp_path, name, old, new)
@@ -526,8 +528,8 @@ def test_read_only_or_immutable_output_folder(capsys, tmp_path, files, read_only
     (["table", "-o", "{tmp}/t.nc", "--velocities", "0", "100", "--depths", "0.3", "1e308"],
      "'depths'"),  # np.round overflowed: RuntimeWarning lines, then 'depths[13]' = inf
     (["stress", "--velocity", "300", "--depth", "0.3", "--config", "{thick}"],
-     "'layers[1].thickness'"),  # lost to round-off below 1e300 m: was 'interfaces[1]'
-    (["batch", "{fast}", "--out", "{tmp}/b"], "'grid.velocities[0]'"),  # ran, exit 0, failed
+     "': layers[1].thickness "),  # lost to round-off below 1e300 m: was 'interfaces[1]'
+    (["batch", "{fast}", "--out", "{tmp}/b"], "': grid.velocities[0] "),  # ran, exit 0, failed
 ])
 def test_other_commands_out_of_range(capsys, tmp_path, argv, name):
     thick = _config(tmp_path, "thick", "thickness = 0.65", "thickness = 1e300")

@@ -216,61 +216,91 @@ def test_base_config_loads(tmp_path):
     assert projectile.R == 0.075
 
 
-@pytest.mark.parametrize(("text", "fragments"), [
-    # malformed TOML
-    (BASE_CONFIG.replace("rho = 2500.0", "rho 2500.0"), ("not valid TOML",)),
-    (BASE_CONFIG + "[[layers]\n", ("not valid TOML",)),
-    (edited("E = 25e9", "E = 25 GPa"), ("not valid TOML",)),
+@pytest.mark.parametrize(("text", "where", "fragments"), [
+    # malformed TOML: the line and column of the fault
+    (BASE_CONFIG.replace("rho = 2500.0", "rho 2500.0"), "line 13, column 5",
+     ("is not valid TOML (Expected '='",)),
+    (BASE_CONFIG + "[[layers]\n", "line 33, column 9", ("is not valid TOML",)),
+    (edited("E = 25e9", "E = 25 GPa"), "line 11, column 8", ("is not valid TOML",)),
     # unknown keys
-    (edited("E = 10e9", "Young = 10e9"), ("unknown key 'layers[1].Young'", "accepted:", "tau")),
-    (edited("m = 0.505", "mass = 0.505"), ("unknown key 'projectile.mass'",)),
-    (BASE_CONFIG + "units = 'SI'\n", ("unknown key 'layers[2].units'",)),
-    ("title = 'runway'\n" + BASE_CONFIG, ("unknown key 'title'",)),
+    (edited("E = 10e9", "Young = 10e9"), "layers[1].Young",
+     ("is not a known key (accepted:", "tau")),
+    (edited("m = 0.505", "mass = 0.505"), "projectile.mass", ("is not a known key",)),
+    (BASE_CONFIG + "units = 'SI'\n", "layers[2].units", ("is not a known key",)),
+    ("title = 'runway'\n" + BASE_CONFIG, "title", ("is not a known key",)),
     # missing keys
-    (edited("rho = 1800.0", ""), ("missing key 'layers[1].rho'",)),
-    (edited("lam = 0.50", ""), ("missing key 'layers[2].lam'",)),
-    (edited("V0 = 1000.0", ""), ("missing key 'projectile.V0'",)),
-    (BASE_CONFIG.split("[[layers]]")[0], ("missing key 'layers'",)),
-    (edited("tau = 10e6", ""), ("'layers[1].tau'", "sigma_c")),
-    (edited("R = 0.075", ""), ("'projectile.R'", "crh")),
+    (edited("rho = 1800.0", ""), "layers[1].rho", ("is missing (required)",)),
+    (edited("lam = 0.50", ""), "layers[2].lam", ("is missing (required)",)),
+    (edited("V0 = 1000.0", ""), "projectile.V0", ("is missing (required)",)),
+    (BASE_CONFIG.split("[[layers]]")[0], "layers", ("is missing (required)",)),
+    (edited("tau = 10e6", ""), "layers[1].tau", ("must be given (or sigma_c given)",)),
+    (edited("R = 0.075", ""), "projectile.R", ("must be given (or crh given)",)),
     # wrong types
-    (edited("E = 25e9", 'E = "25e9"'), ("'layers[0].E'", "a number")),
-    (edited("lam = 0.35", "lam = true"), ("'layers[1].lam'", "a number")),
-    (edited("V0 = 1000.0", "V0 = false"), ("'projectile.V0'", "a number")),
-    (edited("thickness = 0.65", "thickness = [0.65]"), ("'layers[0].thickness'", "a number")),
-    (edited("tau = 6e6", "tau = 1979-05-27"), ("'layers[2].tau'", "a number")),
-    ("projectile = 3\n[[layers]]" + BASE_CONFIG.split("[[layers]]", 1)[1],
-     ("'projectile'", "a table")),
+    (edited("E = 25e9", 'E = "25e9"'), "layers[0].E", ("must be a number (got '25e9')",)),
+    (edited("lam = 0.35", "lam = true"), "layers[1].lam", ("must be a number (got True)",)),
+    (edited("V0 = 1000.0", "V0 = false"), "projectile.V0", ("must be a number",)),
+    (edited("thickness = 0.65", "thickness = [0.65]"), "layers[0].thickness",
+     ("must be a number",)),
+    (edited("tau = 6e6", "tau = 1979-05-27"), "layers[2].tau", ("must be a number",)),
+    ("projectile = 3\n[[layers]]" + BASE_CONFIG.split("[[layers]]", 1)[1], "projectile",
+     ("must be a table",)),
     # thickness placement
-    (edited("tau = 6e6", "tau = 6e6\nthickness = 2.0"), ("'layers[2].thickness'", "absent")),
-    (edited("thickness = 0.45", ""), ("missing key 'layers[1].thickness'",)),
-    (edited("thickness = 0.65", "thickness = -0.65"), ("'layers[0].thickness'", "> 0")),
-    (edited("thickness = 0.45", "thickness = nan"), ("'layers[1].thickness'", "> 0")),
+    (edited("tau = 6e6", "tau = 6e6\nthickness = 2.0"), "layers[2].thickness",
+     ("must be absent",)),
+    (edited("thickness = 0.45", ""), "layers[1].thickness", ("is missing (required)",)),
+    (edited("thickness = 0.65", "thickness = -0.65"), "layers[0].thickness", ("> 0",)),
+    (edited("thickness = 0.45", "thickness = nan"), "layers[1].thickness", ("> 0",)),
     # out-of-range and non-finite numbers, prefixed with where they were read
-    (edited("lam = 0.35", "lam = 3.0"), ("'layers[1].lam'", "in [0, 3)")),
-    (edited("lam = 0.15", "lam = -0.1"), ("'layers[0].lam'", "in [0, 3)")),
-    (edited("nu = 0.3", "nu = 0.5"), ("'layers[2].nu'", "in (-1, 0.5)")),
-    (edited("E = 0.12e9", "E = 0"), ("'layers[2].E'", "> 0")),
-    (edited("E = 10e9", "E = nan"), ("'layers[1].E'", "> 0")),
-    (edited("rho = 1600.0", "rho = -1600.0"), ("'layers[2].rho'", "> 0")),
-    (edited("tau = 25e6", "tau = inf"), ("'layers[0].tau'", "finite")),
-    (edited("V0 = 1000.0", "V0 = -1.0"), ("'projectile.V0'", "> 0")),
-    (edited("r = 0.0125", "r = nan"), ("'projectile.r'", "> 0")),
-    (edited("R = 0.075", "R = 0.01"), ("'projectile.R'", ">= r")),
+    (edited("lam = 0.35", "lam = 3.0"), "layers[1].lam", ("must be in [0, 3) (got 3.0)",)),
+    (edited("lam = 0.15", "lam = -0.1"), "layers[0].lam", ("in [0, 3)",)),
+    (edited("nu = 0.3", "nu = 0.5"), "layers[2].nu", ("in (-1, 0.5)",)),
+    (edited("E = 0.12e9", "E = 0"), "layers[2].E", ("> 0",)),
+    (edited("E = 10e9", "E = nan"), "layers[1].E", ("> 0",)),
+    (edited("rho = 1600.0", "rho = -1600.0"), "layers[2].rho", ("> 0",)),
+    (edited("tau = 25e6", "tau = inf"), "layers[0].tau", ("finite",)),
+    (edited("V0 = 1000.0", "V0 = -1.0"), "projectile.V0", ("> 0",)),
+    (edited("V0 = 1000.0", "V0 = 2e4"), "projectile.V0", ("<= 10000 m/s",)),
+    (edited("r = 0.0125", "r = nan"), "projectile.r", ("> 0",)),
+    (edited("R = 0.075", "R = 0.01"), "projectile.R", (">= r",)),
 ])
-def test_bad_config_raises_input_error(tmp_path, text, fragments):
-    """Malformed TOML, unknown, missing or mistyped keys and bad values: one-line errors."""
+def test_bad_config_raises_input_error(tmp_path, text, where, fragments):
+    """Malformed TOML, unknown, missing or mistyped keys and bad values: one line
+    ``'<path>': <where> <what>``."""
+    path = write_config(tmp_path, text)
     with pytest.raises(CavexInputError) as error:
-        load_config(write_config(tmp_path, text))
+        load_config(path)
+    assert str(error.value).startswith(f"'{path}': {where} "), str(error.value)
     assert_input_error(error, *fragments)
 
 
 def test_unreadable_config_raises_input_error(tmp_path):
-    """A missing file is an input error naming the file."""
+    """A missing file, or a folder, is an input error naming the file."""
     path = tmp_path / "absent.toml"
     with pytest.raises(CavexInputError) as error:
         load_config(path)
-    assert_input_error(error, str(path), "cannot be read")
+    assert str(error.value) == f"'{path}': cannot be read (No such file or directory)"
+    with pytest.raises(CavexInputError) as error:
+        load_config(tmp_path)
+    assert str(error.value).startswith(f"'{tmp_path}': cannot be read (")
+
+
+def test_config_with_a_byte_order_mark_loads(tmp_path):
+    """A UTF-8 byte-order mark at the start (some editors write one) is accepted."""
+    path = tmp_path / "bom.toml"
+    path.write_bytes(b"\xef\xbb\xbf" + BASE_CONFIG.encode())
+    assert load_config(path) == load_config(write_config(tmp_path, BASE_CONFIG))
+
+
+def test_config_parsed_from_a_mapping_names_the_parameter():
+    """Without a file (``parse_config`` of a mapping) the message names the parameter."""
+    import tomllib
+
+    from cavex.config import parse_config
+
+    data = tomllib.loads(edited("E = 10e9", "E = -1.0"))
+    with pytest.raises(CavexInputError) as error:
+        parse_config(data)
+    assert str(error.value) == "parameter 'layers[1].E' must be a finite number > 0 (got -1.0)"
 
 
 @pytest.mark.parametrize("lam", [0.0, 0.35, 2.5])

@@ -15,7 +15,6 @@ import os
 import re
 import sys
 import time
-import tomllib
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -23,6 +22,7 @@ import numpy as np
 from cavex.config import parse_projectile, parse_target
 from cavex.errors import CavexInputError, check_keys, is_finite_number, prefixed, require
 from cavex.fem.settings import make_numerics
+from cavex.input_files import in_file, read_toml
 from cavex.materials import MAX_VELOCITY
 from cavex.verification.fedata.cases import (
     check_run_size,
@@ -103,9 +103,19 @@ def parse_sweep(path_or_dict):
     Raises
     ------
     CavexInputError
-        Unreadable TOML, unknown keys, wrong types or out-of-range values, naming the key.
+        Unreadable TOML, unknown keys, wrong types or out-of-range values, naming the key; from
+        a file ``'<path>': <where> <what>`` (:mod:`cavex.input_files`).
     """
-    data, base_dir, default_name = _read_sweep(path_or_dict)
+    if isinstance(path_or_dict, dict):
+        return _sweep(path_or_dict, os.getcwd(), "sweep")
+    path = os.fspath(path_or_dict)
+    data = read_toml(path)
+    stem = re.sub(r"[^A-Za-z0-9._-]", "_", os.path.splitext(os.path.basename(path))[0])
+    return in_file(path, _sweep, data, os.path.dirname(os.path.abspath(path)),
+                   stem.lstrip("._-") or "sweep")
+
+
+def _sweep(data, base_dir, default_name):
     _check_table(data, "", SECTIONS, required=("grid",))
     meta = _sweep_section(data.get("sweep", {}), default_name)
     layers, projectile = _target_section(data.get("target", {}), base_dir)
@@ -120,24 +130,6 @@ def parse_sweep(path_or_dict):
         raise CavexInputError(f"two swept keys share the dimension name '{duplicated[0]}'")
     return Sweep(meta["name"], meta["scheduler"], meta["workers"], layers, projectile, axes,
                  nu, numerics)
-
-
-def _read_sweep(path_or_dict):
-    if isinstance(path_or_dict, dict):
-        return path_or_dict, os.getcwd(), "sweep"
-    path = os.fspath(path_or_dict)
-    try:
-        with open(path, "rb") as handle:
-            data = tomllib.load(handle)
-    except OSError as exc:
-        raise CavexInputError(f"sweep '{path}' cannot be read: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CavexInputError(f"sweep '{path}' is not valid TOML: {exc}") from None
-    except UnicodeDecodeError as exc:
-        raise CavexInputError(f"sweep '{path}' is not UTF-8 text (byte {exc.start}: "
-                              f"{exc.reason})") from None
-    stem = re.sub(r"[^A-Za-z0-9._-]", "_", os.path.splitext(os.path.basename(path))[0])
-    return data, os.path.dirname(os.path.abspath(path)), stem.lstrip("._-") or "sweep"
 
 
 def _check_table(table, where, allowed, required=()):
@@ -164,14 +156,14 @@ def _target_section(table, base_dir):
     _check_table(table, "target.", TARGET_KEYS)
     if "config" in table:
         if len(table) > 1:
-            raise CavexInputError("key 'target.config' excludes 'target.layers' and "
-                                  "'target.projectile' (give a file or inline tables)")
+            raise CavexInputError("excludes target.layers and target.projectile (give a file "
+                                  "or inline tables)", "target.config")
         path = table["config"]
         require(isinstance(path, str) and path, "target.config", "a path string", path)
         try:
             return config_tables(os.path.join(base_dir, path))
         except CavexInputError as exc:
-            raise CavexInputError(f"key 'target.config': {exc}") from None
+            raise CavexInputError(f"names a bad target file: {exc}", "target.config") from None
     layers, projectile = config_tables()
     if "layers" in table:
         prefixed(parse_target, "target.", table["layers"])
@@ -234,13 +226,13 @@ def _materials_section(entries, layers, grid_sets_nu):
             if prop == "layer":
                 continue
             if prop == "nu" and grid_sets_nu:
-                raise CavexInputError(f"key '{where}nu' conflicts with 'grid.nu' (which sets "
-                                      "every layer's nu)")
+                raise CavexInputError("conflicts with grid.nu (which sets every layer's nu)",
+                                      f"{where}nu")
             strength = "tau" if prop == "sigma_c" else prop  # each replaces the other
             if (index, strength) in seen:
-                raise CavexInputError(f"key '{where}{prop}' varies a property already given"
+                raise CavexInputError("varies a property already given"
                                       + (" (tau and sigma_c replace each other: give one)"
-                                         if strength == "tau" else ""))
+                                         if strength == "tau" else ""), f"{where}{prop}")
             seen.add((index, strength))
             if isinstance(value, list):
                 values = _value_list(value, where + prop)
@@ -264,7 +256,8 @@ def _check_property(layers, index, prop, value, where):
     try:
         parse_target(changed)
     except CavexInputError as exc:
-        raise CavexInputError(f"key '{where}' = {value!r}: {exc}") from None
+        same = exc.where == f"layers[{index}].{prop}"  # else a check of the layer it changed
+        raise CavexInputError(exc.problem if same else f"is refused ({exc})", where) from None
 
 
 def _layer_index(layer, layers, where):

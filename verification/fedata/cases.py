@@ -24,7 +24,7 @@ import uuid
 from dataclasses import fields
 
 from cavex.config import load_config, parse_projectile, parse_target, projectile_table, target_table
-from cavex.errors import CavexInputError, CavexNumericalError, require
+from cavex.errors import CavexInputError, CavexNumericalError, check_keys, require
 from cavex.errors import is_finite_number as _finite
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
 from cavex.fem.settings import Numerics, make_numerics
@@ -95,10 +95,7 @@ def _fe_request(case):
     """``((target, projectile, depth, velocity, nu), numerics, error_target)`` of a case."""
     from cavex.verification.fedata.comparison import fe_problem
 
-    unknown = sorted(set(case) - CASE_KEYS)
-    if unknown:
-        raise CavexInputError(f"unknown key '{unknown[0]}' in case "
-                              f"(accepted: {', '.join(sorted(CASE_KEYS))})")
+    check_keys(case, CASE_KEYS, "")
     target = parse_target(_layers(case["target"]))
     projectile = parse_projectile(case["projectile"])
     numerics = make_numerics(**case.get("numerics", {})).as_dict()

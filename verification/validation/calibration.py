@@ -23,14 +23,14 @@ import math
 import shlex
 import sys
 import time
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from scipy.optimize import least_squares
 
-from cavex.errors import CavexInputError, CavexNumericalError, check_keys, require
+from cavex.errors import CavexInputError, CavexNumericalError, check_keys, prefixed, require
+from cavex.input_files import in_file, read_toml
 from cavex.verification.output.number_format import round_significant
 from cavex.verification.validation.concrete import BOUNDS, FREE_PARAMETERS, Mapping, shot_target
 from cavex.verification.validation.predict import FE_MODEL, MODEL_OPTIONS, TableCache, predict
@@ -77,17 +77,15 @@ def check_parameters(params):
     """The free parameter names: known, not repeated, at least one."""
     params = tuple(params or DEFAULT_PARAMETERS)
     for name in params:
-        if name not in FREE_PARAMETERS:
-            raise CavexInputError(f"unknown calibration parameter '{name}' (accepted: "
-                                  f"{', '.join(FREE_PARAMETERS)})")
+        require(name in FREE_PARAMETERS, "params", f"names from {', '.join(FREE_PARAMETERS)}",
+                name)
     require(len(set(params)) == len(params), "params", "names without repeats", list(params))
     return params
 
 
 def check_option(option):
-    if option not in MODEL_OPTIONS:
-        raise CavexInputError(f"parameter 'model' must be one of {', '.join(MODEL_OPTIONS)} "
-                              f"(got {option!r})")
+    require(isinstance(option, str) and option in MODEL_OPTIONS, "model",
+            f"one of {', '.join(MODEL_OPTIONS)}", option)
     return option
 
 
@@ -244,38 +242,34 @@ def _toml_string(text):
 
 
 def read_calibration(path):
-    """A :class:`Calibration` from a calibration file; a bad file is a one-line input error."""
+    """A :class:`Calibration` from a calibration file; a bad file is a one-line input error
+    ``'<path>': <where> <what>`` (:mod:`cavex.input_files`)."""
+    return in_file(path, parse_calibration, read_toml(path), source=str(path))
+
+
+def parse_calibration(data, source=""):
+    """A :class:`Calibration` from a parsed calibration file (its target checked too)."""
     from cavex.config import parse_config
 
-    try:
-        with open(path, encoding="utf-8") as handle:
-            data = tomllib.loads(handle.read())
-    except OSError as exc:
-        raise CavexInputError(f"calibration '{path}' cannot be read: {exc.strerror}") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise CavexInputError(f"calibration '{path}' is not valid TOML: {exc}") from None
-    try:
-        parse_config(data)
-        table = data.get("calibration")
-        if not isinstance(table, dict):
-            raise CavexInputError("missing table [calibration] (write it with `cavex "
-                                  "calibrate`)")
-        check_keys(table, CALIBRATION_KEYS, "calibration.", required=CALIBRATION_REQUIRED)
-        option = check_option(table["model"])
-        require(isinstance(table["params"], list) and all(isinstance(p, str)
-                                                          for p in table["params"]),
-                "calibration.params", "an array of names", table["params"])
-        params = check_parameters(table["params"])
-        mapping = Mapping(**{k: table[k] for k in ("lam", "strength_factor", "modulus_factor",
-                                                   "nu")})
-        shots = table["shots"]
-        require(isinstance(shots, list) and shots and all(isinstance(s, str) for s in shots),
-                "calibration.shots", "a non-empty array of shot ids", shots)
-    except CavexInputError as exc:
-        raise CavexInputError(f"calibration '{path}': {exc}") from None
+    parse_config(data)
+    if "calibration" not in data:
+        raise CavexInputError("is missing (a calibration file is written by `cavex "
+                              "calibrate`)", "calibration")
+    table = data["calibration"]
+    check_keys(table, CALIBRATION_KEYS, "calibration.", required=CALIBRATION_REQUIRED)
+    option = prefixed(check_option, "calibration.", table["model"])
+    require(isinstance(table["params"], list) and all(isinstance(p, str)
+                                                      for p in table["params"]),
+            "calibration.params", "an array of names", table["params"])
+    params = prefixed(check_parameters, "calibration.", table["params"])
+    mapping = prefixed(Mapping, "calibration.", **{k: table[k] for k in (
+        "lam", "strength_factor", "modulus_factor", "nu")})
+    shots = table["shots"]
+    require(isinstance(shots, list) and shots and all(isinstance(s, str) for s in shots),
+            "calibration.shots", "a non-empty array of shot ids", shots)
     statistics = tuple((k, table[k]) for k in ("n", "mean_abs_log_ratio", "rms_log_ratio",
                                                "evaluations") if k in table)
-    return Calibration(option, mapping, params, tuple(shots), source=str(path),
+    return Calibration(option, mapping, params, tuple(shots), source=source,
                        statistics=statistics)
 
 

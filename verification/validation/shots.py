@@ -5,10 +5,11 @@ A shot file is CSV with a header row naming at least the columns :data:`REQUIRED
 lines starting with ``#`` are comments (the attribution of the data goes there) and blank lines
 are skipped. Extra columns are kept, as text, in :attr:`Shot.extra`.
 
-Every value is checked before anything is computed; a bad value is a one-line
-:class:`~cavex.errors.CavexInputError` naming the file, the line, the shot and the column, e.g.
-``shots file 'x.csv', line 12 (shot 'F94-45'), column 'fc_Pa': must be a compressive strength
-in Pa in [1e+06, 1e+09] (is it in MPa?) (got '35.4')``.
+The file is UTF-8 (a byte-order mark at its start is accepted). Every value is checked before
+anything is computed; a bad value is a one-line :class:`~cavex.errors.CavexInputError` in the
+form of every input file (:mod:`cavex.input_files`) naming the file, the line, the shot and the
+column, e.g. ``'x.csv': line 12 (shot 'F94-45'), column fc_Pa must be a compressive strength in
+Pa in [1e+06, 1e+09] (is it in MPa?) (got '35.4')``.
 
 From a shot to cavex's objects: :func:`shot_projectile` (the ``[projectile]`` table) here, the
 concrete in :mod:`cavex.verification.validation.concrete`.
@@ -20,7 +21,8 @@ import math
 from dataclasses import dataclass, field
 
 from cavex.errors import CavexInputError
-from cavex.materials import Projectile
+from cavex.input_files import in_file, read_text
+from cavex.materials import MAX_VELOCITY, Projectile
 
 REQUIRED_COLUMNS = ("id", "mass_kg", "diameter_m", "crh", "V0_m_s", "fc_Pa", "rho_kg_m3",
                     "depth_m")
@@ -34,7 +36,8 @@ NUMBER_COLUMNS = {
     "length_m": ("length", 0.0, math.inf, "empty or a finite number > 0"),
     # a tangent ogive needs R = crh d >= d/2 (crh 0.5 is a hemisphere)
     "crh": ("crh", 0.5, math.inf, "a finite number >= 0.5 (ogive radius R = crh d >= d/2)"),
-    "V0_m_s": ("V0", 0.0, math.inf, "a finite number > 0"),
+    "V0_m_s": ("V0", 0.0, MAX_VELOCITY,
+               f"a finite number in (0, {MAX_VELOCITY:g}] (rigid-projectile penetration)"),
     "fc_Pa": ("fc", 1e6, 1e9, "a compressive strength in Pa in [1e+06, 1e+09] (is it in MPa?)"),
     "rho_kg_m3": ("rho", 1000.0, 4000.0,
                   "a concrete density in kg/m^3 in [1000, 4000] (is it in g/cm^3?)"),
@@ -106,20 +109,19 @@ def read_shots(path):
     Raises
     ------
     CavexInputError
-        Unreadable file, missing header or column, a row with the wrong number of cells, a
-        value out of range (the line, shot and column named), repeated ids, no shots.
+        ``'<path>': <where> <what>`` (:mod:`cavex.input_files`): an unreadable or non-UTF-8
+        file, a missing header or column, a row with the wrong number of cells, a value out of
+        range (its line, shot and column named), repeated ids, no shots.
     """
-    try:
-        with open(path, encoding="utf-8", newline="") as handle:
-            text = handle.read()
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = getattr(exc, "strerror", None) or str(exc)
-        raise CavexInputError(f"shots file '{path}' cannot be read: {reason}") from None
-    return parse_shots(text, str(path))
+    return parse_shots(read_text(path), str(path))
 
 
 def parse_shots(text, path="<text>"):
-    """Shots from the text of a shot file (``path`` only names it in messages)."""
+    """Shots from the text of a shot file (``path`` names it in messages)."""
+    return in_file(path, _shot_file, text, path)
+
+
+def _shot_file(text, path):
     comments, rows = [], []
     for number, line in enumerate(io.StringIO(text, newline=None), start=1):
         stripped = line.strip()
@@ -128,44 +130,48 @@ def parse_shots(text, path="<text>"):
         elif stripped:
             rows.append((number, line))
     if not rows:
-        raise CavexInputError(f"shots file '{path}' has no header row (and no shots)")
+        raise CavexInputError("has no header row (and no shots)")
     (header_line, header_text), data = rows[0], rows[1:]
-    header = [c.strip() for c in _cells(header_text)]
-    where = f"shots file '{path}', line {header_line} (header)"
+    header = [c.strip() for c in _cells(header_line, header_text)]
+    where = f"line {header_line} (header)"
     for column in REQUIRED_COLUMNS:
         if column not in header:
-            raise CavexInputError(f"{where}: missing column '{column}' (required: "
-                                  f"{', '.join(REQUIRED_COLUMNS)})")
+            raise CavexInputError(f"has no column {column} (required: "
+                                  f"{', '.join(REQUIRED_COLUMNS)})", where)
     repeated = sorted({c for c in header if header.count(c) > 1})
     if repeated or "" in header:
-        raise CavexInputError(f"{where}: column names must be unique and non-empty "
-                              f"(got {header})")
+        raise CavexInputError(f"must name each column once (got {header})", where)
     if not data:
-        raise CavexInputError(f"shots file '{path}' has a header but no shots")
+        raise CavexInputError("has a header but no shots")
     shots, seen = [], {}
     for number, line in data:
-        shot = _parse_row(number, _cells(line), header, path)
+        shot = _parse_row(number, _cells(number, line), header)
         if shot.id in seen:
-            raise CavexInputError(f"shots file '{path}', line {number}, column 'id': shot "
-                                  f"'{shot.id}' repeats line {seen[shot.id]}")
+            raise CavexInputError(f"must be unique (got {shot.id!r}, as on line "
+                                  f"{seen[shot.id]})", f"line {number}, column id")
         seen[shot.id] = number
         shots.append(shot)
     return ShotFile(path, tuple(shots), tuple(comments), tuple(header))
 
 
-def _cells(line):
-    return next(csv.reader([line]))
+def _cells(number, line):
+    try:
+        return next(csv.reader([line]))
+    except csv.Error as exc:
+        raise CavexInputError(f"is not a CSV row ({exc})", f"line {number}") from None
 
 
-def _parse_row(number, cells, header, path):
-    where = f"shots file '{path}', line {number}"
+def _parse_row(number, cells, header):
+    """The :class:`Shot` of line ``number``; a refused value names the line, shot and column."""
     if len(cells) != len(header):
-        raise CavexInputError(f"{where}: has {len(cells)} cells, the header has {len(header)}")
+        raise CavexInputError(f"must have {len(header)} cells, as the header (got "
+                              f"{len(cells)})", f"line {number}")
     row = {name: cell.strip() for name, cell in zip(header, cells, strict=True)}
     shot_id = row["id"]
     if not shot_id:
-        raise CavexInputError(f"{where}, column 'id': must be a non-empty shot name (got '')")
-    where = f"{where} (shot '{shot_id}')"
+        raise CavexInputError("must be a non-empty shot name (got '')", f"line {number}, "
+                              "column id")
+    where = f"line {number} (shot {shot_id!r})"
     values = {}
     for column, (attribute, lower, upper, accepted) in NUMBER_COLUMNS.items():
         text = row.get(column, "")
@@ -175,11 +181,16 @@ def _parse_row(number, cells, header, path):
         value = _number(text)
         low_ok = value >= lower if column in INCLUSIVE_LOWER else value > lower
         if not (math.isfinite(value) and low_ok and value <= upper):
-            raise CavexInputError(f"{where}, column '{column}': must be {accepted} "
-                                  f"(got {text!r})")
+            raise CavexInputError(f"must be {accepted} (got {text!r})",
+                                  f"{where}, column {column}")
         values[attribute] = value
     extra = {k: v for k, v in row.items() if k not in COLUMNS}
-    return Shot(id=shot_id, extra=extra, line=number, **values)
+    shot = Shot(id=shot_id, extra=extra, line=number, **values)
+    try:
+        shot_projectile(shot)
+    except CavexInputError as exc:
+        raise CavexInputError(f"gives no projectile: {exc}", where) from None
+    return shot
 
 
 def _number(text):
