@@ -38,14 +38,23 @@ import math
 from dataclasses import asdict, dataclass, replace
 from functools import partial
 
-from scipy.integrate import solve_ivp
-
 from cavex.analytic import paper_model as pm
-from cavex.analytic.penetration.integrator import crater_depth, penetrate
+from cavex.analytic.penetration.integrator import (
+    ATOL,
+    RTOL,
+    crater_depth,
+    integrate,
+    penetrate,
+)
 from cavex.analytic.penetration.nose import ogive_coefficients
 from cavex.analytic.penetration.resistance import ClosedFormResistance
-from cavex.errors import CavexNumericalError, require
-from cavex.verification.studies.table2 import PAPER_REF10_EXIT_VELOCITY, PAPER_TABLE2, table2_rows
+from cavex.errors import require
+from cavex.verification.studies.table2 import (
+    PAPER_REF10_EXIT_VELOCITY,
+    PAPER_TABLE2,
+    phase_row,
+    table2_rows,
+)
 
 CHOICES = {
     "epsilon": pm.EPSILON_READINGS,
@@ -65,6 +74,7 @@ ADMISSIBLE = {**CHOICES, "crater": ("nose-base",), "crater_medium": ("concrete",
 ROW_KEYS = ("depth_m", "velocity_m_s", "time_s")
 # half a unit of the last digit Table 2 prints: L to 0.01 m, V to 0.1 m/s, t to 0.01 ms
 PRINT_HALF_UNIT = {"depth_m": 0.005, "velocity_m_s": 0.05, "time_s": 0.005e-3}
+SEGMENT_RTOL = 1e-10  # the segments' relative tolerance (the full runs: the integrator's own)
 
 
 @dataclass(frozen=True)
@@ -223,7 +233,7 @@ class CraterAsTunnel:
         return self.inner.crater_force(velocity)
 
 
-def run_reading(target, projectile, reading, rtol=1e-9, atol=1e-12):
+def run_reading(target, projectile, reading, rtol=RTOL, atol=ATOL):
     """Trajectory of the paper model under ``reading``."""
     resistance = ReadingResistance(target, projectile, reading)
     if reading.crater_law == "tunnel":
@@ -232,38 +242,9 @@ def run_reading(target, projectile, reading, rtol=1e-9, atol=1e-12):
     return penetrate(target, projectile, resistance, crater=reading.crater, rtol=rtol, atol=atol)
 
 
-def segment(resistance, mass, start, stop_depth=None, rtol=1e-10, atol=1e-12):
-    """Integrate ``m V' = -F(L, V)`` from ``start = (L, V, t)`` to ``stop_depth`` or rest.
-
-    Returns
-    -------
-    dict
-        ``{"depth_m", "velocity_m_s", "time_s"}`` where the segment ends.
-    """
-    depth0, v0, t0 = start
-
-    def rhs(t, y):
-        return (y[1], -resistance.force(y[0], max(y[1], 0.0)) / mass)
-
-    def stopped(t, y):
-        return y[1]
-
-    def reached(t, y):
-        return y[0] - (stop_depth if stop_depth is not None else math.inf)
-
-    for event in (stopped, reached):
-        event.terminal, event.direction = True, 0.0 if event is reached else -1.0
-    sol = solve_ivp(rhs, (t0, t0 + 1.0), (depth0, v0), method="DOP853",
-                    events=[stopped, reached], rtol=rtol, atol=atol)
-    if sol.status != 1:
-        raise CavexNumericalError(f"segment from {start} did not end: {sol.message}")
-    which = 0 if sol.t_events[0].size else 1
-    t_end, (depth, v) = sol.t_events[which][0], sol.y_events[which][0]
-    return {"depth_m": depth, "velocity_m_s": max(v, 0.0) if which else 0.0, "time_s": t_end}
-
-
 def _paper_start(row):
-    return row["depth_m"], row["velocity_m_s"], row["time_s"]
+    """The integrator's start state ``(t, L, V)`` of a row of the paper's Table 2."""
+    return row["time_s"], row["depth_m"], row["velocity_m_s"]
 
 
 def segment_rows(target, projectile, reading):
@@ -275,7 +256,8 @@ def segment_rows(target, projectile, reading):
     resistance = ReadingResistance(target, projectile, reading)
     ends = (phase_depth_l1(target, projectile, reading.epsilon), target.interface_depths[0],
             None)
-    return [segment(resistance, projectile.m, _paper_start(PAPER_TABLE2[k]), end)
+    return [phase_row(integrate(resistance, projectile.m, _paper_start(PAPER_TABLE2[k]),
+                                stop_depth=end, rtol=SEGMENT_RTOL)[0])
             for k, end in enumerate(ends)]
 
 
