@@ -47,7 +47,7 @@ from cavex.analytic.penetration.integrator import (
     penetrate,
 )
 from cavex.analytic.penetration.nose import ogive_coefficients
-from cavex.analytic.penetration.resistance import ClosedFormResistance
+from cavex.analytic.penetration.resistance import ClosedFormResistance, Resistance
 from cavex.errors import require
 from cavex.verification.studies.table2 import (
     PAPER_REF10_EXIT_VELOCITY,
@@ -148,11 +148,9 @@ def eq29_reading(material, eps, variant):
     return A, B, tau, rho
 
 
-class ReadingResistance:
-    """The paper model (Eqs. 19-29, 34) under one :class:`Reading`.
-
-    Implements the integrator's protocol: ``force(depth, velocity)``, ``label(depth, velocity)``
-    and ``crater_force(velocity)``. The case selection is that of
+class ReadingResistance(Resistance):
+    """The paper model (Eqs. 19-29, 34) under one :class:`Reading`, as the integrator's
+    :class:`~cavex.analytic.penetration.resistance.Resistance`. The case selection is that of
     :func:`cavex.analytic.paper_model.paper_coefficients` (nose-tip switch, ``L1``-``L4``), with
     the reading's ``eps`` per layer and its variants of Eqs. 19 and 29 and of ``tau_0i``,
     ``rho_i`` in Eqs. 13-14.
@@ -164,6 +162,7 @@ class ReadingResistance:
             pm.check_paper_material(material, index)
         self.target, self.projectile, self.reading = target, projectile, reading
         self.eps = [pm.layer_epsilon(m, reading.epsilon) for m in target.layers]
+        self._crater_medium = None
 
     def first_layer(self, depth):
         """Index of the layer whose equations apply at nose-tip depth ``depth``."""
@@ -200,15 +199,16 @@ class ReadingResistance:
         return f"Eq. {equation} ({state})"
 
     def crater_force(self, velocity):
-        """Eq. (29) force of the crater medium (concrete, or the soil in the literal reading)."""
-        index = 0 if self.reading.crater_medium == "concrete" else -1
-        material = self.target.layers[index]
-        A, B, tau, rho = eq29_reading(material, self.eps[index], self.reading.eq29)
-        c_a, c_b = ogive_coefficients(self.projectile, A, B, tau, rho)
-        return c_a + c_b * velocity ** 2
+        """Eq. (29) force of the crater medium alone (concrete, or the soil in the literal
+        reading): this reading's force on the single-medium target of that layer."""
+        if self._crater_medium is None:
+            index = 0 if self.reading.crater_medium == "concrete" else -1
+            self._crater_medium = ReadingResistance(self.target.single(index), self.projectile,
+                                                    self.reading)
+        return self._crater_medium.force(0.0, velocity)
 
 
-class CraterAsTunnel:
+class CraterAsTunnel(Resistance):
     """Wraps a resistance: the crater force ``crater_force(V)`` acts from the surface to ``L_c``.
 
     Used with ``penetrate(..., crater=None)``: above ``L_c`` the label is ``"crater"`` and the
