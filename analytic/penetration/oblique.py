@@ -306,8 +306,8 @@ class ObliqueModel:
             phases.append(self._phase(label, t0, y, reason))
             if crossing:
                 if interface is not None:  # the layer the tip has just entered
-                    label = self.layer_name(interface + 1 if directions[which] > 0
-                                            else interface)
+                    label = self.target.layer_name(interface + 1 if directions[which] > 0
+                                                   else interface)
                 directions[which] = -directions[which]
             else:
                 break
@@ -375,11 +375,8 @@ class ObliqueModel:
             return sol, None
         return sol, next(i for i, te in enumerate(sol.t_events) if te.size)
 
-    def layer_name(self, layer):
-        return self.target.layers[layer].name or f"layer {layer + 1}"
-
     def phase_label(self, y):
-        return self.layer_name(self.target.layer_at(max(self.tip(y)[2], 0.0)))
+        return self.target.layer_name(self.target.layer_at(max(self.tip(y)[2], 0.0)))
 
     def _phase(self, label, t, y, reason):
         end = self._end_state(y, t, reason)

@@ -114,7 +114,7 @@ class ClosedFormResistance(Resistance):
         self._paper = PaperModel(target, projectile, epsilon) if model == "paper" else None
         n = len(target.layers)
         self._tables = [material_table(tuple(target.layers[i:])) for i in range(n)]
-        self._names = [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]
+        self._names = target.layer_names()
         self._cosines, self._weights = nose_rule(projectile)
         self._dynamic = boundary == "dynamic"
         self._r = float(projectile.r)

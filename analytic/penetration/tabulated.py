@@ -96,7 +96,7 @@ class TabulatedResistance(Resistance):
         """Wall layer name and "(table)": phases end where the wall layer changes."""
         self._check_depth(depth)
         index = wall_layer(self.target, self.projectile, depth)
-        return f"{self.target.layers[index].name or f'layer {index + 1}'} (table)"
+        return f"{self.target.layer_name(index)} (table)"
 
     def crater_force(self, velocity):
         """Nose force of the first layer alone (the table's first-layer column)."""

@@ -130,9 +130,9 @@ def _layer_names(ax, target):
     (the last one just below the last interface)."""
     tops = [0.0, *target.interface_depths]
     bottom = ax.get_ylim()[0]  # the axis is inverted: ylim = (deepest, shallowest)
-    for k, layer in enumerate(target.layers):
+    for k, name in enumerate(target.layer_names()):
         low = tops[k + 1] if k + 1 < len(tops) else max(bottom, tops[k] + 0.1)
-        ax.text(1.01, 0.5 * (tops[k] + low), layer.name or f"layer {k + 1}",
+        ax.text(1.01, 0.5 * (tops[k] + low), name,
                 transform=ax.get_yaxis_transform(), va="center", fontsize=8, color="0.3")
 
 
