@@ -18,10 +18,10 @@ from cavex.analytic.paper_model import (
 )
 from cavex.analytic.penetration.integrator import Trajectory, penetrate
 from cavex.analytic.penetration.nose import nose_force, ogive_coefficients
-from cavex.analytic.penetration.oblique import Shot, fly
+from cavex.analytic.penetration.oblique import Strike, fly
 from cavex.analytic.penetration.resistance import ClosedFormResistance
 
-__all__ = ["CavityState", "ClosedFormResistance", "PaperCoefficients", "PaperModel", "Shot",
+__all__ = ["CavityState", "ClosedFormResistance", "PaperCoefficients", "PaperModel", "Strike",
            "Trajectory", "cavity_solution", "cavity_stress", "fly", "nose_force",
            "ogive_coefficients",
            "paper_coefficients", "paper_phase_depths", "paper_stress", "penetrate",

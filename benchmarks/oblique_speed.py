@@ -26,20 +26,20 @@ from pathlib import Path
 import numpy as np
 
 from cavex.analytic.penetration.body import AZIMUTHS, NOSE_POINTS, SHANK_RINGS, build_body
-from cavex.analytic.penetration.oblique import CONTACT_RAMP, RTOL, ObliqueModel, Shot
+from cavex.analytic.penetration.oblique import CONTACT_RAMP, RTOL, ObliqueModel, Strike
 from cavex.analytic.penetration.stress_laws import make_law
 from cavex.config import load_config
 
-SHOT = Shot(800.0, obliquity=30.0)
+STRIKE = Strike(800.0, obliquity=30.0)
 CAVEX = str(Path(sys.executable).with_name("cavex"))  # the installed command
 COMMAND = ["trajectory", "--obliquity", "30", "--velocity", "800", "--json"]
 BEFORE = {"method": "RK45", "rtol": 1e-6, "atol": 1e-9, "contact_ramp": 0.1}  # the old default
 
 
-def run(target, projectile, law, body=None, shot=SHOT, **options):
+def run(target, projectile, law, body=None, strike=STRIKE, **options):
     model = ObliqueModel(target, projectile, law, body=body, **options)
     start, start_cpu = time.perf_counter(), time.process_time()
-    result = model.run(shot)
+    result = model.run(strike)
     wall, cpu = time.perf_counter() - start, time.process_time() - start_cpu
     steps = sum(s.t.size - 1 for s in result.solutions)
     return result, model, steps, wall, cpu
@@ -82,8 +82,9 @@ def series(label, rows):
 def spread(target, projectile, law):
     """Change of the end state under a one-ulp change of the striking speed: the
     sensitivity of the (piecewise smooth) trajectory to the integrator's step decisions."""
-    ends = [run(target, projectile, law, shot=replace(SHOT, speed=float(v)))[0].end
-            for v in (SHOT.speed, np.nextafter(SHOT.speed, 0.0), np.nextafter(SHOT.speed, 1e9))]
+    ends = [run(target, projectile, law, strike=replace(STRIKE, speed=float(v)))[0].end
+            for v in (STRIKE.speed, np.nextafter(STRIKE.speed, 0.0),
+                      np.nextafter(STRIKE.speed, 1e9))]
     z = np.array([e["nose_tip_m"][2] for e in ends])
     pitch = np.array([e["pitch_deg"] for e in ends])
     print(f"\none-ulp change of the speed: tip depth spread {np.ptp(z) / z[0]:.2e} relative, "

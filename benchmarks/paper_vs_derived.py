@@ -7,14 +7,11 @@ Run: ``python benchmarks/paper_vs_derived.py`` (the embedded default target, the
    and velocity.
 3. The cavity-wall stress of the paper model against the derived model, quasi-static and dynamic,
    with the paper's nose-tip layer switch and with the derived cavity switch.
-4. A sketch of the paper's penetration calculation (crater Eq. 34 with Eq. 29 concrete
-   coefficients, then Eq. 15 with the paper's C_A(L), C_B(L)) against its Table 2, for both
-   readings of eps. (The project's integrator lives elsewhere; this is only a check of the model.)
+4. The paper's penetration calculation (crater Eq. 34 with Eq. 29 concrete coefficients, then
+   Eq. 15 with the paper's C_A(L), C_B(L)), run by the project's integrator
+   (``cavex.analytic.penetration.integrator.penetrate``), against its Table 2, for both readings
+   of eps (``docs/table2.md`` runs every reading).
 """
-
-import math
-
-from scipy.integrate import solve_ivp
 
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
@@ -25,10 +22,12 @@ from cavex.analytic.paper_model import (
     layer_epsilon,
     paper_coefficients,
     paper_phase_depths,
-    paper_single_coefficients,
 )
+from cavex.analytic.penetration.integrator import penetrate
+from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.config import load_config
 from cavex.materials import Material, Projectile, Target
+from cavex.verification.studies.table2 import PAPER_TABLE2, table2_rows
 
 DEPTHS = (0.20, 0.45, 0.60, 0.63, 0.67, 0.90, 1.07, 1.12, 1.30)
 VELOCITIES = (300.0, 600.0, 1000.0)
@@ -156,52 +155,25 @@ def print_comparison(target, projectile):
     print()
 
 
-TABLE_2 = ((0.12, 894.7, 0.12), (0.40, 506.4, 0.53), (0.65, 284.3, 1.20), (0.79, 0.0, 2.40))
-
-
-def force_coefficients(coefficients, projectile):
-    """``C_A``, ``C_B`` of Eqs. (13)-(14)."""
-    psi, area = projectile.psi, math.pi * projectile.r ** 2
-    return (area * coefficients.tau * coefficients.A,
-            area * coefficients.rho * coefficients.B * (8 * psi - 1) / (24 * psi ** 2))
-
-
-def crater(target, projectile, epsilon):
-    """Eq. (34) with single-medium concrete (Eq. 29), ``Lc = 4.5 r + l`` (Table 2: 0.12 m)."""
-    c_a, c_b = force_coefficients(paper_single_coefficients(target.layers[0], epsilon), projectile)
-    m, v0, depth = projectile.m, projectile.V0, 4.5 * projectile.r + projectile.l
-    vc = math.sqrt((m * v0 ** 2 - depth * c_a) / (m + depth * c_b))
-    k = m * (v0 ** 2 - vc ** 2) / depth ** 2
-    return depth, vc, math.acos(vc / v0) / math.sqrt(k / m)
-
-
 def penetration_phases(target, projectile, epsilon):
-    """``(L, V, t)`` at the crater end, at ``L1``, at ``H1`` and at rest."""
-    depth, velocity, time = crater(target, projectile, epsilon)
+    """``{"depth_m", "velocity_m_s", "time_s"}`` at the crater end, at ``L1``, at ``H1`` and
+    at rest: the paper model (crater Lc = 4.5 r + l from the nose base) through the project's
+    integrator."""
+    resistance = ClosedFormResistance(target, projectile, "paper", epsilon=epsilon)
+    return table2_rows(penetrate(target, projectile, resistance, crater="nose-base"))
 
-    def rhs(_, y):
-        c_a, c_b = force_coefficients(paper_coefficients(target, projectile, y[0], epsilon),
-                                      projectile)
-        return [y[1], -(c_a + c_b * y[1] ** 2) / projectile.m]
 
-    marks = [paper_phase_depths(target, projectile, epsilon)["L1"], target.interface_depths[0]]
-    events = [lambda _, y, x=x: y[0] - x for x in marks] + [lambda _, y: y[1]]
-    events[-1].terminal = True
-    solution = solve_ivp(rhs, (time, time + 0.05), [depth, velocity], events=events,
-                         max_step=2e-6, rtol=1e-10, atol=1e-12)
-    rows = [(depth, velocity, time)]
-    for times, states in zip(solution.t_events, solution.y_events, strict=True):
-        rows += [(y[0], y[1], t) for t, y in zip(times[:1], states[:1], strict=True)]
-    return rows
+def format_ends(rows):
+    """``(L m, V m/s, t ms)`` of each row."""
+    return "  ".join(f"({row['depth_m']:.3f}, {row['velocity_m_s']:6.1f}, "
+                     f"{1e3 * row['time_s']:.2f})" for row in rows)
 
 
 def print_table_2(target, projectile):
-    print("Paper's penetration (sketch) against its Table 2: (L m, V m/s, t ms) at phase ends")
-    print("  Table 2     : " + "  ".join(f"({L:.3f}, {v:6.1f}, {t:.2f})" for L, v, t in TABLE_2))
+    print("Paper's penetration against its Table 2: (L m, V m/s, t ms) at phase ends")
+    print("  Table 2     : " + format_ends(PAPER_TABLE2))
     for epsilon in ("quasi-static", "cylindrical"):
-        rows = penetration_phases(target, projectile, epsilon)
-        print(f"  {epsilon:12s}: " + "  ".join(f"({L:.3f}, {v:6.1f}, {1e3 * t:.2f})"
-                                              for L, v, t in rows))
+        print(f"  {epsilon:12s}: " + format_ends(penetration_phases(target, projectile, epsilon)))
     print("  (phase ends: crater Lc = 4.5 r + l; b reaches H1 at L1; nose at H1; rest)")
     print()
 

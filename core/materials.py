@@ -134,6 +134,15 @@ class Target:
         """The semi-infinite target made of layer ``index`` alone."""
         return Target((self.layers[index],), ())
 
+    def layer_name(self, index):
+        """Display name of layer ``index`` (from 0, top down): its ``name``, else
+        ``"layer {index + 1}"``."""
+        return self.layers[index].name or f"layer {index + 1}"
+
+    def layer_names(self):
+        """:meth:`layer_name` of every layer, top down."""
+        return [self.layer_name(index) for index in range(len(self.layers))]
+
 
 DEFAULT_DENSITY = 7850.0  # kg/m^3, steel: the body's length when ``length`` is absent
 MAX_CALIBRES = 1000  # longest body, in shank diameters (long-rod penetrators: ~30)

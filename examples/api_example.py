@@ -7,7 +7,7 @@ numbers. SI units (Pa, m, s, kg), compression positive.
 from cavex import load_config
 from cavex.analytic import (
     ClosedFormResistance,
-    Shot,
+    Strike,
     cavity_stress,
     fly,
     penetrate,
@@ -46,7 +46,7 @@ def main():
     # 5. An oblique shot in 3-D (docs/oblique.md): 600 m/s at 20 deg, derived dynamic law
     #    along each surface element's normal, the default contact regularisation and
     #    integrator (about 0.2 s once the kernels are compiled)
-    shot = fly(target, projectile, Shot(600.0, obliquity=20.0))
+    shot = fly(target, projectile, Strike(600.0, obliquity=20.0))
     x, _, z = shot.end["nose_tip_m"]
     print(f"oblique shot: {shot.end['state']} with the nose tip at x = {x:.3f} m, "
           f"z = {z:.3f} m, pitch {shot.end['pitch_deg']:.2f} deg "

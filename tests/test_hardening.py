@@ -591,10 +591,10 @@ def test_ctrl_c_during_a_trajectory_run(tmp_path):
 
 
 def test_a_run_that_reaches_the_time_limit_ends_there():
-    from cavex.analytic.penetration.oblique import MAX_TIME, Shot, fly
+    from cavex.analytic.penetration.oblique import MAX_TIME, Strike, fly
 
     target, projectile = load_config()
-    result = fly(target.single(0), projectile, Shot(1000.0), "law", law_A=0.0, law_B=0.0)
+    result = fly(target.single(0), projectile, Strike(1000.0), "law", law_A=0.0, law_B=0.0)
     assert result.phases[-1]["end_reason"] == "time limit"
     assert result.end["state"] == "time limit" and result.end["time_s"] == MAX_TIME
     assert result.end["nose_tip_m"] == result.phases[-1]["end_nose_tip_m"]

@@ -93,6 +93,13 @@ def test_target_interface_depths_and_layer_lookup():
     assert target.single(1).layers == (layers[1],) and target.single(1).thicknesses == ()
 
 
+def test_target_layer_names_are_names_or_numbers_from_one():
+    named = Material(**GOOD_MATERIAL, name="concrete")
+    target = Target([named, Material(**GOOD_MATERIAL), named], [0.65, 0.45])
+    assert target.layer_names() == ["concrete", "layer 2", "concrete"]
+    assert target.layer_name(1) == "layer 2"
+
+
 @pytest.mark.parametrize(("thicknesses", "parameter", "accepted"), [
     ([0.0, 0.45], "layers[0].thickness", "> 0"),
     ([0.65, -0.1], "layers[1].thickness", "> 0"),

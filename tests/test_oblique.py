@@ -10,7 +10,7 @@ from cavex.analytic.cavity import cavity_stress
 from cavex.analytic.penetration.body import build_body
 from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.nose import ogive_coefficients
-from cavex.analytic.penetration.oblique import ObliqueModel, Shot, fly
+from cavex.analytic.penetration.oblique import ObliqueModel, Strike, fly
 from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.analytic.penetration.stress_laws import DerivedLaw, make_law
 from cavex.analytic.penetration.surface_force import rotation_matrix
@@ -101,7 +101,7 @@ def _one_layer_normal(runway, boundary, method="DOP853", rtol=1e-10):
     law = make_law(single, projectile, "derived", boundary=boundary, free_surface=False)
     model = ObliqueModel(single, projectile, law, body=body, rtol=rtol, atol=1e-3 * rtol,
                          method=method, contact_ramp=0.0)
-    result = model.run(Shot(projectile.V0, tip_depth=start))
+    result = model.run(Strike(projectile.V0, tip_depth=start))
     one_d = penetrate(single, projectile, ClosedFormResistance(single, projectile, "derived",
                                                                 boundary), crater=None)
     return start, result, one_d
@@ -142,14 +142,14 @@ def test_normal_incidence_one_layer_is_the_1d_tunnel(runway, boundary, method, r
     assert final == pytest.approx(one_d.depth[-1], rel=5e-6)
 
 
-SHOT = Shot(600.0, obliquity=20.0, attack=2.0)
+STRIKE = Strike(600.0, obliquity=20.0, attack=2.0)
 
 
 def test_plane_symmetric_shot_stays_in_its_plane_and_mirrors(runway):
     target, projectile = runway
-    a = fly(target, projectile, SHOT, "law", law_A=2e8, law_B=2500.0,
+    a = fly(target, projectile, STRIKE, "law", law_A=2e8, law_B=2500.0,
             contact_ramp=1.0)
-    b = fly(target, projectile, Shot(600.0, obliquity=-20.0, attack=2.0), "law", law_A=2e8,
+    b = fly(target, projectile, Strike(600.0, obliquity=-20.0, attack=2.0), "law", law_A=2e8,
             law_B=2500.0, contact_ramp=1.0)
     h = a.history
     # out-of-plane (round-off): measured y 0 m, omega_x, omega_z 2.5e-8 rad/s
@@ -174,9 +174,9 @@ def test_mirror_shot_with_spin_and_attack_plane_is_exact(runway):
     is the mirror image of the shot to the last bit, state by state at every step."""
     target, projectile = runway
     options = {"law_A": 2e8, "law_B": 2500.0, "contact_ramp": 1.0}
-    a = fly(target, projectile, Shot(650.0, obliquity=35.0, attack=4.0, attack_plane=60.0,
+    a = fly(target, projectile, Strike(650.0, obliquity=35.0, attack=4.0, attack_plane=60.0,
                                      spin=300.0), "law", **options)
-    b = fly(target, projectile, Shot(650.0, obliquity=-35.0, attack=4.0, attack_plane=60.0,
+    b = fly(target, projectile, Strike(650.0, obliquity=-35.0, attack=4.0, attack_plane=60.0,
                                      spin=-300.0), "law", **options)
     from cavex.analytic.penetration.surface_force import mirror_state
     ya = np.concatenate([s.y for s in a.solutions], axis=1)
@@ -191,9 +191,9 @@ def test_work_of_surface_forces_is_the_kinetic_energy_lost(runway):
     from dataclasses import replace
     target, projectile = runway
     projectile = replace(projectile, mu=0.1)
-    shot = Shot(700.0, obliquity=30.0, attack=3.0, attack_plane=40.0, spin=500.0)
+    strike = Strike(700.0, obliquity=30.0, attack=3.0, attack_plane=40.0, spin=500.0)
     # the reference integrator (the compiled default's energy balance: the next test)
-    result = fly(target.single(0), projectile, shot, "law", law_A=2e8, law_B=2500.0,
+    result = fly(target.single(0), projectile, strike, "law", law_A=2e8, law_B=2500.0,
                  contact_ramp=1.0, method="RK45", rtol=1e-6, atol=1e-9)
     # measured 9.6e-10 relative (RK45, rtol 1e-6: the work is integrated with the state)
     assert abs(_work_mismatch(result)) < 1e-6
@@ -216,8 +216,8 @@ def test_compiled_integrator_energy_balance_converges(runway):
     from dataclasses import replace
     target, projectile = runway
     projectile = replace(projectile, mu=0.1)
-    shot = Shot(700.0, obliquity=30.0, attack=3.0, attack_plane=40.0, spin=500.0)
-    mismatch = [abs(_work_mismatch(fly(target.single(0), projectile, shot, "law", law_A=2e8,
+    strike = Strike(700.0, obliquity=30.0, attack=3.0, attack_plane=40.0, spin=500.0)
+    mismatch = [abs(_work_mismatch(fly(target.single(0), projectile, strike, "law", law_A=2e8,
                                        law_B=2500.0, rtol=r, atol=1e-3 * r)))
                 for r in (1e-3, 1e-5)]
     print("work-energy mismatch at rtol 1e-3, 1e-5:", mismatch)
@@ -231,10 +231,10 @@ def test_compiled_integrator_agrees_with_the_reference(runway):
     depth -5.8e-5 relative and pitch -0.0055 deg against RK45 at rtol 1e-6 and at 1e-7 alike
     (19 200 steps against 513)."""
     target, projectile = runway
-    shot = Shot(600.0, obliquity=20.0)
+    strike = Strike(600.0, obliquity=20.0)
     law = {"law_A": 2e8, "law_B": 2500.0, "contact_ramp": 0.1}
-    compiled = fly(target.single(0), projectile, shot, "law", **law)
-    reference = fly(target.single(0), projectile, shot, "law", method="RK45", rtol=1e-6,
+    compiled = fly(target.single(0), projectile, strike, "law", **law)
+    reference = fly(target.single(0), projectile, strike, "law", method="RK45", rtol=1e-6,
                     atol=1e-9, **law)
     depth = compiled.end["nose_tip_m"][2] / reference.end["nose_tip_m"][2] - 1.0
     pitch = compiled.end["pitch_deg"] - reference.end["pitch_deg"]
@@ -257,13 +257,13 @@ def test_surface_discretisation_converges(runway, contact_ramp, order):
     elements: benchmarks/oblique_speed.py, docs/oblique.md)."""
     target, projectile = runway
     law = make_law(target, projectile, "derived")
-    shot = Shot(800.0, obliquity=30.0, attack=3.0, attack_plane=30.0)
+    strike = Strike(800.0, obliquity=30.0, attack=3.0, attack_plane=30.0)
     levels = (8, 16, 32, 128)
     forces = []
     for f in levels:
         body = build_body(projectile, nose_points=2 * f, azimuths=4 * f, shank_rings=2 * f)
         model = ObliqueModel(target, projectile, law, body=body, contact_ramp=contact_ramp)
-        y = model.initial_state(shot)
+        y = model.initial_state(strike)
         y[2] += 0.07  # nose tip 7 cm deep: the body crosses the free surface
         y[10:13] = [50.0, 200.0, -100.0]
         forces.append(model.loads(y)[0])
@@ -286,8 +286,8 @@ def test_default_runway_at_normal_incidence_against_the_1d_integrator(runway):
 
     target, projectile = runway
     projectile = replace(projectile, V0=400.0)
-    three_d = fly(target, projectile, Shot(400.0)).end["nose_tip_m"][2]
-    without = fly(target, projectile, Shot(400.0), free_surface=False).end["nose_tip_m"][2]
+    three_d = fly(target, projectile, Strike(400.0)).end["nose_tip_m"][2]
+    without = fly(target, projectile, Strike(400.0), free_surface=False).end["nose_tip_m"][2]
     resistance = ClosedFormResistance(target, projectile, "derived", "dynamic")
     crater = penetrate(target, projectile, resistance).depth[-1]
     tunnel = penetrate(target, projectile, resistance, crater=None).depth[-1]
@@ -303,7 +303,7 @@ def test_events_end_each_phase_where_they_say(runway):
     integration exactly on their event surfaces (to the root finder's tolerance)."""
     target, projectile = runway
     law = {"law_A": 2e8, "law_B": 2500.0, "contact_ramp": 1.0}
-    deep = fly(target, projectile, Shot(900.0, obliquity=10.0), "law", **law)
+    deep = fly(target, projectile, Strike(900.0, obliquity=10.0), "law", **law)
     crossings = [ph for ph in deep.phases if ph["end_reason"].startswith("nose tip crossed")]
     assert len(crossings) == 2
     for phase, H in zip(crossings, target.interface_depths, strict=True):
@@ -311,7 +311,7 @@ def test_events_end_each_phase_where_they_say(runway):
     assert [ph["label"] for ph in deep.phases] == ["concrete", "macadam", "soil"]
     assert deep.end["state"] == "stopped"
 
-    grazing = fly(target.single(0), projectile, Shot(300.0, obliquity=75.0), "law", **law)
+    grazing = fly(target.single(0), projectile, Strike(300.0, obliquity=75.0), "law", **law)
     reasons = [ph["end_reason"] for ph in grazing.phases]
     assert reasons == ["axis parallel to the surface",
                        "ricochet: left the target through the entry face"]
@@ -320,7 +320,7 @@ def test_events_end_each_phase_where_they_say(runway):
     assert grazing.end["state"] == "ricochet"
     assert _extreme_depths(grazing.model, end)[0] == pytest.approx(0.0, abs=1e-9)
 
-    through = fly(target.single(0), projectile, Shot(600.0, obliquity=20.0), "law",
+    through = fly(target.single(0), projectile, Strike(600.0, obliquity=20.0), "law",
                   bottom=0.3, **law)
     end = through.solutions[-1].y[:, -1]
     assert through.end["state"] == "perforation"
@@ -363,7 +363,7 @@ def test_table_law_survives_integrator_stages_beyond_the_table(runway):
 
     target, projectile = runway
     grid = Path(__file__).resolve().parents[1] / "results" / "verification" / "grid.nc"
-    result = fly(target, projectile, Shot(600.0, obliquity=20.0), "table",
+    result = fly(target, projectile, Strike(600.0, obliquity=20.0), "table",
                  table=load_table(grid), contact_ramp=1.0)
     assert result.end["state"] == "stopped"
     # the accepted states: every surface element's normal velocity within the table (the
@@ -376,8 +376,8 @@ def test_a_model_run_twice_gives_the_same_bits(runway):
     target, projectile = runway
     model = ObliqueModel(target, projectile, make_law(target, projectile, "law", law_A=2e8,
                                                       law_B=2500.0))
-    first = model.run(Shot(600.0, obliquity=20.0))
-    model.run(Shot(900.0, obliquity=40.0))
-    again = model.run(Shot(600.0, obliquity=20.0))
+    first = model.run(Strike(600.0, obliquity=20.0))
+    model.run(Strike(900.0, obliquity=40.0))
+    again = model.run(Strike(600.0, obliquity=20.0))
     assert np.array_equal(first.history["t_s"], again.history["t_s"])
     assert first.end == again.end

@@ -13,6 +13,7 @@ Measured on this machine with the default ``rtol=1e-9, atol=1e-12`` (DOP853):
 - phase ends at the closed-form depths L1, H1 + l - r, H1, L3, H2, L4, H2 + l - r within 6e-14 m.
 """
 
+import inspect
 import math
 
 import numpy as np
@@ -25,11 +26,14 @@ from cavex.analytic.penetration.integrator import (
     crater_depth,
     crater_exit,
     crater_stage,
+    integrate,
     penetrate,
 )
-from cavex.analytic.penetration.resistance import ClosedFormResistance
+from cavex.analytic.penetration.resistance import ClosedFormResistance, Resistance
+from cavex.analytic.penetration.tabulated import TabulatedResistance
 from cavex.config import load_config
 from cavex.materials import Material, Projectile
+from cavex.verification.studies.table2_study import CraterAsTunnel, Reading, ReadingResistance
 
 # Event depths are roots located by solve_ivp's brentq (xtol 4 eps) on the dense output:
 # measured <= 6e-14 m off; 1e-9 m is the requirement of the brief and far above round-off.
@@ -117,6 +121,46 @@ def test_tunnel_stage_matches_exact_constant_coefficient_solution(single):
     # deceleration column is F/m at the same state
     assert trajectory.deceleration == pytest.approx(
         (c_a + c_b * trajectory.velocity ** 2) / m, rel=1e-14)
+
+
+def test_integrate_from_a_start_state_matches_exact_solution(single):
+    """One stretch from a mid-flight state: to a stop depth, then from there to rest."""
+    target, projectile, resistance, c_a, c_b = single
+    m, ratio = projectile.m, c_a / c_b
+    t0, depth0, v0 = 1e-4, 0.3, 600.0
+    stop_depth = 0.5
+    end, sol = integrate(resistance, m, (t0, depth0, v0), stop_depth=stop_depth,
+                         stop_reason="there")
+    v2 = (ratio + v0 ** 2) * math.exp(-2.0 * c_b * (stop_depth - depth0) / m) - ratio
+    assert (end.label, end.end_reason) == (None, "there")
+    assert end.end_depth == pytest.approx(stop_depth, abs=EVENT_DEPTH_TOL)
+    assert end.end_velocity ** 2 == pytest.approx(v2, rel=1e-9)
+    assert sol.t[0] == t0
+    rest, _ = integrate(resistance, m, (end.end_time, end.end_depth, end.end_velocity),
+                        label=resistance.label(end.end_depth, end.end_velocity))
+    assert (rest.end_reason, rest.end_velocity) == ("projectile stopped", 0.0)
+    stop_time = t0 + m / math.sqrt(c_a * c_b) * math.atan(v0 * math.sqrt(c_b / c_a))
+    assert rest.end_time == pytest.approx(stop_time, rel=1e-9)
+    assert rest.end_depth == pytest.approx(
+        depth0 + m / (2.0 * c_b) * math.log1p(c_b * v0 ** 2 / c_a), rel=1e-9)
+
+
+@pytest.mark.parametrize("implementation", [ClosedFormResistance, TabulatedResistance,
+                                            ReadingResistance, CraterAsTunnel])
+def test_resistances_implement_the_protocol(implementation):
+    assert issubclass(implementation, Resistance)
+    for name in ("force", "label", "crater_force"):
+        assert getattr(implementation, name) is not getattr(Resistance, name)  # not inherited
+        assert (list(inspect.signature(getattr(implementation, name)).parameters)
+                == list(inspect.signature(getattr(Resistance, name)).parameters))
+
+
+def test_resistance_instances_pass_the_runtime_check(default):
+    target, projectile = default
+    reading = ReadingResistance(target, projectile, Reading("base"))
+    for resistance in (ClosedFormResistance(target, projectile), reading,
+                       CraterAsTunnel(reading, 0.1)):
+        assert isinstance(resistance, Resistance)
 
 
 @pytest.mark.parametrize("crater", ["nose-base", "nose-tip"])

@@ -9,7 +9,7 @@ import matplotlib.image
 import numpy as np
 import pytest
 
-from cavex.analytic.penetration.oblique import Shot, fly
+from cavex.analytic.penetration.oblique import Strike, fly
 from cavex.config import load_config
 from cavex.verification.cli import main
 from cavex.verification.studies.oblique_study import RAMPS, findings, overload_peaks, table_csv
@@ -31,10 +31,10 @@ def test_files_figures_and_json_hold_the_api_trajectory(command_run, capsys):
     assert main(args) == 0
     document = json.loads(capsys.readouterr().out)
     target, projectile = load_config()
-    shot = Shot(500.0, obliquity=25.0)
-    api = fly(target, projectile, shot, "law", law_A=2e8, law_B=2500.0,
+    strike = Strike(500.0, obliquity=25.0)
+    api = fly(target, projectile, strike, "law", law_A=2e8, law_B=2500.0,
             contact_ramp=1.0)
-    single = fly(target.single(0), projectile, shot, "law", law_A=2e8, law_B=2500.0,
+    single = fly(target.single(0), projectile, strike, "law", law_A=2e8, law_B=2500.0,
             contact_ramp=1.0)
     # the same code on the same data: the same numbers
     assert document["end"]["nose_tip_m"] == api.end["nose_tip_m"]
@@ -68,7 +68,7 @@ def test_no_figures_writes_the_same_numbers_without_pictures(command_run, tmp_pa
         "history_first_layer_only.csv", "history_runway.csv", "summary.json"]
     assert sorted(document["outputs"]) == sorted(str(p) for p in out.iterdir())
     target, projectile = load_config()
-    api = fly(target, projectile, Shot(500.0, obliquity=25.0), "law", law_A=2e8, law_B=2500.0,
+    api = fly(target, projectile, Strike(500.0, obliquity=25.0), "law", law_A=2e8, law_B=2500.0,
               contact_ramp=1.0)
     assert document["end"] == api.end
 
@@ -131,7 +131,7 @@ def test_progress_is_called_once_per_step():
     """``fly(progress=...)`` is called after every integrator step (the command's bar)."""
     target, projectile = load_config()
     seen = []
-    result = fly(target, projectile, Shot(500.0, obliquity=15.0), "law", law_A=2e8,
+    result = fly(target, projectile, Strike(500.0, obliquity=15.0), "law", law_A=2e8,
                  law_B=2500.0, contact_ramp=1.0, progress=lambda t, y: seen.append(t))
     steps = sum(s.t.size - 1 for s in result.solutions)
     assert len(seen) == steps

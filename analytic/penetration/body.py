@@ -14,10 +14,10 @@ The shank is the cylinder ``rho = r`` from ``l_n`` to the overall length, normal
 ``(0, cos(theta), sin(theta))``. The flat tail face is not discretised (it faces backwards:
 it meets target material only in a tail slap or a ricochet, outside this model).
 
-Surface quadrature: Gauss-Legendre in ``phi`` (the rule of
-:func:`cavex.analytic.penetration.nose.nose_rule`,
-so that an axisymmetric stress field gives the 1-D nose force to round-off), the midpoint rule
-in ``theta`` and in the shank's axial coordinate. The azimuths are placed in mirror pairs
+Surface quadrature: Gauss-Legendre in ``phi`` (:func:`cavex.analytic.penetration.nose.angle_rule`,
+the rule of the 1-D nose force :func:`~cavex.analytic.penetration.nose.nose_rule`, so that an
+axisymmetric stress field gives the 1-D nose force to round-off), the midpoint rule in ``theta``
+and in the shank's axial coordinate. The azimuths are placed in mirror pairs
 ``theta_k = (k + 1/2) 2 pi / n`` and ``-theta_k`` (computed as the negative, so that the pair's
 coordinates are exact mirrors); ``partners`` maps each element to its mirror image. Each
 element carries its centroid, normal, area and a size ``h = sqrt(area)`` (the depth band
@@ -35,9 +35,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import quad
 
+from cavex.analytic.penetration.nose import QUADRATURE_POINTS, angle_rule
 from cavex.errors import require
 
-NOSE_POINTS = 8
+NOSE_POINTS = QUADRATURE_POINTS  # the 1-D nose force's rule: the same nodes in phi
 AZIMUTHS = 16
 SHANK_RINGS = 16
 
@@ -138,11 +139,8 @@ def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rin
     cg = projectile.cg if projectile.cg is not None else cg_uniform
     if projectile.inertia is not None:
         transverse = projectile.inertia
-    s0 = (R - r) / R
-    phi0 = math.asin(s0)
-    nodes, weights = np.polynomial.legendre.leggauss(nose_points)
-    phi = phi0 + (0.5 * math.pi - phi0) * 0.5 * (nodes + 1.0)
-    dphi = weights * 0.5 * (0.5 * math.pi - phi0)
+    phi, weights, jacobian = angle_rule(float(R), float(r), nose_points)
+    dphi = weights * jacobian
     k = np.arange(azimuths)
     half = (k + 0.5 < 0.5 * azimuths)
     theta = np.where(half, (k + 0.5) * 2.0 * math.pi / azimuths,

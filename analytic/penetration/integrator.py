@@ -10,7 +10,11 @@ the nose tip (``crater="nose-tip"``).
 
 Tunnel: ``m dV/dt = -F(L, V)``, ``dL/dt = V`` with ``scipy.integrate.solve_ivp``; a phase ends
 (terminal event) where the response-state label of the resistance changes, where the nose tip
-crosses an interface depth ``H_i``, or where ``V = 0``.
+crosses an interface depth ``H_i``, or where ``V = 0``. :func:`integrate` runs one such stretch
+from any start state ``(t0, L0, V0)``; :func:`penetrate` chains them, and the Table 2 study runs
+it from the paper's own row states.
+
+The resistance is any :class:`~cavex.analytic.penetration.resistance.Resistance`.
 """
 
 import math
@@ -26,12 +30,15 @@ CRATER_MODES = ("nose-base", "nose-tip")
 CRATER_RATIO = 4.5
 STOPPED = "projectile stopped"
 STATE_CHANGED = "response state changed"
+DEPTH_REACHED = "stop depth reached"
+RTOL, ATOL = 1e-9, 1e-12  # solve_ivp's tolerances
 MAX_PHASE_DURATION = 10.0  # s; a phase that has not ended by then is a numerical failure
 
 
 @dataclass(frozen=True)
 class Phase:
-    """One phase of the trajectory: its label and where and when it ends."""
+    """One phase of the trajectory: its label (None where :func:`integrate` did not watch the
+    state) and where and when it ends."""
 
     label: str
     end_depth: float
@@ -93,14 +100,13 @@ def crater_stage(projectile, force, depth, samples=50):
     return (t, depths, velocity, stiffness * depths / projectile.m), tc, vc
 
 
-def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=1e-9, atol=1e-12):
+def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, atol=ATOL):
     """Integrate the projectile through the target.
 
     Parameters
     ----------
     target, projectile : Target, Projectile
-    resistance : object
-        Has ``force(depth, velocity)``, ``label(depth, velocity)`` and ``crater_force(velocity)``.
+    resistance : Resistance
     crater : {"nose-base", "nose-tip"}
         Where the crater depth ``4.5 r`` is measured from; ``None`` skips the crater stage.
 
@@ -121,44 +127,82 @@ def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=1e-9, 
 
 
 def _tunnel(target, projectile, resistance, start, columns, phases, rtol, atol):
-    t0, depth0, v0 = start
-    m = projectile.m
-    label = resistance.label(depth0, v0)
-
-    def rhs(t, y):
-        return (y[1], -resistance.force(y[0], max(y[1], 0.0)) / m)
-
-    ahead = [H for H in target.interface_depths if H > depth0]
-    while v0 > 0.0:
-        events = _phase_events(resistance, ahead, len(target.interface_depths), label)
-        sol = solve_ivp(rhs, (t0, t0 + MAX_PHASE_DURATION), (depth0, v0),
-                        method="DOP853", events=[e for e, _ in events], dense_output=True,
-                        rtol=rtol, atol=atol)
-        if sol.status != 1:
-            raise CavexNumericalError(f"penetration integration failed at t={sol.t[-1]} s, "
-                                      f"depth {sol.y[0, -1]} m: {sol.message}")
-        which = next(i for i, te in enumerate(sol.t_events) if te.size)
-        t_end, (depth_end, v_end) = sol.t_events[which][0], sol.y_events[which][0]
-        reason = events[which][1]
-        if reason == STATE_CHANGED and ahead and abs(depth_end - ahead[0]) <= 1e-12 * ahead[0]:
-            reason = events[1][1]  # a state change at the interface itself (nose-tip switch)
-        if reason == STOPPED:
-            v_end = 0.0
-        elif reason.startswith("nose tip"):
+    """Phases from ``start = (t0, L0, V0)`` to rest, each ended by :func:`integrate`."""
+    label = resistance.label(start[1], start[2])
+    ahead = [H for H in target.interface_depths if H > start[1]]
+    while start[2] > 0.0:
+        stop_depth, stop_reason = None, None
+        if ahead:
+            number = len(target.interface_depths) - len(ahead) + 1
+            stop_depth, stop_reason = ahead[0], f"nose tip reached interface {number}"
+        phase, sol = integrate(resistance, projectile.m, start, stop_depth=stop_depth,
+                               stop_reason=stop_reason, label=label, rtol=rtol, atol=atol)
+        if phase.end_reason == stop_reason:
             ahead.pop(0)
-        _append_solution(columns, sol, t_end, rhs, len(phases))
-        phases.append(Phase(label, depth_end, v_end, t_end, reason))
-        t0, depth0, v0 = t_end, depth_end, v_end
-        if v0 > 0.0:
-            label = _next_label(resistance, sol, t_end, label)
+        _append_solution(columns, sol, phase.end_time, resistance, projectile.m, len(phases))
+        phases.append(phase)
+        start = (phase.end_time, phase.end_depth, phase.end_velocity)
+        if start[2] > 0.0:
+            label = _next_label(resistance, sol, phase.end_time, label)
     return _trajectory(columns, phases)
 
 
-def _phase_events(resistance, ahead, n_interfaces, label):
-    """Terminal events of one tunnel phase, each with the reason it ends the phase.
+def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REACHED,
+              label=None, rtol=RTOL, atol=ATOL):
+    r"""Integrate ``m dV/dt = -F(L, V)``, ``dL/dt = V`` from ``start = (t0, L0, V0)`` to the first
+    of: rest (``V = 0``), the nose tip at ``stop_depth``, the response state leaving ``label``.
 
-    ``ahead`` are the interface depths not yet crossed by the nose tip (only the next counts).
+    ``scipy.integrate.solve_ivp`` (DOP853, dense output) with a terminal event for each end.
+
+    Parameters
+    ----------
+    resistance : Resistance
+        Its ``force`` drives the motion, its ``label`` is watched when ``label`` is given.
+    mass : float
+        Projectile mass ``m`` (kg).
+    start : tuple of float
+        ``(t0, L0, V0)``: time (s), nose-tip depth (m), velocity (m/s) > 0.
+    stop_depth : float, optional
+        Nose-tip depth (m) at which the integration ends (None: not watched), with the reason
+        ``stop_reason``; a state change at that depth (to 1e-12 relative) is reported as
+        reaching it.
+    label : str, optional
+        The response-state label of the start; the integration ends where
+        ``resistance.label`` differs from it (None: the state is not watched).
+    rtol, atol : float
+        Tolerances of ``solve_ivp``.
+
+    Returns
+    -------
+    (Phase, scipy.integrate.OdeResult)
+        The end (``end_velocity`` exactly 0 at rest; ``label`` as given) and the solution,
+        whose ``sol`` interpolates inside the phase.
     """
+    t0, depth0, v0 = start
+
+    def rhs(t, y):
+        return (y[1], -resistance.force(y[0], max(y[1], 0.0)) / mass)
+
+    events = _phase_events(resistance, stop_depth, stop_reason, label)
+    sol = solve_ivp(rhs, (t0, t0 + MAX_PHASE_DURATION), (depth0, v0),
+                    method="DOP853", events=[e for e, _ in events], dense_output=True,
+                    rtol=rtol, atol=atol)
+    if sol.status != 1:
+        raise CavexNumericalError(f"penetration integration failed at t={sol.t[-1]} s, "
+                                  f"depth {sol.y[0, -1]} m: {sol.message}")
+    which = next(i for i, te in enumerate(sol.t_events) if te.size)
+    t_end, (depth_end, v_end) = sol.t_events[which][0], sol.y_events[which][0]
+    reason = events[which][1]
+    if (reason == STATE_CHANGED and stop_depth is not None
+            and abs(depth_end - stop_depth) <= 1e-12 * stop_depth):
+        reason = stop_reason  # a state change at the stop depth itself (nose-tip switch)
+    if reason == STOPPED:
+        v_end = 0.0
+    return Phase(label, depth_end, v_end, t_end, reason), sol
+
+
+def _phase_events(resistance, stop_depth, stop_reason, label):
+    """Terminal events of one phase, each with the reason it ends the phase."""
 
     def stopped(t, y):
         return y[1]
@@ -168,10 +212,10 @@ def _phase_events(resistance, ahead, n_interfaces, label):
 
     stopped.direction = state_changed.direction = -1.0
     events = [(stopped, STOPPED)]
-    if ahead:  # before the state change: where both coincide, the interface names the phase end
-        number = n_interfaces - len(ahead) + 1
-        events.append((_depth_event(ahead[0]), f"nose tip reached interface {number}"))
-    events.append((state_changed, STATE_CHANGED))
+    if stop_depth is not None:  # before the state change: where both coincide, the depth
+        events.append((_depth_event(stop_depth), stop_reason))  # names the phase end
+    if label is not None:
+        events.append((state_changed, STATE_CHANGED))
     for event, _ in events:
         event.terminal = True
     return events
@@ -201,10 +245,10 @@ def _append(columns, t, depth, velocity, deceleration, phase):
         column.append(np.asarray(values, dtype=float))
 
 
-def _append_solution(columns, sol, t_end, rhs, phase):
+def _append_solution(columns, sol, t_end, resistance, mass, phase):
     t = np.append(sol.t[sol.t < t_end], t_end)
     y = sol.sol(t)
-    deceleration = np.array([-rhs(ti, yi)[1] for ti, yi in zip(t, y.T, strict=True)])
+    deceleration = np.array([resistance.force(depth, max(v, 0.0)) / mass for depth, v in y.T])
     _append(columns, t, y[0], np.maximum(y[1], 0.0), deceleration, phase)
 
 

@@ -37,12 +37,27 @@ def nose_rule(projectile, points=QUADRATURE_POINTS):
 
 
 @lru_cache(maxsize=64)
-def _rule(R, r, points):
-    s0 = (R - r) / R
-    phi0 = math.asin(s0)
+def angle_rule(R, r, points=QUADRATURE_POINTS):
+    r"""Gauss-Legendre rule in the angle ``phi`` of the ogive's normal over ``[phi_0, pi/2]``,
+    ``phi_0 = asin((R - r)/R)``: ``int f(phi) dphi ~ sum_k f(phi_k) g_k J``.
+
+    Returns ``(phi_k, g_k, J)``: the nodes, the Legendre weights on ``[-1, 1]`` and the
+    Jacobian ``J = (pi/2 - phi_0)/2`` (read-only arrays). The nose force
+    (:func:`nose_rule`) and the 3-D body's surface elements
+    (:func:`cavex.analytic.penetration.body.build_body`) both use it.
+    """
+    phi0 = math.asin((R - r) / R)
     nodes, weights = np.polynomial.legendre.leggauss(points)
     phi = phi0 + (0.5 * math.pi - phi0) * 0.5 * (nodes + 1.0)
-    jacobian = 0.5 * (0.5 * math.pi - phi0)
+    for array in (phi, weights):
+        array.setflags(write=False)
+    return phi, weights, 0.5 * (0.5 * math.pi - phi0)
+
+
+@lru_cache(maxsize=64)
+def _rule(R, r, points):
+    s0 = (R - r) / R
+    phi, weights, jacobian = angle_rule(R, r, points)
     w = 2.0 * math.pi * R ** 2 * (np.sin(phi) - s0) * np.cos(phi) * weights * jacobian
     cosines = np.cos(phi)
     cosines.setflags(write=False)

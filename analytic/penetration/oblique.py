@@ -65,17 +65,18 @@ CONTACT_RAMP = 0.01
 
 
 # ------------------------------------------------------------------------------------------
-# Shot set-up
+# Strike set-up
 # ------------------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
-class Shot:
-    """Striking conditions. Angles in degrees: ``obliquity`` between the velocity and the
-    target normal (+z; negative: the mirror shot, velocity toward -x), ``attack`` between the
-    axis and the velocity, turned in the plane at ``attack_plane`` about the velocity (0: in
-    the plane of obliquity, nose toward +x / the surface; 90: toward +y). ``spin`` (rad/s)
-    about the axis. ``tip_depth``: initial nose-tip depth (m); None: the body's deepest point
-    just touches the surface."""
+class Strike:
+    """Striking conditions of one shot (a measured test is
+    :class:`cavex.verification.validation.shots.Shot`). Angles in degrees: ``obliquity``
+    between the velocity and the target normal (+z; negative: the mirror shot, velocity toward
+    -x), ``attack`` between the axis and the velocity, turned in the plane at ``attack_plane``
+    about the velocity (0: in the plane of obliquity, nose toward +x / the surface; 90: toward
+    +y). ``spin`` (rad/s) about the axis. ``tip_depth``: initial nose-tip depth (m); None: the
+    body's deepest point just touches the surface."""
 
     speed: float
     obliquity: float = 0.0
@@ -223,25 +224,25 @@ class ObliqueModel:
         return dy
 
     # -- kinematics -----------------------------------------------------------------------
-    def initial_state(self, shot):
+    def initial_state(self, strike):
         """State at first contact. A negative obliquity is the mirror image (``x -> -x``) of
         the shot at ``|obliquity|`` and opposite spin, built by :func:`mirror_state` so that
         the two trajectories are mirrors to the last bit."""
-        if shot.obliquity < 0.0:
+        if strike.obliquity < 0.0:
             return mirror_state(self.initial_state(
-                replace(shot, obliquity=-shot.obliquity, spin=-shot.spin)))
-        d, axis, e2, e3 = shot.initial_axes()
+                replace(strike, obliquity=-strike.obliquity, spin=-strike.spin)))
+        d, axis, e2, e3 = strike.initial_axes()
         rot = np.column_stack([axis, e2, e3])
         q = quaternion_from_matrix(rot)
         rot = rotation_matrix(q)
         tip_offset = rot @ self._tip
         x = -tip_offset  # nose tip above the origin
-        if shot.tip_depth is None:  # the deepest point of the body on the surface
+        if strike.tip_depth is None:  # the deepest point of the body on the surface
             x[2] = -max(float((self._p @ rot.T)[:, 2].max()), float(tip_offset[2]))
         else:
-            x[2] += shot.tip_depth
-        v = shot.speed * d
-        omega = np.array([shot.spin, 0.0, 0.0])
+            x[2] += strike.tip_depth
+        v = strike.speed * d
+        omega = np.array([strike.spin, 0.0, 0.0])
         return np.concatenate([x, q, v, omega, [0.0]])
 
     def energy(self, y):
@@ -279,12 +280,12 @@ class ObliqueModel:
         return event_values(y, self.body.mass, self._inertia, args,
                             np.empty(len(self.target.interface_depths) + 4))
 
-    def run(self, shot, max_phases=50, progress=None):
-        """Integrate ``shot`` to a final event; returns a :class:`Result`. ``progress``:
+    def run(self, strike, max_phases=50, progress=None):
+        """Integrate ``strike`` to a final event; returns a :class:`Result`. ``progress``:
         optional ``callable(t, y)`` called after every integrator step."""
-        y = self.initial_state(shot)
+        y = self.initial_state(strike)
         self._step = None  # every run starts afresh: the same shot, the same bits
-        self._min_step = MIN_STEP * self.body.length / shot.speed
+        self._min_step = MIN_STEP * self.body.length / strike.speed
         directions, described, args = self._events(y)
         g = self.event_values(y, args)
         for k, (_, crossing, _) in enumerate(described):  # the next crossing is away from
@@ -306,8 +307,8 @@ class ObliqueModel:
             phases.append(self._phase(label, t0, y, reason))
             if crossing:
                 if interface is not None:  # the layer the tip has just entered
-                    label = self.layer_name(interface + 1 if directions[which] > 0
-                                            else interface)
+                    label = self.target.layer_name(interface + 1 if directions[which] > 0
+                                                   else interface)
                 directions[which] = -directions[which]
             else:
                 break
@@ -375,11 +376,8 @@ class ObliqueModel:
             return sol, None
         return sol, next(i for i, te in enumerate(sol.t_events) if te.size)
 
-    def layer_name(self, layer):
-        return self.target.layers[layer].name or f"layer {layer + 1}"
-
     def phase_label(self, y):
-        return self.layer_name(self.target.layer_at(max(self.tip(y)[2], 0.0)))
+        return self.target.layer_name(self.target.layer_at(max(self.tip(y)[2], 0.0)))
 
     def _phase(self, label, t, y, reason):
         end = self._end_state(y, t, reason)
@@ -435,16 +433,16 @@ class ObliqueModel:
         return history
 
 
-def fly(target, projectile, shot=None, resistance="derived", *, body=None, bottom=None,
+def fly(target, projectile, strike=None, resistance="derived", *, body=None, bottom=None,
         rtol=RTOL, atol=ATOL, method=METHOD, contact_ramp=None, progress=None,
         **law_options):
-    """One trajectory: :class:`Result` of ``shot`` (default: normal incidence at ``V0``);
+    """One trajectory: :class:`Result` of ``strike`` (default: normal incidence at ``V0``);
     ``progress(t, y)`` is called after every integrator step."""
-    shot = shot or Shot(projectile.V0)
+    strike = strike or Strike(projectile.V0)
     law = make_law(target, projectile, resistance, bottom=bottom, **law_options)
     model = ObliqueModel(target, projectile, law, body=body, bottom=bottom, rtol=rtol,
                          atol=atol, method=method, contact_ramp=contact_ramp)
-    return model.run(shot, progress=progress)
+    return model.run(strike, progress=progress)
 
 
 def peaks(history):

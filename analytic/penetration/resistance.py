@@ -14,6 +14,7 @@ kept: the integrator asks for the label at points where it has asked for the for
 """
 
 import math
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
@@ -48,7 +49,41 @@ def check_model(model, boundary=None):
             "'quasi-static' for the paper model", boundary)
 
 
-class ClosedFormResistance:
+@runtime_checkable
+class Resistance(Protocol):
+    r"""What the 1-D integrator (:mod:`cavex.analytic.penetration.integrator`) asks a resistance.
+
+    The motion is ``m dV/dt = -F(L, V)``, ``dL/dt = V`` at nose-tip depth ``L`` (m, >= 0) and
+    velocity ``V`` (m/s, >= 0; the integrator clips negative trial values to 0).
+
+    - ``force(depth, velocity)``: the axial nose force ``F(L, V)`` (N) against the motion; a
+      function of ``(L, V)`` alone, with no history (the integrator evaluates trial points in
+      any order and repeats some).
+    - ``label(depth, velocity)``: the response-state label (str) of the phase ``(L, V)`` is in.
+      A tunnel phase ends where the label changes (a terminal event of the integrator, located
+      to round-off), so equal labels must mean the same law of ``F``.
+    - ``crater_force(velocity)``: the force ``F_1(V)`` (N) of the crater medium alone (in the
+      paper the first layer as a single medium), which sets the crater stage:
+      ``K L_c = F_1(V_c)`` and ``m (V_0^2 - V_c^2) = L_c F_1(V_c)`` (Eqs. 31-34).
+
+    Input outside the model's range raises :class:`~cavex.errors.CavexInputError`, a closed
+    form that fails to converge :class:`~cavex.errors.CavexNumericalError`.
+    """
+
+    def force(self, depth, velocity):
+        """Axial nose force ``F(L, V)`` (N)."""
+        ...
+
+    def label(self, depth, velocity):
+        """Response-state label of the phase at ``(L, V)``."""
+        ...
+
+    def crater_force(self, velocity):
+        """Force ``F_1(V)`` (N) of the crater medium alone."""
+        ...
+
+
+class ClosedFormResistance(Resistance):
     """Resistance from the derived closed forms or the paper's printed model.
 
     Parameters
@@ -79,7 +114,7 @@ class ClosedFormResistance:
         self._paper = PaperModel(target, projectile, epsilon) if model == "paper" else None
         n = len(target.layers)
         self._tables = [material_table(tuple(target.layers[i:])) for i in range(n)]
-        self._names = [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]
+        self._names = target.layer_names()
         self._cosines, self._weights = nose_rule(projectile)
         self._dynamic = boundary == "dynamic"
         self._r = float(projectile.r)

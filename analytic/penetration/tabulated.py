@@ -31,7 +31,7 @@ from scipy.interpolate import PchipInterpolator
 from cavex.analytic.geometry import switch_depths, wall_layer
 from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.nose import nose_rule
-from cavex.analytic.penetration.resistance import ClosedFormResistance
+from cavex.analytic.penetration.resistance import ClosedFormResistance, Resistance
 from cavex.config import fingerprint, fingerprint_data
 from cavex.errors import CavexInputError, require_choice
 
@@ -39,8 +39,9 @@ METHODS = ("pchip", "linear")
 NODE_TOLERANCE = 1e-6  # m: a switch node this close to a segment end belongs to both segments
 
 
-class TabulatedResistance:
-    """Integrator protocol (``force``, ``label``, ``crater_force``) from a ``sigma_r`` table.
+class TabulatedResistance(Resistance):
+    """The integrator's :class:`~cavex.analytic.penetration.resistance.Resistance` from a
+    ``sigma_r`` table.
 
     Parameters
     ----------
@@ -95,7 +96,7 @@ class TabulatedResistance:
         """Wall layer name and "(table)": phases end where the wall layer changes."""
         self._check_depth(depth)
         index = wall_layer(self.target, self.projectile, depth)
-        return f"{self.target.layers[index].name or f'layer {index + 1}'} (table)"
+        return f"{self.target.layer_name(index)} (table)"
 
     def crater_force(self, velocity):
         """Nose force of the first layer alone (the table's first-layer column)."""

@@ -40,7 +40,7 @@ def penetration_job(target, projectile, *, model="derived", boundary=None,
             "notes": crater_notes(target, projectile, crater),
             "interface_depths": target.interface_depths, "title": title,
             "table": None if table_path is None else str(table_path),
-            "layer_names": [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]}
+            "layer_names": target.layer_names()}
 
 
 def crater_notes(target, projectile, crater):

@@ -26,10 +26,10 @@ def stress_at_depth(target, projectile, depth, velocity, *, model="derived", bou
     index = wall_layer(target, projectile, depth)
     return _finite({"model": "derived", "boundary": boundary, "depth_m": depth,
             "velocity_m_s": velocity, "sigma_r_Pa": state.stress, "S": state.S,
-            "S_normalised_by": f"tau of {_name(target, index)} ({layers[0].tau} Pa)",
+            "S_normalised_by": f"tau of {target.layer_name(index)} ({layers[0].tau} Pa)",
             "response_state": state.state, "plastic_radius_m": state.plastic_radius,
-            "wall_layer": _name(target, index), "interface_radii_m": list(interfaces),
-            "plastic_zones": [{"layer": _name(target, index + i), "r_inner_m": r0,
+            "wall_layer": target.layer_name(index), "interface_radii_m": list(interfaces),
+            "plastic_zones": [{"layer": target.layer_name(index + i), "r_inner_m": r0,
                                "r_outer_m": r1} for i, r0, r1 in state.plastic_zones]})
 
 
@@ -50,7 +50,3 @@ def _paper(target, projectile, depth, velocity, epsilon):
             "sigma_r_Pa": c.stress(velocity), "S": c.S(velocity),
             "S_normalised_by": f"tau = {c.tau} Pa (as the paper's Eq. {c.equation})",
             "A": c.A, "B": c.B, "equation": c.equation, "response_state": c.state}
-
-
-def _name(target, index):
-    return target.layers[index].name or f"layer {index + 1}"

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.penetration.oblique import CONTACT_RAMP, Shot, fly, peaks
+from cavex.analytic.penetration.oblique import CONTACT_RAMP, Strike, fly, peaks
 from cavex.analytic.penetration.surface_force import rotation_matrix as rotation
 from cavex.errors import is_finite_number, require
 from cavex.verification.fedata.runner import show_progress
@@ -28,7 +28,7 @@ DEFAULT_DIR = "results/trajectory"
 MIN_CONTACT_RAMP = 0.001
 
 
-def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="dynamic",
+def trajectory_job(target, projectile, strike, resistance="derived", *, boundary="dynamic",
                    free_surface=True, table=None, law_A=None, law_B=None,
                    compare_homogeneous=False, contact_ramp=None, progress=False):
     """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``;
@@ -44,7 +44,7 @@ def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="
         from cavex.analytic.penetration.tabulated import load_table
         options["table"] = load_table(table)
     with _steps("runway", progress) as step:
-        runs = {"runway": fly(target, projectile, shot, resistance, progress=step, **options)}
+        runs = {"runway": fly(target, projectile, strike, resistance, progress=step, **options)}
     if compare_homogeneous and len(target.layers) > 1:
         single = target.single(0)
         if resistance == "table":  # the table belongs to the runway; first layer by closed form
@@ -53,11 +53,11 @@ def trajectory_job(target, projectile, shot, resistance="derived", *, boundary="
         else:
             resistance_single = resistance
         with _steps("first layer only", progress) as step:
-            runs["first layer only"] = fly(single, projectile, shot, resistance_single,
+            runs["first layer only"] = fly(single, projectile, strike, resistance_single,
                                            progress=step, **options)
-    settings = {"speed_m_s": shot.speed, "obliquity_deg": shot.obliquity,
-                "attack_deg": shot.attack, "attack_plane_deg": shot.attack_plane,
-                "spin_rad_s": shot.spin, "resistance": resistance, "boundary": boundary,
+    settings = {"speed_m_s": strike.speed, "obliquity_deg": strike.obliquity,
+                "attack_deg": strike.attack, "attack_plane_deg": strike.attack_plane,
+                "spin_rad_s": strike.spin, "resistance": resistance, "boundary": boundary,
                 "free_surface": free_surface, "contact_ramp_m_s": contact_ramp}
     return {"runs": runs, "settings": settings, "target": target}
 
@@ -130,9 +130,9 @@ def _layer_names(ax, target):
     (the last one just below the last interface)."""
     tops = [0.0, *target.interface_depths]
     bottom = ax.get_ylim()[0]  # the axis is inverted: ylim = (deepest, shallowest)
-    for k, layer in enumerate(target.layers):
+    for k, name in enumerate(target.layer_names()):
         low = tops[k + 1] if k + 1 < len(tops) else max(bottom, tops[k] + 0.1)
-        ax.text(1.01, 0.5 * (tops[k] + low), layer.name or f"layer {k + 1}",
+        ax.text(1.01, 0.5 * (tops[k] + low), name,
                 transform=ax.get_yaxis_transform(), va="center", fontsize=8, color="0.3")
 
 
@@ -290,16 +290,16 @@ def trajectory_main(args, target, projectile):
         raise CavexInputError("option '--compare-homogeneous' needs a target of two or more "
                               "layers (this one is its first layer alone already)")
     folder = check_output_dir(args.out, "out")
-    speed = projectile.V0 if args.velocity is None else args.velocity  # Shot checks it
+    speed = projectile.V0 if args.velocity is None else args.velocity  # Strike checks it
     top = MAX_VELOCITY / projectile.r  # the shank's surface speed <= MAX_VELOCITY
     require(math.isfinite(args.spin) and abs(args.spin) <= top, "spin",
             f"in [-{top:g}, {top:g}] rad/s (shank surface speed <= {MAX_VELOCITY:g} m/s)",
             args.spin)
-    shot = Shot(speed, args.obliquity, args.attack, args.attack_plane, args.spin)
+    strike = Strike(speed, args.obliquity, args.attack, args.attack_plane, args.spin)
     projectile.body_length  # noqa: B018 (a projectile without a length refuses here)
     try:  # forces beyond the body's mass and inertia overflow (warnings, then a bogus end)
         with np.errstate(over="raise", invalid="raise"):
-            job = trajectory_job(target, projectile, shot, args.resistance,
+            job = trajectory_job(target, projectile, strike, args.resistance,
                                  boundary=args.boundary, free_surface=not args.no_free_surface,
                                  table=args.table, law_A=args.law_A, law_B=args.law_B,
                                  compare_homogeneous=args.compare_homogeneous,

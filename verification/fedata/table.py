@@ -234,7 +234,7 @@ def assemble_table(target, projectile, velocities, depths, cells, crater, settin
     """The Dataset from grid arrays (see :func:`build_table`)."""
     v, d = np.asarray(velocities, dtype=float), np.asarray(depths, dtype=float)
     grid = ("velocity", "depth")
-    names = [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]
+    names = target.layer_names()
     data = {
         "sigma_r": (grid, cells["sigma_r"], _attrs("Pa", "FE cavity-wall radial stress, "
                                                    "compression positive")),

@@ -45,11 +45,6 @@ MODEL_PARTS = {"dynamic": ("idealisation",), "quasi_static": ("convention", "ide
                "paper": ("formulas", "convention", "idealisation")}
 
 
-def layer_names(target):
-    """Display name of every layer of ``target``."""
-    return [m.name or f"layer {i + 1}" for i, m in enumerate(target.layers)]
-
-
 def analytic_cells(target, projectile, depths, velocities):
     """Closed-form quantities on the grid, ``cells[i][j]`` a plain dict at ``velocities[i]``
     (m/s) and ``depths[j]`` (m), computed through the array form: one derived call per group

@@ -32,7 +32,6 @@ from cavex.verification.report.analysis import (
     TOLERANCES,
     all_stats,
     analyse,
-    layer_names,
 )
 from cavex.verification.report.html import markdown_to_html, slug
 
@@ -311,7 +310,7 @@ def report_sections(grid, target, stats, lines, trajectory, pic, paths, info):
 
 def report_markdown(grid, target, stats, lines, trajectory, pic, paths, info):
     """The whole ``report.md`` text: title, one line on the target, contents, sections."""
-    names = layer_names(target)
+    names = target.layer_names()
     sections = report_sections(grid, target, stats, lines, trajectory, pic, paths, info)
     contents = " · ".join(f"[{heading}](#{slug(heading)})" for heading, _ in sections)
     md = ["# cavex verification report: closed forms against FE", "",

@@ -48,6 +48,7 @@ def fe_fields(target, projectile, velocity, depth, numerics=None, nu=None):
     from dataclasses import replace
 
     layers, interfaces = spherical_problem(target, projectile, depth)
+    wall = len(target.layers) - len(layers)  # index of the wall layer in the target
     fe_layers = [replace(m, nu=nu) for m in layers] if nu is not None else layers
     result = expand_cavity(fe_layers, interfaces, velocity, projectile.r,
                            **{**(numerics or {}), "error_estimate": False})
@@ -61,7 +62,7 @@ def fe_fields(target, projectile, velocity, depth, numerics=None, nu=None):
             "sigma_theta": result.fields["sigma_theta"][order],
             "layer": result.fields["layer"][order], "a": projectile.r,
             "b": result.plastic_radius, "interfaces": [float(h) for h in interfaces],
-            "layers": [m.name or f"layer {i + 1}" for i, m in enumerate(layers)],
+            "layers": target.layer_names()[wall:],
             "cavity_stress": result.cavity_stress, "closed_form": closed}
 
 

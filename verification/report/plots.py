@@ -27,7 +27,6 @@ from cavex.verification.report.analysis import (  # noqa: E402
     RESOLVED_FRACTION,
     STATE_GROUPS,
     TOLERANCES,
-    layer_names,
     state_meaning,
 )
 
@@ -70,7 +69,7 @@ def _interfaces_v(ax, target):
     bounds = [-np.inf, *target.interface_depths, np.inf]
     for H in target.interface_depths:
         ax.axvline(H, color="k", lw=0.8, ls="--")
-    for k, name in enumerate(layer_names(target)):
+    for k, name in enumerate(target.layer_names()):
         lo, hi = max(bounds[k], left), min(bounds[k + 1], right)
         if hi - lo > 0.06 * (right - left):
             ax.text(0.5 * (lo + hi), 1.0, name, fontsize=8, style="italic", va="bottom",
@@ -150,7 +149,7 @@ def frame(columns, grid, target, names_on=0):
     v, d = grid.velocity.values, grid.depth.values
     failed = grid["failed"].values.astype(bool)
     V, L = np.meshgrid(v, d, indexing="ij")
-    names = layer_names(target)
+    names = target.layer_names()
     for c, column in enumerate(columns):
         for ax in column:
             limits = ax.get_ylim()  # set_yticks widens the view to every tick: restored
@@ -289,7 +288,7 @@ def state_map(grid, target, out):
     for column, key in zip(columns, keys, strict=True):
         for ax in column:
             _label_cells(ax, grid, grid[f"state_{key}"].values, labels)
-    names = layer_names(target)
+    names = target.layer_names()
     groups = [f"{letters}: {n} layers around the cavity ({', '.join(names[-n:])})"
               for n, letters in STATE_GROUPS.items() if len(names) >= n]
     handles = [Patch(fc=cmap(i), ec="none", label=f"{label}: {state_meaning(label, names, True)}")

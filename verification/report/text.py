@@ -15,7 +15,6 @@ from cavex.verification.report.analysis import (
     RESOLVED_FRACTION,
     TOLERANCES,
     attribution,
-    layer_names,
     part_medians,
     state_labels,
     state_meaning,
@@ -74,7 +73,7 @@ def conclusions(grid, target, stats):
     :data:`~cavex.verification.report.analysis.MODEL_PARTS` (their medians, the part dominating
     the median and the part dominating the worst cell).
     """
-    names = layer_names(target)
+    names = target.layer_names()
     vmax, vmin = float(grid.velocity.max()), float(grid.velocity.min())
     lines = []
     for index in sorted(next(iter(stats.values()))):
@@ -116,7 +115,7 @@ def _attribution_text(a, median):
 
 def accuracy_table(stats, target):
     """Per closed form and wall layer: median, worst, fractions within 1 % and 5 %, limits."""
-    names = layer_names(target)
+    names = target.layer_names()
     rows = []
     for key, s_by_layer in stats.items():
         for index, s in s_by_layer.items():
@@ -140,7 +139,7 @@ def _v(v):
 
 def parts_table(grid, target):
     """Median of each part of the paper's error, per wall layer (exactly additive per cell)."""
-    names = layer_names(target)
+    names = target.layer_names()
     rows = []
     for index in sorted({int(i) for i in np.unique(grid["wall_layer"].values)}):
         parts = part_medians(grid, index)
@@ -163,7 +162,7 @@ def failed_table(grid):
 
 def cell_rows(grid, target):
     """One row per (V, L) cell: the grid numbers as printed in the appendix."""
-    names = layer_names(target)
+    names = target.layer_names()
     states = {key: state_labels(grid, key) for key in ("dynamic", "quasi_static")}
     rows = []
     for i, V in enumerate(grid.velocity.values):
@@ -237,7 +236,7 @@ def resolution_text(grid, stats):
 
 def states_text(grid, target):
     """What the response-state labels of the state map mean (those present in the grid)."""
-    names = layer_names(target)
+    names = target.layer_names()
     used = {int(x) for key in ("dynamic", "quasi_static")
             for x in np.unique(grid[f"state_{key}"].values)}
     present = [label for code, label in enumerate(

@@ -23,7 +23,7 @@ import sys
 
 import numpy as np
 
-from cavex.analytic.penetration.oblique import CONTACT_RAMP, Shot, fly, peaks
+from cavex.analytic.penetration.oblique import CONTACT_RAMP, Strike, fly, peaks
 from cavex.config import load_config
 from cavex.verification.fedata.runner import run_cases
 from cavex.verification.output.files import save_figure, write_text_atomic
@@ -92,8 +92,8 @@ def study_chunk(chunk):
     for case in chunk:
         try:
             t = target if case["target"] == "runway" else target.single(0)
-            shot = Shot(case["speed_m_s"], obliquity=case["obliquity_deg"])
-            out.append(shot_summary(fly(t, projectile, shot,
+            strike = Strike(case["speed_m_s"], obliquity=case["obliquity_deg"])
+            out.append(shot_summary(fly(t, projectile, strike,
                                         contact_ramp=case["contact_ramp_m_s"]), approach))
         except Exception as exc:  # noqa: BLE001 (reported per case)
             out.append(exc)
@@ -359,9 +359,9 @@ def main(argv=None):
     answers = findings(results, interfaces)
     runs = {}
     for v in (400.0, 600.0):  # the paper's two shots (its Figs. 8 and 9)
-        shot = Shot(v, obliquity=20.0)
-        runs[f"runway {v:g} m/s"] = fly(target, projectile, shot)
-        runs[f"concrete only {v:g} m/s"] = fly(target.single(0), projectile, shot)
+        strike = Strike(v, obliquity=20.0)
+        runs[f"runway {v:g} m/s"] = fly(target, projectile, strike)
+        runs[f"concrete only {v:g} m/s"] = fly(target.single(0), projectile, strike)
     write_text_atomic(folder / "study.csv", table_csv(results))
     write_text_atomic(folder / "report.md", report_md(results, answers, interfaces))
     figures(results, folder, interfaces, runs)

@@ -31,10 +31,11 @@ def table2_rows(trajectory):
                    if p.label.endswith("(a)") and not q.label.endswith("(a)")), None)
     at_h1 = next((p for p in phases if p.end_reason == "nose tip reached interface 1"), None)
     stop = phases[-1] if phases and phases[-1].end_reason == "projectile stopped" else None
-    return [_row(p) for p in (crater, left_a, at_h1, stop)]
+    return [phase_row(p) for p in (crater, left_a, at_h1, stop)]
 
 
-def _row(phase):
+def phase_row(phase):
+    """``{"depth_m", "velocity_m_s", "time_s"}`` where ``phase`` ends (None for None)."""
     if phase is None:
         return None
     return {"depth_m": phase.end_depth, "velocity_m_s": phase.end_velocity,

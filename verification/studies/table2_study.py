@@ -38,14 +38,23 @@ import math
 from dataclasses import asdict, dataclass, replace
 from functools import partial
 
-from scipy.integrate import solve_ivp
-
 from cavex.analytic import paper_model as pm
-from cavex.analytic.penetration.integrator import crater_depth, penetrate
+from cavex.analytic.penetration.integrator import (
+    ATOL,
+    RTOL,
+    crater_depth,
+    integrate,
+    penetrate,
+)
 from cavex.analytic.penetration.nose import ogive_coefficients
-from cavex.analytic.penetration.resistance import ClosedFormResistance
-from cavex.errors import CavexNumericalError, require
-from cavex.verification.studies.table2 import PAPER_REF10_EXIT_VELOCITY, PAPER_TABLE2, table2_rows
+from cavex.analytic.penetration.resistance import ClosedFormResistance, Resistance
+from cavex.errors import require
+from cavex.verification.studies.table2 import (
+    PAPER_REF10_EXIT_VELOCITY,
+    PAPER_TABLE2,
+    phase_row,
+    table2_rows,
+)
 
 CHOICES = {
     "epsilon": pm.EPSILON_READINGS,
@@ -65,6 +74,7 @@ ADMISSIBLE = {**CHOICES, "crater": ("nose-base",), "crater_medium": ("concrete",
 ROW_KEYS = ("depth_m", "velocity_m_s", "time_s")
 # half a unit of the last digit Table 2 prints: L to 0.01 m, V to 0.1 m/s, t to 0.01 ms
 PRINT_HALF_UNIT = {"depth_m": 0.005, "velocity_m_s": 0.05, "time_s": 0.005e-3}
+SEGMENT_RTOL = 1e-10  # the segments' relative tolerance (the full runs: the integrator's own)
 
 
 @dataclass(frozen=True)
@@ -138,11 +148,9 @@ def eq29_reading(material, eps, variant):
     return A, B, tau, rho
 
 
-class ReadingResistance:
-    """The paper model (Eqs. 19-29, 34) under one :class:`Reading`.
-
-    Implements the integrator's protocol: ``force(depth, velocity)``, ``label(depth, velocity)``
-    and ``crater_force(velocity)``. The case selection is that of
+class ReadingResistance(Resistance):
+    """The paper model (Eqs. 19-29, 34) under one :class:`Reading`, as the integrator's
+    :class:`~cavex.analytic.penetration.resistance.Resistance`. The case selection is that of
     :func:`cavex.analytic.paper_model.paper_coefficients` (nose-tip switch, ``L1``-``L4``), with
     the reading's ``eps`` per layer and its variants of Eqs. 19 and 29 and of ``tau_0i``,
     ``rho_i`` in Eqs. 13-14.
@@ -154,6 +162,7 @@ class ReadingResistance:
             pm.check_paper_material(material, index)
         self.target, self.projectile, self.reading = target, projectile, reading
         self.eps = [pm.layer_epsilon(m, reading.epsilon) for m in target.layers]
+        self._crater_medium = None
 
     def first_layer(self, depth):
         """Index of the layer whose equations apply at nose-tip depth ``depth``."""
@@ -190,15 +199,16 @@ class ReadingResistance:
         return f"Eq. {equation} ({state})"
 
     def crater_force(self, velocity):
-        """Eq. (29) force of the crater medium (concrete, or the soil in the literal reading)."""
-        index = 0 if self.reading.crater_medium == "concrete" else -1
-        material = self.target.layers[index]
-        A, B, tau, rho = eq29_reading(material, self.eps[index], self.reading.eq29)
-        c_a, c_b = ogive_coefficients(self.projectile, A, B, tau, rho)
-        return c_a + c_b * velocity ** 2
+        """Eq. (29) force of the crater medium alone (concrete, or the soil in the literal
+        reading): this reading's force on the single-medium target of that layer."""
+        if self._crater_medium is None:
+            index = 0 if self.reading.crater_medium == "concrete" else -1
+            self._crater_medium = ReadingResistance(self.target.single(index), self.projectile,
+                                                    self.reading)
+        return self._crater_medium.force(0.0, velocity)
 
 
-class CraterAsTunnel:
+class CraterAsTunnel(Resistance):
     """Wraps a resistance: the crater force ``crater_force(V)`` acts from the surface to ``L_c``.
 
     Used with ``penetrate(..., crater=None)``: above ``L_c`` the label is ``"crater"`` and the
@@ -223,7 +233,7 @@ class CraterAsTunnel:
         return self.inner.crater_force(velocity)
 
 
-def run_reading(target, projectile, reading, rtol=1e-9, atol=1e-12):
+def run_reading(target, projectile, reading, rtol=RTOL, atol=ATOL):
     """Trajectory of the paper model under ``reading``."""
     resistance = ReadingResistance(target, projectile, reading)
     if reading.crater_law == "tunnel":
@@ -232,38 +242,9 @@ def run_reading(target, projectile, reading, rtol=1e-9, atol=1e-12):
     return penetrate(target, projectile, resistance, crater=reading.crater, rtol=rtol, atol=atol)
 
 
-def segment(resistance, mass, start, stop_depth=None, rtol=1e-10, atol=1e-12):
-    """Integrate ``m V' = -F(L, V)`` from ``start = (L, V, t)`` to ``stop_depth`` or rest.
-
-    Returns
-    -------
-    dict
-        ``{"depth_m", "velocity_m_s", "time_s"}`` where the segment ends.
-    """
-    depth0, v0, t0 = start
-
-    def rhs(t, y):
-        return (y[1], -resistance.force(y[0], max(y[1], 0.0)) / mass)
-
-    def stopped(t, y):
-        return y[1]
-
-    def reached(t, y):
-        return y[0] - (stop_depth if stop_depth is not None else math.inf)
-
-    for event in (stopped, reached):
-        event.terminal, event.direction = True, 0.0 if event is reached else -1.0
-    sol = solve_ivp(rhs, (t0, t0 + 1.0), (depth0, v0), method="DOP853",
-                    events=[stopped, reached], rtol=rtol, atol=atol)
-    if sol.status != 1:
-        raise CavexNumericalError(f"segment from {start} did not end: {sol.message}")
-    which = 0 if sol.t_events[0].size else 1
-    t_end, (depth, v) = sol.t_events[which][0], sol.y_events[which][0]
-    return {"depth_m": depth, "velocity_m_s": max(v, 0.0) if which else 0.0, "time_s": t_end}
-
-
 def _paper_start(row):
-    return row["depth_m"], row["velocity_m_s"], row["time_s"]
+    """The integrator's start state ``(t, L, V)`` of a row of the paper's Table 2."""
+    return row["time_s"], row["depth_m"], row["velocity_m_s"]
 
 
 def segment_rows(target, projectile, reading):
@@ -275,7 +256,8 @@ def segment_rows(target, projectile, reading):
     resistance = ReadingResistance(target, projectile, reading)
     ends = (phase_depth_l1(target, projectile, reading.epsilon), target.interface_depths[0],
             None)
-    return [segment(resistance, projectile.m, _paper_start(PAPER_TABLE2[k]), end)
+    return [phase_row(integrate(resistance, projectile.m, _paper_start(PAPER_TABLE2[k]),
+                                stop_depth=end, rtol=SEGMENT_RTOL)[0])
             for k, end in enumerate(ends)]
 
 
