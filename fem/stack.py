@@ -114,11 +114,6 @@ class Stack:
         """Slice of case ``c``'s elements."""
         return slice(self.el_start[c], self.el_start[c] + self.el_count[c])
 
-    def displacement_gradients(self, u):
-        """``(du/dR, u/R)`` at the points, shape (elements, points)."""
-        ue = u[self.element_dofs]
-        return (ue[:, :, None] * self.dNdR).sum(1), (ue @ self.N) / self.R_points
-
     def new_buffers(self):
         """Output arrays of :meth:`assemble`: ``(f, band, response, folded, force_scale)``."""
         shape = self.R_points.shape
