@@ -247,17 +247,6 @@ class RadialSolver:
         self.cases["work"][done] += work[ok]
         self.cases["dissipated"][done] += stack.per_case_sum(dissipation)[ok]
 
-    def advance(self, load, dt):
-        """One step of every case to the wall ``load`` (per case or shared) over ``dt``, with
-        the cut-back policy; raises the first case's :class:`CavexNumericalError`."""
-        k = self.stack.n_cases
-        load = np.broadcast_to(np.asarray(load, dtype=float), (k,))
-        times = [[self.cases["t"][c] + dt] for c in range(k)] if self.dynamic else None
-        errors = self.run([[x] for x in load], times)
-        for error in errors:
-            if error is not None:
-                raise error
-
     def start_under_load(self, load):
         """Consistent start for a wall pressure ``load`` applied suddenly at ``t = 0+``.
 

@@ -18,8 +18,6 @@ from cavex.fem.banded import solve_blocks
 from cavex.fem.constitutive import PointMaterial
 from cavex.fem.element import assemble_cases
 
-WALL_CONTROLS = ("displacement", "pressure")
-
 
 def ranges(starts, counts):
     """Concatenated ``arange(s, s + c)`` for every pair (vectorised)."""
