@@ -37,7 +37,7 @@ import xarray as xr
 
 from cavex.analytic.geometry import spherical_problem, switch_depths, wall_layer
 from cavex.config import config_text, fingerprint, fingerprint_data, projectile_table, target_table
-from cavex.errors import require
+from cavex.errors import require, require_choice
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
 from cavex.materials import MAX_VELOCITY
 from cavex.problem import BOUNDARIES
@@ -207,6 +207,7 @@ def analytic_table(target, projectile, velocities, depths, boundary="dynamic",
     with ``boundary``); the grid is built as :func:`build_table` builds it.
     """
     check_grid(velocities, depths)
+    require_choice(boundary, BOUNDARIES, "boundary")
     v = np.unique(np.asarray(velocities, dtype=float))
     d = grid_depths(depths, target, projectile, refine)
 
