@@ -43,8 +43,7 @@ Implementation: one compiled (numba) kernel per point, :func:`return_point`, use
 loop of :mod:`cavex.fem.element` for every case. It tries the Mohr-Coulomb-only return first (one
 multiplier, the common case) and falls back, for that point only, to the multi-surface return
 when the trial state or the Mohr-Coulomb-returned one violates the tension cut-off.
-:func:`return_map` applies it to arrays of points (for tests and post-processing). An
-independent numpy implementation of the same equations is kept in ``tests/oracles.py`` and
+An independent numpy implementation of the same equations is kept in ``tests/oracles.py`` and
 compared with this kernel point by point (``tests/test_fem_kernels.py``).
 """
 
@@ -98,10 +97,6 @@ class PointMaterial:
                    tau=per_layer([m.tau for m in layers]),
                    lam_psi=np.full(pick.shape, lam_psi),
                    tension=per_layer(cut))
-
-    def take(self, index):
-        """The constants at ``index`` (anything that indexes the point arrays)."""
-        return PointMaterial(**{name: value[index] for name, value in vars(self).items()})
 
 
 
@@ -235,33 +230,4 @@ def return_point(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tensio
         plastic = _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
                                        lam_psi, tension, out)
     return plastic
-
-
-@njit(cache=True, error_model="numpy")
-def _return_points(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, out,
-                   plastic):
-    row = np.empty(9)
-    for i in range(eps_r.size):
-        plastic[i] = return_point(eps_r[i], eps_t[i], theta_p[i], gamma_p[i], K[i], G[i],
-                                  lam[i], tau[i], lam_psi[i], tension[i], row)
-        out[:, i] = row
-
-
-def return_map(eps_r, eps_t, theta_p, gamma_p, material):
-    """:func:`return_point` at every point of the arrays (all of one shape).
-
-    Returns a dict of arrays of that shape: the :data:`OUTPUTS` and ``plastic``.
-    """
-    shape = np.shape(eps_r)
-    flat = [np.ascontiguousarray(np.broadcast_to(x, shape), dtype=float).ravel()
-            for x in (eps_r, eps_t, theta_p, gamma_p)]
-    props = [np.ascontiguousarray(np.broadcast_to(getattr(material, name), shape),
-                                  dtype=float).ravel()
-             for name in ("K", "G", "lam", "tau", "lam_psi", "tension")]
-    out = np.empty((len(OUTPUTS), flat[0].size))
-    plastic = np.empty(flat[0].size, dtype=np.bool_)
-    _return_points(*flat, *props, out, plastic)
-    result = {name: out[i].reshape(shape) for i, name in enumerate(OUTPUTS)}
-    result["plastic"] = plastic.reshape(shape)
-    return result
 

@@ -83,10 +83,6 @@ class Discretisation:
         self.mass_band = to_banded(self.mass, degree)
 
     # ------------------------------------------------------------------ helpers
-    def to_skfem(self, u_radial):
-        """Radial-ordered dof vector in scikit-fem's order."""
-        return u_radial[self.radial]
-
     def _assemble_mass(self):
         M = asm(forms.mass, self.mass_basis, rho=self._rho_mass)
         return M[np.argsort(self.radial)][:, np.argsort(self.radial)].tocsr()

@@ -5,11 +5,14 @@ until the cavity radius is ``radius``; the material starts at rest and unstresse
 grow with the cavity (``da = growth_per_step * a``), so every step is a fixed fraction of the
 self-similar process. With ``velocity = 0`` the run is quasi-static.
 
-:func:`expand_cavities` runs any number of such problems with shared numerical settings on the
-one solver (:class:`cavex.fem.solver.RadialSolver`, stacks of ``batch_size`` cases);
-:func:`expand_cavity` is the same on one problem, recording its history and fields through
-observers of the run. The error-estimate companion and the refinement of cases above an error
-target are policies of :mod:`cavex.fem.estimate`, applied here to every problem alike.
+:func:`expand_problems` runs any number of such problems (each a checked
+:class:`cavex.problem.SphericalProblem`) with shared numerical settings (a checked
+:class:`cavex.fem.settings.Numerics`) on the one solver (:class:`cavex.fem.solver.RadialSolver`,
+stacks of ``batch_size`` cases); :func:`expand_cavities` builds and checks both from plain
+values first, and :func:`expand_cavity` is the same on one problem, recording its history and
+fields through observers of the run. The error-estimate companion and the refinement of cases
+above an error target are policies of :mod:`cavex.fem.estimate`, applied here to every problem
+alike.
 """
 
 import math
@@ -24,9 +27,9 @@ from cavex.fem.estimate import estimate_errors, refine_above
 from cavex.fem.fields import cauchy_stresses, current_point_radii, plastic_radius, wall_stress
 from cavex.fem.mesh import element_layers, reference_mesh
 from cavex.fem.result import ExpansionResult
-from cavex.fem.settings import make_numerics
+from cavex.fem.settings import check_seed_radius, make_numerics
 from cavex.fem.solver import RadialSolver
-from cavex.problem import check_problem
+from cavex.problem import SphericalProblem
 
 DEFAULT_BATCH = 200     # cases per stack (measured optimum on a 2-core machine: 100-400)
 ON_ERROR = ("return", "raise")
@@ -130,11 +133,13 @@ class Recorder:
 
 # ---------------------------------------------------------------------------------- runs
 def run_problems(problems, numerics, batch_size=DEFAULT_BATCH, record=False):
-    """One run of every problem at ``numerics`` (no error estimate): stacks of ``batch_size``
-    cases, dynamic and quasi-static ones apart. Returns a list of :class:`ExpansionResult`."""
+    """One run of every problem (:class:`~cavex.problem.SphericalProblem`) at ``numerics`` (no
+    error estimate): stacks of ``batch_size`` cases, dynamic and quasi-static ones apart.
+    Returns a list of :class:`ExpansionResult`."""
     out = [None] * len(problems)
     for dynamic in (True, False):
-        group = [i for i, p in enumerate(problems) if is_dynamic(p[2], numerics) == dynamic]
+        group = [i for i, p in enumerate(problems)
+                 if is_dynamic(p.velocity, numerics) == dynamic]
         for start in range(0, len(group), batch_size):
             chunk = group[start:start + batch_size]
             for i, result in zip(chunk, _run_stack([problems[i] for i in chunk], numerics,
@@ -145,16 +150,15 @@ def run_problems(problems, numerics, batch_size=DEFAULT_BATCH, record=False):
 
 def _run_stack(problems, numerics, dynamic, record):
     started = time.perf_counter()
-    models = [build_model(layers, interfaces, radius, numerics)
-              for layers, interfaces, _, radius in problems]
-    velocity = np.array([p[2] for p in problems])
+    models = [build_model(p.layers, p.interfaces, p.radius, numerics) for p in problems]
+    velocity = np.array([p.velocity for p in problems])
     solver = RadialSolver([m[0] for m in models], dynamic=dynamic, rho_inf=numerics.rho_inf,
                           outer=numerics.outer, newton_tol=numerics.newton_tol,
                           max_cutbacks=numerics.max_cutbacks,
                           wall_velocity=velocity if dynamic and numerics.start_ramp == 0
                           else 0.0)
     seeds = [float(m[0].R_dofs[0]) for m in models]
-    radii = [radius_schedule(p[3], s, numerics.growth_per_step)
+    radii = [radius_schedule(p.radius, s, numerics.growth_per_step)
              for p, s in zip(problems, seeds, strict=True)]
     times = ([wall_times(r, s, v, numerics.start_ramp)
               for r, s, v in zip(radii, seeds, velocity, strict=True)] if dynamic else None)
@@ -174,7 +178,7 @@ def _run_stack(problems, numerics, dynamic, record):
 
 
 def _result(solver, c, problem, vertices, numerics, error, seconds, recorder):
-    layers, interfaces, velocity, radius = problem
+    layers, interfaces, velocity, radius = problem.as_tuple()
     one = solver.case(c)
     disc = one.disc
     settings = {"layers": [asdict(m) for m in layers], "interfaces": [float(h) for h in interfaces],
@@ -206,7 +210,10 @@ def _result(solver, c, problem, vertices, numerics, error, seconds, recorder):
 
 # ---------------------------------------------------------------------------------- public API
 def _problem(i, problem):
-    """``(layers, interfaces, velocity, radius)`` of one entry, checked."""
+    """The :class:`~cavex.problem.SphericalProblem` of one entry (built and checked here, or
+    given)."""
+    if isinstance(problem, SphericalProblem):
+        return problem
     if isinstance(problem, dict):
         unknown = set(problem) - {"layers", "interfaces", "velocity", "radius"}
         require(not unknown, f"problems[{i}]", "a dict with keys layers, interfaces, velocity, "
@@ -221,12 +228,9 @@ def _problem(i, problem):
                 "velocity", "a number", velocity)
         require(isinstance(radius, (int, float)) and not isinstance(radius, bool),
                 "radius", "a number", radius)
-        layers = tuple(layers)
-        interfaces = tuple(float(h) for h in interfaces)
-        check_problem(layers, interfaces, float(velocity), float(radius), "dynamic")
+        return SphericalProblem(tuple(layers), interfaces, velocity, radius)
     except (CavexInputError, TypeError) as exc:
         raise CavexInputError(f"problems[{i}]: {exc}") from None
-    return layers, interfaces, float(velocity), float(radius)
 
 
 def expand_cavities(problems, *, batch_size=DEFAULT_BATCH, on_error="return", error_target=None,
@@ -270,15 +274,26 @@ def expand_cavities(problems, *, batch_size=DEFAULT_BATCH, on_error="return", er
     CavexNumericalError
         With ``on_error="raise"``, when some case failed.
     """
+    settings = make_numerics(**numerics)
+    return expand_problems([_problem(i, p) for i, p in enumerate(problems)], settings,
+                           batch_size=batch_size, on_error=on_error, error_target=error_target,
+                           max_refinements=max_refinements, record=record)
+
+
+def expand_problems(problems, numerics, *, batch_size=DEFAULT_BATCH, on_error="return",
+                    error_target=None, max_refinements=2, record=False):
+    """:func:`expand_cavities` on problems and settings already built (and so checked): a list
+    of :class:`~cavex.problem.SphericalProblem` and one :class:`~cavex.fem.settings.Numerics`.
+    Only what depends on both (the seed radius, :func:`~cavex.fem.settings.check_seed_radius`)
+    and the options are checked here."""
     require(isinstance(batch_size, int) and not isinstance(batch_size, bool) and batch_size >= 1,
             "batch_size", "an integer >= 1", batch_size)
     require(on_error in ON_ERROR, "on_error", " or ".join(map(repr, ON_ERROR)), on_error)
-    settings = make_numerics(**numerics)
-    problems = [_problem(i, p) for i, p in enumerate(problems)]
-    for i, (_, _, _, radius) in enumerate(problems):
-        require(settings.seed_radius is None or settings.seed_radius <= radius / 5.0,
-                f"problems[{i}]: seed_radius", f"in (0, radius/5 = {radius / 5.0:g}]",
-                settings.seed_radius)
+    for i, problem in enumerate(problems):
+        try:
+            check_seed_radius(numerics, problem.radius)
+        except CavexInputError as exc:
+            raise CavexInputError(f"problems[{i}]: {exc}") from None
     require(error_target is None or (isinstance(error_target, float) and 0 < error_target < 1),
             "error_target", "None or a float in (0, 1)", error_target)
     require(isinstance(max_refinements, int) and not isinstance(max_refinements, bool)
@@ -294,9 +309,9 @@ def expand_cavities(problems, *, batch_size=DEFAULT_BATCH, on_error="return", er
                             lambda p, n: run_problems(p, n, batch_size))
         return results
 
-    results = run_estimated(problems, settings)
-    if error_target is not None and settings.error_estimate:
-        refine_above(problems, results, settings, error_target, max_refinements,
+    results = run_estimated(problems, numerics)
+    if error_target is not None and numerics.error_estimate:
+        refine_above(problems, results, numerics, error_target, max_refinements,
                      run_estimated)
     if on_error == "raise":
         for r in results:
@@ -329,16 +344,11 @@ def expand_cavity(layers, interfaces, velocity, radius, **numerics):
         Newton failed even after step cut-backs and the line search (the message names V, the
         step and the wall radius).
     """
-    layers = list(layers)
-    interfaces = [float(h) for h in interfaces]
-    check_problem(layers, interfaces, float(velocity), float(radius), "dynamic")
-    settings = make_numerics(**{k: v for k, v in numerics.items()
-                                if k not in ("error_target", "max_refinements")})
-    require(settings.seed_radius is None or settings.seed_radius <= radius / 5.0,
-            "seed_radius", f"in (0, radius/5 = {radius / 5.0:g}]", settings.seed_radius)
+    problem = SphericalProblem(tuple(layers), interfaces, velocity, radius)
+    options = {k: numerics.pop(k) for k in ("error_target", "max_refinements") if k in numerics}
+    settings = make_numerics(**numerics)
     try:
-        result, = expand_cavities([(layers, interfaces, float(velocity), float(radius))],
-                                  on_error="raise", record=True, **numerics)
+        result, = expand_problems([problem], settings, on_error="raise", record=True, **options)
     except CavexInputError as exc:  # one problem: its index says nothing
         raise CavexInputError(str(exc).removeprefix("problems[0]: ")) from None
     return result

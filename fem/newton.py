@@ -37,10 +37,6 @@ SHRINK_FRACTION = 0.25  # continue on a smaller stack when at most this fraction
 MIN_SHRINK = 8          # ... and the stack has at least this many cases
 LINE_SEARCH_EVALUATIONS = 20  # residual evaluations per line search (Illinois steps)
 LINE_SEARCH_TOLERANCE = 0.5   # accept s once |G(s)| <= this * |G(0)|
-#: Start-of-step data of a Newton call (see :func:`newton`), by where it lives in the stack.
-DOF_INPUTS = ("u0", "v0", "a0", "f0", "du_prev")
-POINT_INPUTS = ("theta_p", "gamma_p")
-CASE_INPUTS = ("load", "dt", "dt_old", "has_prev", "active")
 
 
 @dataclass
@@ -64,42 +60,74 @@ class StepFailure(Exception):
     """A Newton iteration that did not converge (internal: triggers a cut-back)."""
 
 
-def take(w, dofs, elements, cases):
-    """The start-of-step data ``w`` of a subset of the stack's cases."""
-    out = {name: w[name][dofs] for name in DOF_INPUTS if name in w}
-    out.update({name: w[name][elements] for name in POINT_INPUTS})
-    out.update({name: w[name][cases] for name in CASE_INPUTS})
-    return out
+@dataclass
+class StepStart:
+    """Start-of-step data of a Newton call, in stack layout.
+
+    Per dof: ``u0, v0, a0, f0`` (displacement, velocity, acceleration and internal force at
+    the start of the step) and ``du_prev`` (the last step's increment); per point:
+    ``theta_p, gamma_p`` (plastic strains); per case: ``load`` (the wall load at the end of
+    the step), ``dt``, ``dt_old`` (the last step's), ``has_prev`` (a last step exists) and
+    ``active`` (the case iterates). ``u``: the current iterate when a call continues another's
+    iteration, None when it starts from the predictor (:func:`predict`).
+    """
+
+    u0: np.ndarray
+    v0: np.ndarray
+    a0: np.ndarray
+    f0: np.ndarray
+    du_prev: np.ndarray
+    theta_p: np.ndarray
+    gamma_p: np.ndarray
+    load: np.ndarray
+    dt: np.ndarray
+    dt_old: np.ndarray
+    has_prev: np.ndarray
+    active: np.ndarray
+    u: np.ndarray | None = None
+
+    def subset(self, dofs, elements, cases, u=None):
+        """The start of a subset of the stack's cases (:meth:`Stack.subset`'s maps), all of
+        them active, continuing from the iterate ``u`` when given."""
+        return StepStart(u0=self.u0[dofs], v0=self.v0[dofs], a0=self.a0[dofs],
+                         f0=self.f0[dofs], du_prev=self.du_prev[dofs],
+                         theta_p=self.theta_p[elements], gamma_p=self.gamma_p[elements],
+                         load=self.load[cases], dt=self.dt[cases], dt_old=self.dt_old[cases],
+                         has_prev=self.has_prev[cases],
+                         active=np.ones(np.size(cases), dtype=bool), u=u)
+
+
+def converged(iteration, r_max, scale, tol):
+    """The convergence rule of every Newton iteration here: ``max |r_free| <= tol * scale``
+    (``r_max`` NaN never converges), from the second iteration on (the first residual is the
+    predictor's). Scalars or arrays per case."""
+    return (iteration > 1) & (r_max <= tol * scale)
 
 
 def newton(stack, w, params, dynamic, tol, first_iteration=1):
-    """Generalized-alpha Newton iteration of every case of ``stack`` with ``w["active"]``.
+    """Generalized-alpha Newton iteration of every case of ``stack`` with ``w.active``.
 
-    ``w`` holds the start-of-step state in stack layout (``u0, v0, a0, f0, du_prev`` per dof,
-    ``theta_p, gamma_p`` per point, ``load, dt, dt_old, has_prev, active`` per case; ``u`` the
-    current iterate when continuing at ``first_iteration > 1``). Converged: ``max |r_free| <=
-    tol * scale`` from the second iteration on. Returns ``(u, a, f, response, iterations,
-    reasons)``; ``reasons[c]`` is None for a converged case, else why it failed. Inactive cases
-    come back as converged (their values are not to be used).
+    ``w`` is the :class:`StepStart` (``w.u`` the current iterate when continuing at
+    ``first_iteration > 1``). Converged: :func:`converged`. Returns ``(u, a, f, response,
+    iterations, reasons)``; ``reasons[c]`` is None for a converged case, else why it failed.
+    Inactive cases come back as converged (their values are not to be used).
     """
     k = stack.n_cases
-    u = predict(stack, w, dynamic) if first_iteration == 1 else w["u"]
-    done = ~w["active"]
+    u = predict(stack, w, dynamic) if first_iteration == 1 else w.u
+    done = ~w.active
     reasons = np.full(k, None, dtype=object)
     iterations = np.zeros(k, dtype=int)
     buffers = system = None
     for iteration in range(first_iteration, MAX_ITERATIONS + 1):
-        buffers = stack.assemble(u, w["theta_p"], w["gamma_p"], done, buffers)
+        buffers = stack.assemble(u, w.theta_p, w.gamma_p, done, buffers)
         f, band, resp, folded, force_scale = buffers
         _fail(reasons, done, folded, "non-positive stretch")
         system = equations(stack, w, params, dynamic, u, f, band, force_scale, done, system)
         a, r_free, jac, scale, r_max = system
         _fail(reasons, done, np.isnan(r_max), "non-finite residual")
-        converged = r_max <= tol * scale
-        if iteration > 1:
-            newly = converged & ~done
-            iterations[newly] = iteration - 1
-            done |= newly
+        newly = converged(iteration, r_max, scale, tol) & ~done
+        iterations[newly] = iteration - 1
+        done |= newly
         if done.all():
             return u, a, f, resp, iterations, reasons
         remaining = np.flatnonzero(~done)
@@ -121,14 +149,14 @@ def predict(stack, w, dynamic):
     step's ``dt``, or (first step) ``u0 + dt v0`` dynamic and ``u0`` quasi-static; the wall at
     its prescribed displacement under displacement control."""
     dof_case = stack.dof_case
-    u0 = w["u0"]
+    u0 = w.u0
     u = u0.copy()
     if not stack.pressure_control:
-        u[stack.wall] = w["load"]
-    guess = u0 + w["dt"][dof_case] * w["v0"] if dynamic else u0
-    ratio = (w["dt"] / w["dt_old"])[dof_case]
-    predicted = np.where(w["has_prev"][dof_case], u0 + ratio * w["du_prev"], guess)
-    return np.where(stack.free & w["active"][dof_case], predicted, u)
+        u[stack.wall] = w.load
+    guess = u0 + w.dt[dof_case] * w.v0 if dynamic else u0
+    ratio = (w.dt / w.dt_old)[dof_case]
+    predicted = np.where(w.has_prev[dof_case], u0 + ratio * w.du_prev, guess)
+    return np.where(stack.free & w.active[dof_case], predicted, u)
 
 
 def equations(stack, w, params, dynamic, u, f, band, force_scale, skip=None, out=None):
@@ -146,8 +174,8 @@ def equations(stack, w, params, dynamic, u, f, band, force_scale, skip=None, out
         skip = np.zeros(k, dtype=bool)
     a, r_free, jac, scale, r_max = out
     p = params
-    step_equations(u, w["u0"], w["v0"], w["a0"], w["f0"], f, band, stack.mass_band, w["dt"],
-                   w["load"], stack.dof_start, stack.dof_count, stack.free, skip, stack.degree,
+    step_equations(u, w.u0, w.v0, w.a0, w.f0, f, band, stack.mass_band, w.dt,
+                   w.load, stack.dof_start, stack.dof_count, stack.free, skip, stack.degree,
                    p.alpha_m, p.alpha_f, p.beta, dynamic, stack.pressure_control,
                    stack.outer_fixed, stack.R_dofs, force_scale, a, r_free, jac, scale, r_max)
     return out
@@ -218,9 +246,7 @@ def _continue_on_subset(stack, w, params, dynamic, tol, iteration, cases, u, a, 
                         iterations, reasons):
     """Continue the Newton iteration of ``cases`` on a smaller stack, from ``iteration``."""
     sub, dofs, elements = stack.subset(cases)
-    sw = take(w, dofs, elements, cases)
-    sw["active"] = np.ones(cases.size, dtype=bool)
-    sw["u"] = u[dofs]
+    sw = w.subset(dofs, elements, cases, u=u[dofs])
     su, sa, sf, sresp, sit, sreasons = newton(sub, sw, params, dynamic, tol, iteration)
     u, a, f = u.copy(), a.copy(), f.copy()
     u[dofs], a[dofs], f[dofs] = su, sa, sf
@@ -253,8 +279,8 @@ def line_search_newton(evaluate, solve, x, tol, max_iterations):
     ``evaluate(x)`` returns a tuple starting with the free-dof residual ``r`` and the force
     yardstick ``scale`` at the free-dof iterate ``x`` (it raises :class:`StepFailure` where the
     equations cannot be evaluated); ``solve(out, r)`` returns the Newton increment ``J^-1 r``
-    for the tangent of ``out``. Converged: ``max |r| <= tol * scale`` from the second
-    iteration on, as :func:`newton`. Returns ``(x, out, iterations)``.
+    for the tangent of ``out``. Converged: :func:`converged`, as in :func:`newton`. Returns
+    ``(x, out, iterations)``.
 
     The full step ``d = -J^-1 r`` is taken unless it increases ``max |r|``; then ``s`` in
     ``(0, 1)`` is sought with ``G(s) = d . r(x + s d) = 0`` (the energy along the step is
@@ -269,7 +295,7 @@ def line_search_newton(evaluate, solve, x, tol, max_iterations):
     for iteration in range(1, max_iterations + 1):
         r, scale = out[0], out[1]
         norm = np.max(np.abs(r))
-        if iteration > 1 and norm <= tol * scale:
+        if converged(iteration, norm, scale, tol):
             return x, out, iteration - 1
         d = -solve(out, r)
         if not np.all(np.isfinite(d)):
@@ -321,7 +347,7 @@ def newton_line_search(stack, w, params, dynamic, tol):
     def evaluate(x):
         u = start.copy()
         u[free] = x
-        f, band, resp, folded, force_scale = stack.assemble(u, w["theta_p"], w["gamma_p"])
+        f, band, resp, folded, force_scale = stack.assemble(u, w.theta_p, w.gamma_p)
         if folded[0]:
             raise StepFailure("non-positive stretch")
         a, r_free, jac, scale, r_max = equations(stack, w, params, dynamic, u, f, band,

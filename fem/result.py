@@ -78,15 +78,3 @@ class ExpansionResult:
     def S(self):
         """``cavity_stress / tau`` of the layer at the wall."""
         return self.cavity_stress / self.settings["layers"][0]["tau"]
-
-    def summary(self):
-        """Plain JSON-able digest (scalars only)."""
-        final_time = None if self.history is None else float(self.history["time"][-1])
-        return {"cavity_stress": float(self.cavity_stress),
-                "error_estimate": None if self.error_estimate is None
-                else float(self.error_estimate),
-                "plastic_radius": float(self.plastic_radius),
-                "interfaces_final": [float(h) for h in self.interfaces_final],
-                "final_time": final_time,
-                **{k: float(v) for k, v in self.energy.items()},
-                **{k: v for k, v in self.stats.items()}}

@@ -152,3 +152,11 @@ def make_numerics(**overrides):
     for name in overrides:
         require(name in known, name, "one of " + ", ".join(sorted(known)), "unknown setting")
     return Numerics(**overrides)
+
+
+def check_seed_radius(numerics, radius):
+    """Raise ``CavexInputError`` unless the seed cavity fits a problem of cavity radius
+    ``radius``: ``seed_radius`` (when given) at most ``radius / 5`` (the smallest
+    ``seed_ratio``)."""
+    require(numerics.seed_radius is None or numerics.seed_radius <= radius / 5.0,
+            "seed_radius", f"in (0, radius/5 = {radius / 5.0:g}]", numerics.seed_radius)

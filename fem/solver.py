@@ -29,11 +29,11 @@ import numpy as np
 from cavex.errors import CavexNumericalError
 from cavex.fem.newton import (
     Newmark,
+    StepStart,
     copy_response,
     newton,
     newton_line_search,
     replace_points,
-    take,
 )
 from cavex.fem.stack import Stack
 
@@ -150,14 +150,14 @@ class RadialSolver:
                 cases = np.flatnonzero(~finished)
                 stack, dofs, elements = root.subset(cases)
                 active = np.ones(cases.size, dtype=bool)
-            w = {"u0": self.dofs["u"][dofs], "v0": self.dofs["v"][dofs],
-                 "a0": self.dofs["a"][dofs], "f0": self.dofs["f"][dofs],
-                 "du_prev": self.dofs["du_prev"][dofs],
-                 "theta_p": self.points["theta_p"][elements],
-                 "gamma_p": self.points["gamma_p"][elements],
-                 "load": task_load[cases], "dt": task_dt[cases],
-                 "dt_old": self.cases["dt_old"][cases], "has_prev": self.has_prev[cases],
-                 "active": active & ~task_search[cases]}
+            w = StepStart(u0=self.dofs["u"][dofs], v0=self.dofs["v"][dofs],
+                          a0=self.dofs["a"][dofs], f0=self.dofs["f"][dofs],
+                          du_prev=self.dofs["du_prev"][dofs],
+                          theta_p=self.points["theta_p"][elements],
+                          gamma_p=self.points["gamma_p"][elements],
+                          load=task_load[cases], dt=task_dt[cases],
+                          dt_old=self.cases["dt_old"][cases], has_prev=self.has_prev[cases],
+                          active=active & ~task_search[cases])
             trial, ok, iterations, reasons = self._attempt(stack, w, active,
                                                            task_search[cases])
             self._commit(stack, cases, dofs, elements, ok, w, trial)
@@ -202,8 +202,7 @@ class RadialSolver:
             resp = copy_response(resp)
             for i in np.flatnonzero(search):
                 sub, sdofs, selements = stack.subset([i])
-                sw = take(w, sdofs, selements, [i])
-                sw["active"] = np.ones(1, dtype=bool)
+                sw = w.subset(sdofs, selements, [i])
                 su, sa, sf, sresp, iterations[i], reasons[i] = newton_line_search(
                     sub, sw, self.params, self.dynamic, self.newton_tol)
                 if reasons[i] is None:
@@ -218,27 +217,27 @@ class RadialSolver:
         u, a, f, resp = trial
         p = self.params
         if self.dynamic:
-            dt_d = w["dt"][stack.dof_case]
-            v = w["v0"] + dt_d * ((1.0 - p.gamma) * w["a0"] + p.gamma * a)
-            mid = stack.mass @ ((1.0 - p.alpha_m) * a + p.alpha_m * w["a0"])
-            mid_force = (mid + (1.0 - p.alpha_f) * f + p.alpha_f * w["f0"])[stack.wall]
+            dt_d = w.dt[stack.dof_case]
+            v = w.v0 + dt_d * ((1.0 - p.gamma) * w.a0 + p.gamma * a)
+            mid = stack.mass @ ((1.0 - p.alpha_m) * a + p.alpha_m * w.a0)
+            mid_force = (mid + (1.0 - p.alpha_f) * f + p.alpha_f * w.f0)[stack.wall]
             end_force = f[stack.wall] + (stack.mass @ a)[stack.wall]
         else:
             v = np.zeros_like(u)
-            mid_force = 0.5 * (f[stack.wall] + w["f0"][stack.wall])
+            mid_force = 0.5 * (f[stack.wall] + w.f0[stack.wall])
             end_force = f[stack.wall]
         # energies: wall work (trapezoidal in the generalized-alpha sense) and dissipation
-        work = mid_force * (u[stack.wall] - w["u0"][stack.wall])
+        work = mid_force * (u[stack.wall] - w.u0[stack.wall])
         P = -(resp.tau_r + 2.0 * resp.tau_t) / 3.0
         Q = resp.tau_t - resp.tau_r
-        dissipation = stack.weights * (-P * (resp.theta_p - w["theta_p"])
-                                       - (2.0 / 3.0) * Q * (resp.gamma_p - w["gamma_p"]))
+        dissipation = stack.weights * (-P * (resp.theta_p - w.theta_p)
+                                       - (2.0 / 3.0) * Q * (resp.gamma_p - w.gamma_p))
         ok_dofs, ok_elements = ok[stack.dof_case], ok[stack.element_case]
-        new = {"u": u, "v": v, "a": a, "f": f, "du_prev": u - w["u0"]}
+        new = {"u": u, "v": v, "a": a, "f": f, "du_prev": u - w.u0}
         for name in DOF_STATE:
             self.dofs[name][dofs[ok_dofs]] = new[name][ok_dofs]
         eq_p = (self.points["eq_p"][elements]
-                + np.abs(resp.gamma_p - w["gamma_p"]) * (2.0 / 3.0))
+                + np.abs(resp.gamma_p - w.gamma_p) * (2.0 / 3.0))
         new = {"eq_p": eq_p, **{name: getattr(resp, name) for name in POINT_STATE
                                 if name != "eq_p"}}
         for name in POINT_STATE:
@@ -247,17 +246,6 @@ class RadialSolver:
         self.cases["wall_force"][done] = end_force[ok]
         self.cases["work"][done] += work[ok]
         self.cases["dissipated"][done] += stack.per_case_sum(dissipation)[ok]
-
-    def advance(self, load, dt):
-        """One step of every case to the wall ``load`` (per case or shared) over ``dt``, with
-        the cut-back policy; raises the first case's :class:`CavexNumericalError`."""
-        k = self.stack.n_cases
-        load = np.broadcast_to(np.asarray(load, dtype=float), (k,))
-        times = [[self.cases["t"][c] + dt] for c in range(k)] if self.dynamic else None
-        errors = self.run([[x] for x in load], times)
-        for error in errors:
-            if error is not None:
-                raise error
 
     def start_under_load(self, load):
         """Consistent start for a wall pressure ``load`` applied suddenly at ``t = 0+``.

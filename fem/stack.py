@@ -18,8 +18,6 @@ from cavex.fem.banded import solve_blocks
 from cavex.fem.constitutive import PointMaterial
 from cavex.fem.element import assemble_cases
 
-WALL_CONTROLS = ("displacement", "pressure")
-
 
 def ranges(starts, counts):
     """Concatenated ``arange(s, s + c)`` for every pair (vectorised)."""
@@ -113,11 +111,6 @@ class Stack:
     def elements(self, c):
         """Slice of case ``c``'s elements."""
         return slice(self.el_start[c], self.el_start[c] + self.el_count[c])
-
-    def displacement_gradients(self, u):
-        """``(du/dR, u/R)`` at the points, shape (elements, points)."""
-        ue = u[self.element_dofs]
-        return (ue[:, :, None] * self.dNdR).sum(1), (ue @ self.N) / self.R_points
 
     def new_buffers(self):
         """Output arrays of :meth:`assemble`: ``(f, band, response, folded, force_scale)``."""

@@ -14,6 +14,7 @@ kernels point by point and element by element.
 from dataclasses import dataclass
 
 import numpy as np
+from fem_helpers import take_points, to_skfem
 from skfem import BilinearForm, LinearForm, asm
 
 from cavex.fem.discretisation import to_banded
@@ -113,7 +114,7 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat, groups=None):
         redo = np.isin(groups, np.unique(groups[general]))
         replace_points(response, redo, _general_return(theta[redo], gamma[redo], J[redo],
                                                        theta_p[redo], gamma_p[redo],
-                                                       mat.take(redo)))
+                                                       take_points(mat, redo)))
     return response
 
 
@@ -206,11 +207,6 @@ def _general_return(theta, gamma, J, theta_p, gamma_p, mat):
     return _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P, Q, T, ~elastic, J, mat)
 
 
-def equivalent_plastic_strain(gamma_p, theta_p):
-    """``sqrt(2/3 eps_p : eps_p)`` of the plastic log strain (deviatoric and volumetric parts)."""
-    return np.sqrt((2.0 / 3.0) * ((2.0 / 3.0) * gamma_p ** 2 + theta_p ** 2 / 3.0))
-
-
 # ----------------------------------------------------------------------------- the weak form
 def _d_eps(v, w):
     """Variations ``(d eps_r, d eps_t)`` of the log strains for the test/trial function ``v``."""
@@ -238,7 +234,7 @@ def tangent(u, v, w):
 def assemble_forms(disc, u, theta_p, gamma_p):
     """``(f, band, response)`` at the radial dofs ``u`` from the scikit-fem forms and the
     numpy return map (radial dof order, LAPACK band storage)."""
-    field = disc.basis.interpolate(disc.to_skfem(u))
+    field = disc.basis.interpolate(to_skfem(disc, u))
     g_r, g_t = field.grad[0], np.asarray(field) / disc.R_points
     resp = hencky_mohr_coulomb(np.log1p(g_r), np.log1p(g_t), theta_p, gamma_p, disc.material)
     fields = {"lam_r": 1.0 + g_r, "lam_t": 1.0 + g_t, "tau_r": resp.tau_r, "tau_t": resp.tau_t}

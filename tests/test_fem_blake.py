@@ -47,6 +47,7 @@ import functools
 
 import numpy as np
 import pytest
+from fem_helpers import advance
 from skfem import MeshLine
 
 from cavex.fem.discretisation import Discretisation
@@ -131,7 +132,7 @@ def fe_histories(h, degree, rho_inf=0.0, consistent=True, outer="fixed", radii=R
     dt = T_END / steps
     u = [solver.u[nodes].copy()]
     for _ in range(steps):
-        solver.advance(P, dt)
+        advance(solver, P, dt)
         u.append(solver.u[nodes].copy())
     assert solver.t == pytest.approx(T_END, rel=1e-12)
     return np.linspace(0.0, T_END, steps + 1), np.array(u)
@@ -206,7 +207,7 @@ def test_start_under_load_needs_a_fresh_dynamic_pressure_controlled_solver():
         with pytest.raises(ValueError, match="start_under_load"):
             RadialSolver(disc, **kwargs).start_under_load(P)
     solver = RadialSolver(disc, wall_control="pressure")
-    solver.advance(P, 0.1)
+    advance(solver, P, 0.1)
     with pytest.raises(ValueError, match="before its first step"):
         solver.start_under_load(P)
     # on a fresh solver: M a_0 balances the wall load, the free dofs start at rest

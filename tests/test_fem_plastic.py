@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from fem_helpers import advance
 from skfem import MeshLine
 
 from cavex.fem import expand_cavity
@@ -24,7 +25,7 @@ def hollow_sphere(n_elements, nu, wall_displacement, steps=10):
     disc = Discretisation(mesh, 2, np.zeros(n_elements, int), [material])
     solver = RadialSolver(disc, dynamic=False, outer="free")
     for k in range(1, steps + 1):
-        solver.advance(wall_displacement * k / steps, 1.0)
+        advance(solver, wall_displacement * k / steps, 1.0)
     p = wall_stress(disc, solver.u, solver.f[0])
     c = plastic_radius(disc, solver.u, solver.response, solver.state)
     return p, c
@@ -45,9 +46,9 @@ def test_hill_first_yield_and_elastic_below_it():
     mesh = MeshLine(np.geomspace(A, B, 9))
     disc = Discretisation(mesh, 2, np.zeros(8, int), [material])
     solver = RadialSolver(disc, dynamic=False, outer="free", wall_control="pressure")
-    solver.advance(below, 1.0)
+    advance(solver, below, 1.0)
     assert not solver.response.plastic.any()
-    solver.advance(1.3 * below, 1.0)
+    advance(solver, 1.3 * below, 1.0)
     assert solver.response.plastic[0, 0]
 
 

@@ -18,6 +18,7 @@ import pytest
 
 from cavex.errors import CavexInputError
 from cavex.verification.fedata.cases import config_tables, fe_cases, make_fe_cases, probe_cases
+from cavex.verification.fedata.comparison import with_closed_forms
 from cavex.verification.fedata.runner import read_store, run_cases, write_case
 
 COARSE = {"elements_per_decade": 8, "growth_per_step": 0.15, "seed_ratio": 5,
@@ -79,8 +80,31 @@ def test_fe_results_bitwise_identical_serial_pool_and_dask(cluster):
     assert first["status"] == "ok" and first["layers"] == ["concrete", "macadam", "soil"]
     assert first["fe_sigma_r_Pa"] == pytest.approx(612.485e6, rel=1e-4)  # coarse, measured
     assert first["S"] == pytest.approx(first["fe_sigma_r_Pa"] / 25e6, rel=1e-15)
-    for r in serial:  # coarse mesh, nu = 0.4999: within a few % of the closed form
+    assert "analytic_sigma_r_Pa" not in first  # the closed forms are evaluated where kept
+    compared = with_closed_forms(serial, {c["id"]: c.problem for c in cases})
+    for r in compared:  # coarse mesh, nu = 0.4999: within a few % of the closed form
         assert abs(r["relative_difference"]["dynamic"]) < 0.08
+
+
+def test_built_cases_are_not_parsed_or_checked_again(monkeypatch):
+    """A case is built and checked once where it is made: the work unit parses no table, makes
+    no Numerics and builds no SphericalProblem (and so checks none) again."""
+    import cavex.fem.expansion
+    import cavex.verification.fedata.cases as cases_module
+    from cavex.problem import SphericalProblem
+
+    case = grid_cases()[0]
+    reference, = fe_cases([dict(case)])  # a plain description: built in the work unit
+
+    def again(*args, **kwargs):
+        raise AssertionError("parsed or checked again")
+
+    for module, name in ((cases_module, "parse_target"), (cases_module, "parse_projectile"),
+                         (cases_module, "make_numerics"), (cavex.fem.expansion, "make_numerics")):
+        monkeypatch.setattr(module, name, again)
+    monkeypatch.setattr(SphericalProblem, "__post_init__", again)
+    built, = fe_cases([case])
+    assert without_seconds([built]) == without_seconds([reference])
 
 
 def test_failing_case_is_recorded_and_the_others_finish():

@@ -25,12 +25,14 @@ from cavex.fem.settings import make_numerics
 from cavex.input_files import in_file, read_toml
 from cavex.materials import MAX_VELOCITY
 from cavex.verification.fedata.cases import (
+    CaseBuilder,
     check_run_size,
     config_tables,
     fe_case_id,
     fe_cases,
     numerics_names,
 )
+from cavex.verification.fedata.comparison import with_closed_forms
 from cavex.verification.fedata.runner import check_execution, check_store, read_store, run_cases
 from cavex.verification.fedata.table import MAX_DEPTH, write_table
 from cavex.verification.output.cf_metadata import CONVENTIONS, boolean_attrs
@@ -47,7 +49,7 @@ PROPERTY_UNITS = {"thickness": "m", "E": "Pa", "nu": "1", "rho": "kg m-3", "lam"
 NUMERICS_UNITS = {"seed_radius": "m", "tension_cutoff": "Pa", "dilatancy_deg": "degree"}
 SWEEP_FILE, STORE_DIR, RESULTS_FILE = "sweep.json", "cases", "results.nc"
 
-VARIABLES = {  # name: (path in the fe_cases result, units, long name)
+VARIABLES = {  # name: (path in the comparison record of a case, units, long name)
     "fe_sigma_r": (("fe_sigma_r_Pa",), "Pa", "FE radial stress at the cavity wall"),
     "S": (("S",), "1", "FE wall stress over the wall layer's tau"),
     "error_estimate": (("error_estimate",), "1",
@@ -321,13 +323,16 @@ def _is_int(value):
 # --- cases --------------------------------------------------------------------------------------
 
 def sweep_cases(sweep):
-    """The FE cases of a sweep, in the C order of its axes (the last axis varies fastest)."""
+    """The FE cases of a sweep (:class:`~cavex.verification.fedata.cases.FECase`, each distinct
+    target and numerics parsed once), in the C order of its axes (the last axis varies
+    fastest)."""
     cases = [_case(sweep, combination) for combination in _combinations(sweep.axes)]
     ids = [case["id"] for case in cases]
     if len(set(ids)) != len(ids):
         raise CavexInputError("two cases of the sweep get the same id: swept values too close "
                               "to tell apart (velocity to 1e-3 m/s, depth to 1e-5 m)")
-    return cases
+    build = CaseBuilder()
+    return [build(case) for case in cases]
 
 
 def _case(sweep, combination):
@@ -402,6 +407,7 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
     results = run_cases(fe_cases, cases, store=os.path.join(out_dir, STORE_DIR),
                         scheduler=scheduler, workers=workers, progress=progress,
                         chunk_size=chunk_size)
+    results = with_closed_forms(results, {case["id"]: case.problem for case in cases})
     dataset = _dataset(description, {r["id"]: r for r in results})
     # exactly as computed: the file mirrors the case store (it loads back identical to
     # load_sweep) and holds the wall times, so it is not a reproducible result file anyway
@@ -410,7 +416,8 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
 
 
 def load_sweep(out_dir):
-    """The sweep in ``out_dir`` as one Dataset, from its stored cases (a partial run too).
+    """The sweep in ``out_dir`` as one Dataset, from its stored cases (a partial run too); the
+    closed forms are evaluated from the stored case descriptions.
 
     Returns
     -------
@@ -434,7 +441,11 @@ def load_sweep(out_dir):
     with open(path, encoding="utf-8") as handle:
         description = json.load(handle)
     stored = read_store(os.path.join(out_dir, STORE_DIR))
-    return _dataset(description, {k: entry["result"] for k, entry in stored.items()})
+    build = CaseBuilder()
+    problems = {k: build(entry["case"]).problem for k, entry in stored.items()
+                if entry["result"]["status"] == "ok"}
+    results = with_closed_forms([entry["result"] for entry in stored.values()], problems)
+    return _dataset(description, {r["id"]: r for r in results})
 
 
 def _description(sweep, cases):

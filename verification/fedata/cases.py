@@ -1,6 +1,6 @@
-"""Self-contained, JSON-able FE cases for :func:`cavex.verification.fedata.runner.run_cases`.
+"""FE cases for :func:`cavex.verification.fedata.runner.run_cases`: built and checked once.
 
-An FE case is a plain dict::
+An FE case is described by a plain, JSON-able dict::
 
     {"id": "v0500.000_L0.30000", "velocity": 500.0, "depth": 0.3,
      "nu": 0.4999,                        # optional: Poisson's ratio for every layer
@@ -10,10 +10,16 @@ An FE case is a plain dict::
      "projectile": {"r": 0.0125, "l": 0.06, "R": 0.075, "m": 0.505, "V0": 1000.0}}
 
 ``target`` is the list of ``[[layers]]`` tables and ``projectile`` the ``[projectile]`` table of
-the config TOML schema (``core/data/runway.toml``), so a case carries everything it needs.
-FE cases are run in chunks (:func:`fe_cases`, the work unit of
-:func:`cavex.verification.fedata.runner.run_cases` for processes and Dask): the cases of a chunk
-that share their numerics run together on the one FE solver.
+the config TOML schema (``core/data/runway.toml``), so a description carries everything it
+needs; it is what the runner's store keeps (``{"case": ..., "result": ...}``).
+
+:func:`make_fe_cases` (and the batch sweeps) build every case once, in the process that makes
+them, into an :class:`FECase`: the description (a read-only mapping) with the checked objects
+the FE runs on, a :class:`~cavex.problem.SphericalProblem` and a :class:`~cavex.fem.Numerics`
+(each distinct target, projectile and numerics parsed once, :class:`CaseBuilder`). A process or
+a Dask worker receives them pickled and parses or checks nothing again. FE cases are run in
+chunks (:func:`fe_cases`, the work unit of :func:`cavex.verification.fedata.runner.run_cases`):
+the cases of a chunk that share their numerics run together on the one FE solver.
 """
 
 import json
@@ -21,14 +27,14 @@ import math
 import os
 import time
 import uuid
+from collections.abc import Mapping
 from dataclasses import fields
 
 from cavex.config import load_config, parse_projectile, parse_target, projectile_table, target_table
 from cavex.errors import CavexInputError, CavexNumericalError, check_keys, require
 from cavex.errors import is_finite_number as _finite
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
-from cavex.fem.settings import Numerics, make_numerics
-from cavex.problem import check_problem
+from cavex.fem.settings import Numerics, check_seed_radius, make_numerics
 
 CASE_KEYS = {"id", "velocity", "depth", "nu", "numerics", "error_target", "target",
              "projectile"}
@@ -53,62 +59,146 @@ def check_run_size(n_cases, workers, allow_large, option="allow-large"):
            "per worker)"
 
 
+class FECase(Mapping):
+    """One FE case, built and checked once.
+
+    A read-only mapping: the case's JSON-able description (module docstring), which the store
+    keeps and the id names. Beside it what the FE runs on, so that nothing is parsed or
+    checked again where the case runs:
+
+    Attributes
+    ----------
+    problem : SphericalProblem
+        The spherical problem at the case's depth (``nu`` applied), checked.
+    numerics : Numerics
+        The FE settings, checked (the seed radius against the problem too).
+    error_target : float or None
+        Refine while the error estimate exceeds it (None: never).
+    """
+
+    def __init__(self, description, problem, numerics, error_target):
+        self._description = description
+        self.problem = problem
+        self.numerics = numerics
+        self.error_target = error_target
+
+    def __getitem__(self, key):
+        return self._description[key]
+
+    def __iter__(self):
+        return iter(self._description)
+
+    def __len__(self):
+        return len(self._description)
+
+    def __repr__(self):
+        return f"FECase({self._description!r})"
+
+    def renamed(self, case_id):
+        """The same case under another id."""
+        return FECase({**self._description, "id": case_id}, self.problem, self.numerics,
+                      self.error_target)
+
+
+class CaseBuilder:
+    """Builds :class:`FECase` from descriptions, parsing each distinct target, projectile and
+    numerics once (the cases of a grid share them); a ``target`` and ``projectile`` given are
+    taken for their tables (:func:`target_table`, :func:`projectile_table`) without parsing."""
+
+    def __init__(self, target=None, projectile=None):
+        self._parsed = {}
+        if target is not None:
+            self._parsed[self._key(parse_target, target_table(target))] = target
+        if projectile is not None:
+            self._parsed[self._key(parse_projectile, projectile_table(projectile))] = projectile
+
+    @staticmethod
+    def _key(parse, value):
+        return parse.__name__, json.dumps(value, sort_keys=True)
+
+    def _once(self, parse, value):
+        key = self._key(parse, value)
+        if key not in self._parsed:
+            self._parsed[key] = parse(value)
+        return self._parsed[key]
+
+    def target(self, layers):
+        """The :class:`~cavex.materials.Target` of ``[[layers]]`` tables (or
+        ``{"layers": [...]}``)."""
+        return self._once(parse_target, _layers(layers))
+
+    def projectile(self, table):
+        return self._once(parse_projectile, table)
+
+    def numerics(self, settings):
+        return self._once(_numerics, settings)
+
+    def __call__(self, description):
+        """The :class:`FECase` of a description; raises :class:`CavexInputError` (or
+        ``KeyError``/``TypeError``/``ValueError`` for a malformed dict) if it is not a valid
+        case."""
+        from cavex.verification.fedata.comparison import fe_problem
+
+        check_keys(description, CASE_KEYS, "")
+        target = self.target(description["target"])
+        projectile = self.projectile(description["projectile"])
+        numerics = self.numerics(description.get("numerics", {}))
+        error_target = description.get("error_target", DEFAULT_ERROR_TARGET)
+        require(error_target is None or (_finite(error_target) and 0 < error_target < 1),
+                "error_target", "null or a number in (0, 1)", error_target)
+        problem = fe_problem(target, projectile, description["depth"], description["velocity"],
+                             description.get("nu"))
+        check_seed_radius(numerics, problem.radius)
+        return FECase(description, problem, numerics,
+                      None if error_target is None else float(error_target))
+
+
+def _numerics(settings):
+    return make_numerics(**settings)
+
+
 def fe_cases(chunk):
     """Run a chunk of FE cases: per case :func:`~cavex.verification.fedata.comparison.
-    compare_at_depth`'s dict plus ``"id"``, or the exception the case failed with.
+    fe_record`'s dict plus ``"id"``, or the exception the case failed with.
 
     The cases that share their numerics and error target run together
-    (:func:`~cavex.verification.fedata.comparison.compare_many`: stacks of the one FE solver); a
-    case computes the same bits in any chunk.
+    (:func:`~cavex.verification.fedata.comparison.fe_records`: stacks of the one FE solver); a
+    case computes the same bits in any chunk. The closed forms are not evaluated here: they
+    are evaluated once where the results are kept
+    (:func:`~cavex.verification.fedata.comparison.closed_forms`).
 
     Parameters
     ----------
-    chunk : list of dict
-        Cases with keys ``id``, ``velocity`` (m/s), ``depth`` (nose-tip depth, m), optional
-        ``nu``, optional ``numerics`` (dict of :class:`cavex.fem.Numerics` settings), optional
-        ``error_target`` (default :data:`cavex.fem.estimate.DEFAULT_ERROR_TARGET`; None: no
-        refinement), ``target`` (list of layer tables, or ``{"layers": [...]}``) and
-        ``projectile`` (table).
+    chunk : list of FECase or dict
+        Built cases (:func:`make_fe_cases`), or descriptions (module docstring), which are
+        built here: a bad one fails alone.
     """
-    from cavex.verification.fedata.comparison import compare_many
+    from cavex.verification.fedata.comparison import fe_records
 
     out = [None] * len(chunk)
+    build = CaseBuilder()
     groups = {}
     for i, case in enumerate(chunk):
-        try:
-            request, numerics, target = _fe_request(case)
-        except (CavexInputError, KeyError, TypeError, ValueError) as exc:
-            out[i] = exc
-            continue
-        key = json.dumps([numerics, target], sort_keys=True)
-        groups.setdefault(key, (numerics, target, []))[2].append((i, request))
-    for numerics, target, members in groups.values():
-        results = compare_many([request for _, request in members], error_target=target,
-                               **numerics)
-        for (i, _), result in zip(members, results, strict=True):
-            out[i] = result if isinstance(result, Exception) else {**result,
-                                                                  "id": chunk[i]["id"]}
+        if not isinstance(case, FECase):
+            try:
+                case = build(case)
+            except (CavexInputError, KeyError, TypeError, ValueError) as exc:
+                out[i] = exc
+                continue
+        key = (json.dumps(case.numerics.as_dict(), sort_keys=True), case.error_target)
+        groups.setdefault(key, []).append((i, case))
+    for members in groups.values():
+        first = members[0][1]
+        results = fe_records([case["depth"] for _, case in members],
+                             [case.problem for _, case in members], first.numerics,
+                             first.error_target)
+        for (i, case), result in zip(members, results, strict=True):
+            out[i] = result if isinstance(result, Exception) else {**result, "id": case["id"]}
     return out
 
 
-def _fe_request(case):
-    """``((target, projectile, depth, velocity, nu), numerics, error_target)`` of a case."""
-    from cavex.verification.fedata.comparison import fe_problem
-
-    check_keys(case, CASE_KEYS, "")
-    target = parse_target(_layers(case["target"]))
-    projectile = parse_projectile(case["projectile"])
-    numerics = make_numerics(**case.get("numerics", {})).as_dict()
-    error_target = case.get("error_target", DEFAULT_ERROR_TARGET)
-    require(error_target is None or (_finite(error_target) and 0 < error_target < 1),
-            "error_target", "null or a number in (0, 1)", error_target)
-    request = (target, projectile, case["depth"], case["velocity"], case.get("nu"))
-    check_problem(*fe_problem(*request), "dynamic")  # a bad case fails alone, not its chunk
-    return request, numerics, None if error_target is None else float(error_target)
-
-
 def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, numerics=None,
-                  error_target=DEFAULT_ERROR_TARGET):
+                  error_target=DEFAULT_ERROR_TARGET, build=None):
     """FE cases on the grid ``velocities x depths`` (velocity outermost), with stable ids.
 
     Parameters
@@ -126,25 +216,30 @@ def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, n
         :class:`cavex.fem.Numerics` settings shared by all cases.
     error_target : float or None
         Refine an FE case while its error estimate exceeds this (None: never).
+    build : CaseBuilder, optional
+        The builder to use (one made with the target and projectile objects of the tables
+        saves parsing them back).
 
     Returns
     -------
-    list of dict
-        Cases with ids ``"v0500.000_L0.30000"`` (``"_nu0.499900"`` appended when ``nu`` is
-        given); the ids are unique and depend only on the values.
+    list of FECase
+        Built cases with ids ``"v0500.000_L0.30000"`` (``"_nu0.499900"`` appended when ``nu``
+        is given); the ids are unique and depend only on the values.
 
     Raises
     ------
     CavexInputError
-        Invalid target, projectile, numerics, velocities or depths, or two values too close to
-        be told apart by the id format.
+        Invalid target, projectile, numerics, velocities or depths, a spherical problem that
+        cannot be run (e.g. a seed radius beyond ``r/5``), or two values too close to be told
+        apart by the id format.
     """
     layers = [dict(table) for table in _layers(target_table)]
     projectile = dict(projectile_table)
-    parse_target(layers)
-    parse_projectile(projectile)
     numerics = dict(numerics or {})
-    make_numerics(**numerics)
+    build = build or CaseBuilder()
+    build.target(layers)
+    build.projectile(projectile)
+    build.numerics(numerics)
     if nu is not None:
         require(_finite(nu) and -1.0 < nu < 0.5, "nu", "in (-1, 0.5)", nu)
     cases = []
@@ -163,7 +258,7 @@ def make_fe_cases(target_table, projectile_table, velocities, depths, nu=None, n
                 case["error_target"] = error_target
             cases.append({**case, "target": layers, "projectile": projectile})
     check_unique_ids(cases)
-    return cases
+    return [build(case) for case in cases]
 
 
 def fe_case_id(velocity, depth, nu=None):

@@ -3,54 +3,60 @@
 The FE side runs on the one solver of :mod:`cavex.fem` (all problems of a call in stacks), with
 the default error target: a problem whose estimated discretisation error exceeds
 :data:`cavex.fem.estimate.DEFAULT_ERROR_TARGET` is refined (up to twice) until it does not.
+Its record (:func:`fe_record`) is what an FE case returns.
+
+The closed-form side (:func:`closed_forms`) is evaluated once per problem and convention
+through the array form of :func:`cavex.analytic.cavity.cavity_solution`, for all problems of a
+call together, where the numbers are kept (the FE table, the batch Dataset, ``cavex fem``);
+:func:`comparison_record` puts both sides in one record.
 """
 
 from dataclasses import replace
 
+import numpy as np
+
 from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET, MAX_REFINEMENTS
-from cavex.fem.expansion import expand_cavities
+from cavex.fem.expansion import expand_problems
 from cavex.fem.output import write_result
-from cavex.problem import BOUNDARIES, check_problem
+from cavex.fem.settings import make_numerics
+from cavex.problem import BOUNDARIES, SphericalProblem
 from cavex.verification.output.paths import check_output_dir
 
 #: Numerics settings renamed in JSON output (their unit appended)
 NUMERICS_JSON_KEYS = {"seed_radius": "seed_radius_m", "tension_cutoff": "tension_cutoff_Pa"}
+#: Keys of a comparison record, in order (the FE record's and the closed forms')
+COMPARISON_KEYS = ("depth_m", "velocity_m_s", "cavity_radius_m", "layers", "interface_radii_m",
+                   "interface_radii_final_m", "fe_sigma_r_Pa", "S", "analytic_sigma_r_Pa",
+                   "relative_difference", "error_estimate", "refinements",
+                   "fe_plastic_radius_m", "analytic_plastic_radius_m", "numerics",
+                   "wall_time_s")
 
 
 def fe_problem(target, projectile, depth, velocity, nu=None):
-    """``(layers, interfaces, velocity, radius)`` of the FE problem at nose-tip depth ``depth``
+    """The :class:`~cavex.problem.SphericalProblem` of the FE at nose-tip depth ``depth``
     (:func:`cavex.analytic.geometry.spherical_problem`; cavity radius = shank radius), with
-    Poisson's ratio ``nu`` for every layer when given."""
+    Poisson's ratio ``nu`` for every layer when given; checked as it is built."""
     layers, interfaces = spherical_problem(target, projectile, depth)
     if nu is not None:
         layers = [replace(m, nu=nu) for m in layers]
-    return list(layers), list(interfaces), float(velocity), float(projectile.r)
+    return SphericalProblem(tuple(layers), interfaces, velocity, projectile.r)
 
 
-def compare_many(requests, error_target=DEFAULT_ERROR_TARGET, max_refinements=MAX_REFINEMENTS,
-                 **numerics):
-    """FE against closed form for many ``(target, projectile, depth, velocity, nu)`` requests,
-    with shared numerics; a list of dicts (see :func:`compare_at_depth`), or of the
+def fe_records(depths, problems, numerics, error_target=DEFAULT_ERROR_TARGET):
+    """FE runs of checked ``problems`` (nose-tip ``depths``) with one
+    :class:`~cavex.fem.Numerics`: per problem its :func:`fe_record`, or the
     :class:`~cavex.errors.CavexNumericalError` of a failed FE run."""
-    return [comparison(request[2], problem, result) if result.ok else result.error
-            for request, problem, result in zip(requests, *_run(requests, error_target,
-                                                                max_refinements, False,
-                                                                **numerics), strict=True)]
+    results = expand_problems(problems, numerics, error_target=error_target,
+                              max_refinements=MAX_REFINEMENTS)
+    return [fe_record(depth, problem, result) if result.ok else result.error
+            for depth, problem, result in zip(depths, problems, results, strict=True)]
 
 
-def _run(requests, error_target, max_refinements, record, **numerics):
-    problems = [fe_problem(*request) for request in requests]
-    return problems, expand_cavities(problems, error_target=error_target,
-                                     max_refinements=max_refinements, record=record, **numerics)
-
-
-def comparison(depth, problem, result):
-    """The JSON-able comparison of one FE result with both closed-form conventions."""
-    layers, interfaces, velocity, radius = problem
-    analytic = {b: cavity_solution(layers, interfaces, velocity, radius, boundary=b)
-                for b in BOUNDARIES}
+def fe_record(depth, problem, result):
+    """The JSON-able record of one FE result (the FE side of :func:`compare_at_depth`)."""
+    layers, interfaces, velocity, radius = problem.as_tuple()
     fe = result.cavity_stress
     return {
         "depth_m": float(depth), "velocity_m_s": float(velocity),
@@ -60,15 +66,71 @@ def comparison(depth, problem, result):
         "interface_radii_final_m": [float(h) for h in result.interfaces_final],
         "fe_sigma_r_Pa": float(fe),
         "S": float(fe / layers[0].tau),
-        "analytic_sigma_r_Pa": {b: float(s.stress) for b, s in analytic.items()},
-        "relative_difference": {b: float(fe / s.stress - 1.0) for b, s in analytic.items()},
         "error_estimate": None if result.error_estimate is None else float(result.error_estimate),
         "refinements": int(result.stats["refinements"]),
         "fe_plastic_radius_m": float(result.plastic_radius),
-        "analytic_plastic_radius_m": {b: float(s.plastic_radius) for b, s in analytic.items()},
         "numerics": numerics_json(result.numerics),
         "wall_time_s": float(result.stats["seconds"]),
     }
+
+
+def closed_forms(problems, boundaries=BOUNDARIES):
+    """Closed-form wall stress and plastic radius of every problem, evaluated once each.
+
+    Parameters
+    ----------
+    problems : sequence of tuple
+        ``(layers, interfaces, velocity, radius)`` each (checked by the evaluation).
+    boundaries : sequence of str
+        Conventions (:data:`cavex.problem.BOUNDARIES`).
+
+    Returns
+    -------
+    dict
+        ``{boundary: (stress, plastic_radius)}``, float arrays in the order of ``problems``:
+        one :func:`~cavex.analytic.cavity.cavity_solution` call per convention and group of
+        problems with the same layers (interfaces, velocities and radii as arrays; the same
+        bits as one call per problem).
+    """
+    groups = {}
+    for i, (layers, *_) in enumerate(problems):
+        groups.setdefault(tuple(layers), []).append(i)
+    out = {b: (np.full(len(problems), np.nan), np.full(len(problems), np.nan))
+           for b in boundaries}
+    for layers, members in groups.items():
+        interfaces = np.array([problems[i][1] for i in members], dtype=float).reshape(
+            len(members), len(layers) - 1)
+        velocity = np.array([problems[i][2] for i in members], dtype=float)
+        radius = np.array([problems[i][3] for i in members], dtype=float)
+        for b in boundaries:
+            state = cavity_solution(layers, interfaces, velocity, radius, boundary=b)
+            out[b][0][members] = state.stress
+            out[b][1][members] = state.plastic_radius
+    return out
+
+
+def comparison_record(record, closed, i):
+    """An FE ``record`` (:func:`fe_record`) with problem ``i`` of ``closed``
+    (:func:`closed_forms`) beside it: ``analytic_sigma_r_Pa``, ``relative_difference``
+    (``fe/analytic - 1``) and ``analytic_plastic_radius_m``, each keyed by convention; keys in
+    the order :data:`COMPARISON_KEYS`, then any others of ``record``."""
+    fe = record["fe_sigma_r_Pa"]
+    stress = {b: float(s[i]) for b, (s, _) in closed.items()}
+    merged = {**record, "analytic_sigma_r_Pa": stress,
+              "relative_difference": {b: float(fe / s - 1.0) for b, s in stress.items()},
+              "analytic_plastic_radius_m": {b: float(r[i]) for b, (_, r) in closed.items()}}
+    return {**{k: merged[k] for k in COMPARISON_KEYS if k in merged},
+            **{k: v for k, v in merged.items() if k not in COMPARISON_KEYS}}
+
+
+def with_closed_forms(records, problems):
+    """``records`` (dicts with ``"status"``) where the ``"ok"`` ones get the closed forms of
+    ``problems[record["id"]]`` (:func:`comparison_record`; one :func:`closed_forms` for all);
+    the others as they are."""
+    ok = [r for r in records if r.get("status") == "ok"]
+    closed = closed_forms([problems[r["id"]].as_tuple() for r in ok])
+    done = {id(r): comparison_record(r, closed, i) for i, r in enumerate(ok)}
+    return [done.get(id(r), r) for r in records]
 
 
 def numerics_json(numerics):
@@ -119,13 +181,13 @@ def compare_at_depth(target, projectile, depth, velocity, nu=None,
     """
     if fields is not None:
         fields = check_output_dir(fields, "fields")
-    request = (target, projectile, depth, velocity, nu)
-    check_problem(*fe_problem(*request), "dynamic")  # named without the batch's index
-    (problem,), (result,) = _run([request], error_target, MAX_REFINEMENTS, fields is not None,
-                                 **numerics)
+    problem = fe_problem(target, projectile, depth, velocity, nu)
+    result, = expand_problems([problem], make_numerics(**numerics), error_target=error_target,
+                              max_refinements=MAX_REFINEMENTS, record=fields is not None)
     if not result.ok:
         raise result.error
-    out = comparison(depth, problem, result)
+    out = comparison_record(fe_record(depth, problem, result),
+                            closed_forms([problem.as_tuple()]), 0)
     if fields is not None:
         out["fields"] = str(write_result(result, fields / "fem"))
     return out

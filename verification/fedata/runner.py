@@ -1,13 +1,15 @@
 """Run many independent cases locally or on a Dask cluster, with a resumable on-disk store.
 
-One function does the work, :func:`run_cases`. A *case* is a JSON-able dict with a unique string
-``"id"``; the *function* is a picklable top-level callable that takes a *chunk* (a list of
-cases) and returns one entry per case: a JSON-able dict, or the exception that case failed
-with. The work unit sent to a process or a Dask worker is a chunk, so a function can treat its
-cases together (the FE cases run as stacks of one solver, :func:`cavex.verification.fedata.cases.
-fe_cases`). Every result is passed through JSON inside the worker, so a result read back from
-the store is bit-for-bit the one computed (floats are written with ``repr``, which round-trips
-exactly).
+One function does the work, :func:`run_cases`. A *case* is a mapping of JSON-able values with a
+unique string ``"id"`` (a dict, or a mapping that also carries built objects for the function,
+such as :class:`cavex.verification.fedata.cases.FECase`: the store keeps its items, the worker
+receives the case itself); the *function* is a picklable top-level callable that takes a
+*chunk* (a list of cases) and returns one entry per case: a JSON-able dict, or the exception
+that case failed with. The work unit sent to a process or a Dask worker is a chunk, so a
+function can treat its cases together (the FE cases run as stacks of one solver,
+:func:`cavex.verification.fedata.cases.fe_cases`). Every result is passed through JSON inside
+the worker, so a result read back from the store is bit-for-bit the one computed (floats are
+written with ``repr``, which round-trips exactly).
 """
 
 import contextlib
@@ -24,6 +26,7 @@ import sys
 import threading
 import time
 import uuid
+from collections.abc import Mapping
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 
 from cavex.errors import CavexInputError, require
@@ -50,8 +53,9 @@ def run_cases(function, cases, *, store=None, scheduler=None, workers=None, prog
     function : callable
         Picklable top-level callable ``chunk(list of dict) -> list`` with, per case, a
         JSON-able dict or the exception the case failed with.
-    cases : list of dict
-        JSON-able dicts, each with a unique string key ``"id"`` (used as a file name).
+    cases : list of Mapping
+        Mappings of JSON-able values (dicts, or :class:`~cavex.verification.fedata.cases.FECase`),
+        each with a unique string key ``"id"`` (used as a file name).
     store : str or os.PathLike, optional
         Directory; each finished case is written atomically to ``store/<id>.json`` as soon as
         it finishes, and cases already stored there are loaded instead of recomputed.
@@ -186,7 +190,7 @@ def case_path(store, case_id):
 def write_case(store, case, result):
     """Atomically write ``{"case": case, "result": result}`` to ``store/<id>.json``."""
     write_text_atomic(case_path(store, case["id"]),
-                      json.dumps({"case": case, "result": result}, indent=1))
+                      json.dumps({"case": dict(case), "result": result}, indent=1))
     _fsync_dir(store)
 
 
@@ -237,7 +241,7 @@ def _compare_with_store(store, cases):
         entry = stored.get(case["id"])
         if entry is None:
             continue
-        if entry["case"] != _json_normalised(case):
+        if entry["case"] != _json_normalised(dict(case)):
             raise CavexInputError(f"store '{os.fspath(store)}' holds a different case under id "
                                   f"'{case['id']}'; use a new store directory")
         results[case["id"]] = entry["result"]
@@ -276,8 +280,8 @@ def _json_normalised(value):
 def _check_cases(cases):
     seen = set()
     for i, case in enumerate(cases):
-        require(isinstance(case, dict) and "id" in case, f"cases[{i}]", "a dict with an 'id'",
-                case)
+        require(isinstance(case, Mapping) and "id" in case, f"cases[{i}]",
+                "a mapping with an 'id'", case)
         case_id = case["id"]
         require(_usable_id(case_id), f"cases[{i}].id",
                 "a non-empty string usable as a file name (no path separators, not starting "
@@ -285,7 +289,7 @@ def _check_cases(cases):
         require(case_id not in seen, f"cases[{i}].id", "unique", case_id)
         seen.add(case_id)
         try:
-            json.dumps(case, allow_nan=False)
+            json.dumps(dict(case), allow_nan=False)
         except (TypeError, ValueError) as exc:
             raise CavexInputError(f"case '{case_id}' is not JSON-able: {exc}") from None
 

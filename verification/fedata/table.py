@@ -35,13 +35,14 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem, switch_depths, wall_layer
 from cavex.config import config_text, fingerprint, fingerprint_data, projectile_table, target_table
-from cavex.errors import require
+from cavex.errors import require, require_choice
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
 from cavex.materials import MAX_VELOCITY
-from cavex.verification.fedata.cases import fe_cases, make_fe_cases
+from cavex.problem import BOUNDARIES
+from cavex.verification.fedata.cases import CaseBuilder, fe_cases, make_fe_cases
+from cavex.verification.fedata.comparison import closed_forms
 from cavex.verification.fedata.runner import check_execution, run_cases
 from cavex.verification.output.cf_metadata import CONVENTIONS, UNITS, boolean_attrs, flag_attrs
 from cavex.verification.output.number_format import round_dataset
@@ -145,7 +146,7 @@ def build_table(target, projectile, velocities, depths, *, nu=None, numerics=Non
     v = np.unique(np.asarray(velocities, dtype=float))
     d = grid_depths(depths, target, projectile, refine)
     grid = table_cases(target, projectile, v, d, nu, numerics, error_target)
-    first = [{**case, "id": f"first-layer-{case['id']}"} for case in
+    first = [case.renamed(f"first-layer-{case['id']}") for case in
              table_cases(target.single(0), projectile, v, [FIRST_LAYER_DEPTH], nu, numerics,
                          error_target)]
     results = run_cases(fe_cases, grid + first, store=store, scheduler=scheduler,
@@ -153,14 +154,16 @@ def build_table(target, projectile, velocities, depths, *, nu=None, numerics=Non
     cells = _cells(results[:len(grid)], grid, v, d)
     crater = _cells(results[len(grid):], first, v, [FIRST_LAYER_DEPTH])
     return assemble_table(target, projectile, v, d, cells, crater,
-                          settings_json(nu, numerics, error_target))
+                          settings_json(nu, numerics, error_target),
+                          analytic_grid(target, projectile, v, d))
 
 
 def table_cases(target, projectile, velocities, depths, nu, numerics,
                 error_target=DEFAULT_ERROR_TARGET):
     """FE cases in the order velocity-major, depth-minor (``V = 0`` is a quasi-static run)."""
     return make_fe_cases(target_table(target), projectile_table(projectile), velocities,
-                         depths, nu=nu, numerics=numerics, error_target=error_target)
+                         depths, nu=nu, numerics=numerics, error_target=error_target,
+                         build=CaseBuilder(target, projectile))
 
 
 def _cells(results, cases, velocities, depths):
@@ -204,34 +207,41 @@ def analytic_table(target, projectile, velocities, depths, boundary="dynamic",
     with ``boundary``); the grid is built as :func:`build_table` builds it.
     """
     check_grid(velocities, depths)
+    require_choice(boundary, BOUNDARIES, "boundary")
     v = np.unique(np.asarray(velocities, dtype=float))
     d = grid_depths(depths, target, projectile, refine)
 
-    def cells(tgt, ds):
-        sigma, b = _analytic_grid(tgt, projectile, v, ds, boundary, ("stress", "plastic_radius"))
+    def cells(tgt, ds, closed):
+        sigma, b = closed[boundary]
         tau = np.array([tgt.layers[wall_layer(tgt, projectile, L)].tau for L in ds])
         return {"sigma_r": sigma, "S": sigma / tau, "error_estimate": np.zeros_like(sigma),
                 "plastic_radius": b,
                 "failed": np.zeros(sigma.shape, dtype=bool), "failures": []}
 
-    return assemble_table(target, projectile, v, d, cells(target, d),
-                          cells(target.single(0), [FIRST_LAYER_DEPTH]),
-                          json.dumps({"analytic": boundary, "switch": "cavity"}))
+    reference = analytic_grid(target, projectile, v, d)
+    first = target.single(0)
+    return assemble_table(target, projectile, v, d, cells(target, d, reference),
+                          cells(first, [FIRST_LAYER_DEPTH],
+                                analytic_grid(first, projectile, v, [FIRST_LAYER_DEPTH],
+                                              (boundary,))),
+                          json.dumps({"analytic": boundary, "switch": "cavity"}), reference)
 
 
-def _analytic_grid(target, projectile, velocities, depths, boundary, fields=None):
-    """Closed-form ``sigma_r`` on the grid, or one array per :class:`CavityState` field."""
-    out = np.empty((len(fields or ("stress",)), len(velocities), len(depths)))
-    for j, L in enumerate(depths):
-        layers, interfaces = spherical_problem(target, projectile, L)
-        for i, V in enumerate(velocities):
-            state = cavity_solution(layers, interfaces, V, projectile.r, boundary=boundary)
-            out[:, i, j] = [getattr(state, f) for f in fields or ("stress",)]
-    return out[0] if fields is None else tuple(out)
+def analytic_grid(target, projectile, velocities, depths, boundaries=BOUNDARIES):
+    """The closed forms on the grid, each cell once
+    (:func:`cavex.verification.fedata.comparison.closed_forms`): ``{boundary: (sigma_r,
+    plastic_radius)}``, arrays of shape ``(velocities, depths)``."""
+    columns = [spherical_problem(target, projectile, float(L)) for L in depths]
+    problems = [(layers, interfaces, float(V), projectile.r)
+                for V in velocities for layers, interfaces in columns]
+    shape = (len(velocities), len(depths))
+    return {b: (stress.reshape(shape), radius.reshape(shape))
+            for b, (stress, radius) in closed_forms(problems, boundaries).items()}
 
 
-def assemble_table(target, projectile, velocities, depths, cells, crater, settings):
-    """The Dataset from grid arrays (see :func:`build_table`)."""
+def assemble_table(target, projectile, velocities, depths, cells, crater, settings, reference):
+    """The Dataset from grid arrays (see :func:`build_table`); ``reference`` holds the closed
+    forms on the grid (:func:`analytic_grid`)."""
     v, d = np.asarray(velocities, dtype=float), np.asarray(depths, dtype=float)
     grid = ("velocity", "depth")
     names = target.layer_names()
@@ -255,9 +265,9 @@ def assemble_table(target, projectile, velocities, depths, cells, crater, settin
         "failed_first_layer": ("velocity", cells_first(crater, "failed"),
                                boolean_attrs("FE first-layer run failed", "ok", "failed")),
     }
-    for boundary in ("dynamic", "quasi-static"):
+    for boundary in BOUNDARIES:
         data["sigma_r_" + boundary.replace("-", "_")] = (
-            grid, _analytic_grid(target, projectile, v, d, boundary),
+            grid, reference[boundary][0],
             _attrs("Pa", f"analytic cavity-wall stress, {boundary} boundary (reference)"))
     coords = {"velocity": ("velocity", v, _attrs(UNITS["velocity"],
                                                  "cavity expansion velocity V")),

@@ -16,7 +16,6 @@ CONVENTIONS = "CF-1.10"
 # UDUNITS spellings of every unit the netCDF files use
 UNITS = {"velocity": "m s-1", "length": "m", "stress": "Pa", "density": "kg m-3",
          "time": "s", "angle": "degree", "dimensionless": "1"}
-ALLOWED_UNITS = frozenset(UNITS.values())
 
 
 def flag_word(text):

@@ -327,13 +327,6 @@ def row_score(row):
     return max(excess)
 
 
-def within_print(row, key):
-    """Does our value round to the paper's printed value (half a unit of its last digit)?"""
-    if row["ours"] is None:
-        return False
-    return abs(row["ours"][key] - row["paper"][key]) <= PRINT_HALF_UNIT[key] * (1 + 1e-12)
-
-
 def factorial_readings(axes=CHOICES):
     """Every combination of the discrete choices in ``axes`` as a :class:`Reading`."""
     keys = tuple(axes)
