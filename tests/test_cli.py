@@ -221,16 +221,15 @@ BAD_INPUTS = [
 ]
 
 # the earlier spellings of the resistance choice (issue 18), each refused with the new one
+MODEL_REPLACED = ("option --model was replaced by --resistance derived|paper|table (with "
+                  "--boundary dynamic|quasi-static)")
 OLD_SPELLINGS = [
     (["penetrate", "--out", "OUT", "--model", "paper"],
-     "option --model was replaced by --resistance derived|paper|table (with --boundary "
-     "dynamic|quasi-static); for 'paper' use --resistance paper"),
+     f"{MODEL_REPLACED}; for 'paper' use --resistance paper"),
     (["penetrate", "--out", "OUT", "--model", "derived"],
-     "option --model was replaced by --resistance derived|paper|table (with --boundary "
-     "dynamic|quasi-static); for 'derived' use --resistance derived"),
+     f"{MODEL_REPLACED}; for 'derived' use --resistance derived"),
     (["stress", "--velocity", "500", "--depth", "0.3", "--model", "paper"],
-     "option --model was replaced by --resistance derived|paper|table (with --boundary "
-     "dynamic|quasi-static); for 'paper' use --resistance paper"),
+     f"{MODEL_REPLACED}; for 'paper' use --resistance paper"),
     (["penetrate", "--out", "OUT", "--resistance", "closed-form"],
      "option --resistance closed-form was replaced by --resistance derived or --resistance "
      "paper"),
@@ -239,17 +238,45 @@ OLD_SPELLINGS = [
      "--boundary quasi-static"),
     (["calibrate", "--shots", "examples/shots_forrestal1994.csv", "--out", "OUT.toml",
       "--model", "fe-table"],
-     "option --model was replaced by --resistance derived|paper|table (with --boundary "
-     "dynamic|quasi-static); for 'fe-table' use --resistance table"),
+     f"{MODEL_REPLACED}; for 'fe-table' use --resistance table"),
     (["calibrate", "--shots", "examples/shots_forrestal1994.csv", "--out", "OUT.toml",
       "--model", "derived-quasi-static"],
-     "option --model was replaced by --resistance derived|paper|table (with --boundary "
-     "dynamic|quasi-static); for 'derived-quasi-static' use --resistance derived --boundary "
+     f"{MODEL_REPLACED}; for 'derived-quasi-static' use --resistance derived --boundary "
      "quasi-static"),
     (["calibrate", "--shots", "examples/shots_forrestal1994.csv", "--out", "OUT.toml",
       "--resistance", "fe-table"], "option --resistance fe-table was replaced by --resistance "
      "table"),
 ]
+
+
+def test_resistance_options_of_every_command():
+    """One vocabulary: the settings each command reads from its options (calibrate builds its
+    FE tables, so it has no --table; stress has no table)."""
+    from cavex.verification.cli import build_parser
+    from cavex.verification.commands.options import CLOSED_FORMS, resistance_settings
+
+    parser = build_parser()
+    calibrate = ["calibrate", "--shots", "s.csv", "--out", "c.toml"]
+    cases = [
+        (["penetrate"], {"resistance": "derived", "boundary": "dynamic",
+                         "epsilon": "quasi-static", "table": None}),
+        (["penetrate", "--resistance", "paper", "--epsilon", "cylindrical"],
+         {"resistance": "paper", "boundary": "quasi-static", "epsilon": "cylindrical",
+          "table": None}),
+        (["penetrate", "--resistance", "table", "--table", "t.nc", "--boundary",
+          "quasi-static"], {"resistance": "table", "boundary": "quasi-static",
+                            "epsilon": "quasi-static", "table": "t.nc"}),
+        (["trajectory", "--resistance", "law"], {"resistance": "law", "boundary": "dynamic",
+                                                 "epsilon": "quasi-static", "table": None}),
+        ([*calibrate, "--resistance", "table"], {"resistance": "table", "boundary": "dynamic",
+                                                 "epsilon": "quasi-static", "table": None}),
+        ([*calibrate, "--boundary", "quasi-static"],
+         {"resistance": "derived", "boundary": "quasi-static", "epsilon": "quasi-static",
+          "table": None}),
+    ]
+    for argv, settings in cases:
+        offered = CLOSED_FORMS if argv[0] == "stress" else ("derived", "paper", "table", "law")
+        assert resistance_settings(parser.parse_args(argv), offered) == settings, argv
 
 
 @pytest.mark.parametrize("argv, message", OLD_SPELLINGS, ids=lambda v: " ".join(v)

@@ -66,7 +66,8 @@ def replaced(value):
 def resistance_settings(args, offered=RESISTANCES):
     """``{"resistance", "boundary", "epsilon", "table"}`` of the parsed options, checked: the
     resistance is one of ``offered``, ``--table FILE`` goes with ``--resistance table`` (both or
-    neither), the paper model takes only its own boundary. ``boundary`` is resolved (the
+    neither; where the command has ``--table``: ``calibrate`` builds its tables), the paper
+    model takes only its own boundary. ``boundary`` is resolved (the
     derived model's default for a table or a law: the first layer alone, if flown, is
     derived)."""
     if args.old_model is not None:
@@ -83,7 +84,7 @@ def resistance_settings(args, offered=RESISTANCES):
                                                     "gives the FE wall stress"
                                                     if resistance == "table" else ""))
     table = getattr(args, "table", None)
-    if (resistance == "table") != (table is not None):
+    if "table" in args and (resistance == "table") != (table is not None):
         raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
                               "neither)")
     if resistance in CLOSED_FORMS:
