@@ -64,12 +64,12 @@ def replaced(value):
 
 
 def resistance_settings(args, offered=RESISTANCES):
-    """``{"resistance", "boundary", "epsilon", "table"}`` of the parsed options, checked: the
-    resistance is one of ``offered``, ``--table FILE`` goes with ``--resistance table`` (both or
-    neither; where the command has ``--table``: ``calibrate`` builds its tables), the paper
-    model takes only its own boundary. ``boundary`` is resolved (the
-    derived model's default for a table or a law: the first layer alone, if flown, is
-    derived)."""
+    """``{"resistance", "boundary", "epsilon", "table"}`` of the parsed options, checked: no
+    old spelling, the resistance is one of ``offered``, ``--table FILE`` goes with
+    ``--resistance table`` (both or neither, where the command has ``--table``: ``calibrate``
+    builds its own tables), the paper model takes only its own boundary. ``boundary`` is
+    resolved (for a table or a law the derived model's default: the first layer alone, where
+    it is flown, is derived)."""
     if args.old_model is not None:
         hint = replaced(args.old_model)
         raise CavexInputError(f"option --model was replaced by {NEW_OPTIONS}"
