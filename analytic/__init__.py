@@ -19,10 +19,11 @@ from cavex.analytic.paper_model import (
 from cavex.analytic.penetration.integrator import Trajectory, penetrate
 from cavex.analytic.penetration.nose import nose_force, ogive_coefficients
 from cavex.analytic.penetration.oblique import Strike, fly
-from cavex.analytic.penetration.resistance import ClosedFormResistance
+from cavex.analytic.penetration.resistance import ClosedFormResistance, make_resistance
 
 __all__ = ["CavityState", "ClosedFormResistance", "PaperCoefficients", "PaperModel", "Strike",
-           "Trajectory", "cavity_solution", "cavity_stress", "fly", "nose_force",
+           "Trajectory", "cavity_solution", "cavity_stress", "fly", "make_resistance",
+           "nose_force",
            "ogive_coefficients",
            "paper_coefficients", "paper_phase_depths", "paper_stress", "penetrate",
            "plastic_radius", "quasi_static_coefficients", "response_state", "spherical_problem"]

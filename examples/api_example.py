@@ -6,10 +6,10 @@ numbers. SI units (Pa, m, s, kg), compression positive.
 
 from cavex import load_config
 from cavex.analytic import (
-    ClosedFormResistance,
     Strike,
     cavity_stress,
     fly,
+    make_resistance,
     penetrate,
     spherical_problem,
 )
@@ -31,9 +31,11 @@ def main():
     # 3. The FE solution of the same problem (compressible, finite strain), with its estimate
     fe = expand_cavity(layers, interfaces, velocity, projectile.r)
 
-    # 4. The rigid projectile through the runway with the derived dynamic resistance
-    trajectory = penetrate(target, projectile,
-                           ClosedFormResistance(target, projectile, boundary="dynamic"))
+    # 4. The rigid projectile through the runway with the derived dynamic resistance (model
+    #    "derived-dynamic"; resistance="paper" is the paper's printed model, resistance="table"
+    #    with table=PATH an FE table from `cavex table`)
+    trajectory = penetrate(target, projectile, make_resistance(
+        target, projectile, resistance="derived", boundary="dynamic"))
 
     print(f"wall stress at L = {depth} m, V = {velocity} m/s:")
     print(f"  closed form, dynamic      {dynamic / 1e6:9.2f} MPa")

@@ -14,8 +14,8 @@ import pytest
 import xarray as xr
 
 from cavex.errors import CavexInputError
+from cavex.verification.commands import batch as batch_command
 from cavex.verification.fedata.batch import (
-    batch_main,
     load_sweep,
     parse_sweep,
     run_sweep,
@@ -145,14 +145,19 @@ def test_sweep_on_dask_gives_identical_numbers(tmp_path):
     assert not dask.failed.any()
 
 
-def test_batch_main_summary_and_resume_from_the_store(tmp_path):
+def batch_text(sweep, out):
+    """What ``cavex batch SWEEP --out OUT --workers 1`` prints."""
+    return batch_command.text(batch_command.summary(batch_command.job(sweep, out, workers=1)))
+
+
+def test_batch_command_summary_and_resume_from_the_store(tmp_path):
     sweep = tmp_path / "coarse.toml"
     sweep.write_text(COARSE_SWEEP)
-    first = batch_main(str(sweep), str(tmp_path / "out"), None, 1)
+    first = batch_text(str(sweep), str(tmp_path / "out"))
     assert "sweep 'coarse': 8 cases (8 run, 0 loaded from the store), 0 failed" in first
     assert "dimensions: velocity=2, depth=2, growth_per_step=2" in first
     assert f"wrote {tmp_path / 'out' / 'results.nc'}" in first
-    again = batch_main(str(sweep), str(tmp_path / "out"), None, 1)
+    again = batch_text(str(sweep), str(tmp_path / "out"))
     assert "8 cases (0 run, 8 loaded from the store), 0 failed" in again
 
 

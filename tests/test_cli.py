@@ -55,9 +55,9 @@ def test_penetrate_json_outputs_and_files(capsys, tmp_path, default):
     code, out, err = run(capsys, "penetrate", "--json", "--out", str(out_dir))
     assert (code, err) == (0, "")
     result = json.loads(out)
-    assert {k: result[k] for k in ("model", "boundary", "epsilon", "crater")} == {
-        "model": "derived", "boundary": "dynamic", "epsilon": "quasi-static",
-        "crater": "nose-base"}  # the default boundary is dynamic (README "Commands")
+    assert {k: result[k] for k in ("model", "resistance", "boundary", "epsilon", "crater")} == {
+        "model": "derived-dynamic", "resistance": "derived", "boundary": "dynamic",
+        "epsilon": "quasi-static", "crater": "nose-base"}  # default: dynamic (README "Commands")
     trajectory = penetrate(target, projectile, ClosedFormResistance(target, projectile,
                                                                     boundary="dynamic"))
     assert len(result["phases"]) == len(trajectory.phases) == 10
@@ -104,13 +104,13 @@ def test_penetrate_json_outputs_and_files(capsys, tmp_path, default):
 
 def test_penetrate_text_paper_model(capsys, tmp_path, default):
     target, projectile = default
-    code, out, err = run(capsys, "penetrate", "--model", "paper", "--out", str(tmp_path))
+    code, out, err = run(capsys, "penetrate", "--resistance", "paper", "--out", str(tmp_path))
     assert (code, err) == (0, "")
     trajectory = penetrate(target, projectile, ClosedFormResistance(target, projectile, "paper"))
     for phase in trajectory.phases:
         assert f"{phase.end_depth:8.4f}" in out and phase.label in out
     assert "beside the paper's Table 2" in out and "894.7" in out
-    code, out, err = run(capsys, "penetrate", "--model", "paper", "--json", "--out",
+    code, out, err = run(capsys, "penetrate", "--resistance", "paper", "--json", "--out",
                          str(tmp_path))
     result = json.loads(out)
     assert result["model"] == "paper"
@@ -141,7 +141,7 @@ def test_stress_json_equals_cavity_solution(capsys, default, boundary):
 def test_stress_paper_model(capsys, default):
     target, projectile = default
     code, out, err = run(capsys, "stress", "--velocity", "500", "--depth", "0.3", "--json",
-                         "--model", "paper")
+                         "--resistance", "paper")
     assert (code, err) == (0, "")
     result = json.loads(out)
     c = paper_coefficients(target, projectile, 0.3)
@@ -192,13 +192,14 @@ BAD_INPUTS = [
     # CONFIG:<name> by a bad TOML file
     (["stress", "--velocity", "-1", "--depth", "0.3"], "'velocity'"),
     (["stress", "--velocity", "500", "--depth", "-0.3"], "'depth'"),
-    (["stress", "--velocity", "500", "--depth", "-0.3", "--model", "paper"], "'depth'"),
+    (["stress", "--velocity", "500", "--depth", "-0.3", "--resistance", "paper"], "'depth'"),
     (["stress", "--velocity", "abc", "--depth", "0.3"], "--velocity"),
     (["stress", "--depth", "0.3"], "--velocity"),
     (["fem", "--velocity", "300", "--depth", "0.3", "--nu", "0.6"], "'nu'"),
     (["fem", "--velocity", "-300", "--depth", "0.3"], "'velocity'"),
     (["penetrate", "--out", "OUT", "--foo"], "--foo"),
-    (["penetrate", "--out", "OUT", "--model", "paper", "--boundary", "dynamic"], "'boundary'"),
+    (["penetrate", "--out", "OUT", "--resistance", "paper", "--boundary", "dynamic"],
+     "'boundary'"),
     (["penetrate", "--out", "OUT", "--config", "CONFIG:malformed"], "malformed.toml"),
     (["penetrate", "--out", "OUT", "--config", "CONFIG:unknown_key"], "': layers[0].foo "),
     (["penetrate", "--out", "OUT", "--config", "CONFIG:lam"], "': layers[0].lam "),
@@ -206,15 +207,88 @@ BAD_INPUTS = [
     (["penetrate", "--out", "OUT", "--config", "missing.toml"], "missing.toml"),
     # BUG: `--velocity inf` passes the `>= 0` check of the paper path of stress_at_depth and
     # prints "Infinity" (not JSON) with exit code 0.
-    (["stress", "--velocity", "inf", "--depth", "0.3", "--model", "paper", "--json"],
+    (["stress", "--velocity", "inf", "--depth", "0.3", "--resistance", "paper", "--json"],
      "'velocity'"),
     # BUG: an infinite depth passes spherical_problem's `depth >= 0` and returns the soil's
     # single-medium stress at "depth_m": Infinity with exit code 0.
     (["stress", "--velocity", "500", "--depth", "inf", "--json"], "'depth'"),
     # BUG: stress silently ignores --boundary for the paper model (penetrate rejects it).
-    (["stress", "--velocity", "500", "--depth", "0.3", "--model", "paper", "--boundary",
+    (["stress", "--velocity", "500", "--depth", "0.3", "--resistance", "paper", "--boundary",
       "dynamic"], "'boundary'"),
+    (["stress", "--velocity", "500", "--depth", "0.3", "--resistance", "table"],
+     "a table is no closed form"),
+    (["penetrate", "--out", "OUT", "--resistance", "table"], "'--table FILE' goes with"),
 ]
+
+# the earlier spellings of the resistance choice (issue 18), each refused with the new one
+MODEL_REPLACED = ("option --model was replaced by --resistance derived|paper|table (with "
+                  "--boundary dynamic|quasi-static)")
+OLD_SPELLINGS = [
+    (["penetrate", "--out", "OUT", "--model", "paper"],
+     f"{MODEL_REPLACED}; for 'paper' use --resistance paper"),
+    (["penetrate", "--out", "OUT", "--model", "derived"],
+     f"{MODEL_REPLACED}; for 'derived' use --resistance derived"),
+    (["stress", "--velocity", "500", "--depth", "0.3", "--model", "paper"],
+     f"{MODEL_REPLACED}; for 'paper' use --resistance paper"),
+    (["penetrate", "--out", "OUT", "--resistance", "closed-form"],
+     "option --resistance closed-form was replaced by --resistance derived or --resistance "
+     "paper"),
+    (["trajectory", "--out", "OUT", "--resistance", "derived-quasi-static"],
+     "option --resistance derived-quasi-static was replaced by --resistance derived "
+     "--boundary quasi-static"),
+    (["calibrate", "--shots", "examples/shots_forrestal1994.csv", "--out", "OUT.toml",
+      "--model", "fe-table"],
+     f"{MODEL_REPLACED}; for 'fe-table' use --resistance table"),
+    (["calibrate", "--shots", "examples/shots_forrestal1994.csv", "--out", "OUT.toml",
+      "--model", "derived-quasi-static"],
+     f"{MODEL_REPLACED}; for 'derived-quasi-static' use --resistance derived --boundary "
+     "quasi-static"),
+    (["calibrate", "--shots", "examples/shots_forrestal1994.csv", "--out", "OUT.toml",
+      "--resistance", "fe-table"], "option --resistance fe-table was replaced by --resistance "
+     "table"),
+]
+
+
+def test_resistance_options_of_every_command():
+    """One vocabulary: the settings each command reads from its options (calibrate builds its
+    FE tables, so it has no --table; stress has no table)."""
+    from cavex.verification.cli import build_parser
+    from cavex.verification.commands.options import CLOSED_FORMS, resistance_settings
+
+    parser = build_parser()
+    calibrate = ["calibrate", "--shots", "s.csv", "--out", "c.toml"]
+    cases = [
+        (["penetrate"], {"resistance": "derived", "boundary": "dynamic",
+                         "epsilon": "quasi-static", "table": None}),
+        (["penetrate", "--resistance", "paper", "--epsilon", "cylindrical"],
+         {"resistance": "paper", "boundary": "quasi-static", "epsilon": "cylindrical",
+          "table": None}),
+        (["penetrate", "--resistance", "table", "--table", "t.nc", "--boundary",
+          "quasi-static"], {"resistance": "table", "boundary": "quasi-static",
+                            "epsilon": "quasi-static", "table": "t.nc"}),
+        (["trajectory", "--resistance", "law"], {"resistance": "law", "boundary": "dynamic",
+                                                 "epsilon": "quasi-static", "table": None}),
+        ([*calibrate, "--resistance", "table"], {"resistance": "table", "boundary": "dynamic",
+                                                 "epsilon": "quasi-static", "table": None}),
+        ([*calibrate, "--boundary", "quasi-static"],
+         {"resistance": "derived", "boundary": "quasi-static", "epsilon": "quasi-static",
+          "table": None}),
+    ]
+    for argv, settings in cases:
+        offered = CLOSED_FORMS if argv[0] == "stress" else ("derived", "paper", "table", "law")
+        assert resistance_settings(parser.parse_args(argv), offered) == settings, argv
+
+
+@pytest.mark.parametrize("argv, message", OLD_SPELLINGS, ids=lambda v: " ".join(v)
+                         if isinstance(v, list) else None)
+def test_old_spellings_are_refused_with_the_new_one(capsys, tmp_path, argv, message):
+    out = tmp_path / "fresh"
+    argv = [str(out) if a == "OUT" else f"{out}.toml" if a == "OUT.toml" else a for a in argv]
+    code, stdout, err = run(capsys, *argv)
+    assert (code, stdout) == (2, "")
+    assert err.splitlines() == [f"cavex: error: {message}"]
+    assert not out.exists() and not Path(f"{out}.toml").exists()
+
 
 
 @pytest.mark.parametrize("argv, names", BAD_INPUTS, ids=lambda v: " ".join(v)

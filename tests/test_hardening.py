@@ -292,7 +292,7 @@ def test_dataset_written_by_write_table_loads(tmp_path, good_table):
 @pytest.mark.parametrize("argv", [
     ["stress", "--velocity", "1.2e154", "--depth", "0.3", "--json"],
     ["stress", "--velocity", "1e300", "--depth", "0.3"],
-    ["stress", "--velocity", "1e300", "--depth", "0.3", "--model", "paper"],
+    ["stress", "--velocity", "1e300", "--depth", "0.3", "--resistance", "paper"],
     ["stress", "--velocity", "1.5e154", "--depth", "0.3", "--boundary", "dynamic"],
     ["fem", "--velocity", "1e300", "--depth", "0.3"],
     ["table", "-o", "{tmp}/t.nc", "--velocities", "0", "2e4"],
@@ -603,6 +603,7 @@ def test_a_run_that_reaches_the_time_limit_ends_there():
 def test_verify_writes_its_report_complete_or_not_at_all(tmp_path, monkeypatch):
     """A verify run that fails (or is interrupted) after writing part of its report leaves the
     previous report in place and no hidden folder behind; a finished one replaces it."""
+    from cavex.verification.commands import verify as verify_command
     from cavex.verification.report import build as report
 
     out = tmp_path / "report"
@@ -615,7 +616,7 @@ def test_verify_writes_its_report_complete_or_not_at_all(tmp_path, monkeypatch):
 
     monkeypatch.setattr(report, "verify", failing)
     with pytest.raises(KeyboardInterrupt):
-        report.verify_main(out_dir=out)
+        verify_command.job(*load_config(), out_dir=out)
     assert sorted(p.name for p in out.iterdir()) == ["report.md"]
     assert (out / "report.md").read_text() == "old report"
 
@@ -625,8 +626,8 @@ def test_verify_writes_its_report_complete_or_not_at_all(tmp_path, monkeypatch):
                 "quick": True}
 
     monkeypatch.setattr(report, "verify", finishing)
-    monkeypatch.setattr(report, "summary_text", lambda summary: summary["files"]["report"])
-    assert report.verify_main(out_dir=out) == str(out / "report.md")
+    assert verify_command.job(*load_config(), out_dir=out)["files"] == {
+        "report": str(out / "report.md")}
     assert sorted(p.name for p in out.iterdir()) == ["report.md"]
     assert (out / "report.md").read_text() == "new report"
 

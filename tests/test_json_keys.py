@@ -113,15 +113,15 @@ def test_every_command_has_json():
 
 @pytest.mark.parametrize("argv", [
     ("stress", "--velocity", "800", "--depth", "0.3"),
-    ("stress", "--velocity", "800", "--depth", "0.3", "--model", "paper"),
+    ("stress", "--velocity", "800", "--depth", "0.3", "--resistance", "paper"),
 ])
 def test_stress(capsys, argv):
     assert offending_keys(run_json(capsys, *argv)) == []
 
 
-@pytest.mark.parametrize("model", ["derived", "paper"])
-def test_penetrate(capsys, tmp_path, model):
-    document = run_json(capsys, "penetrate", "--model", model, "--out", str(tmp_path))
+@pytest.mark.parametrize("resistance", ["derived", "paper"])
+def test_penetrate(capsys, tmp_path, resistance):
+    document = run_json(capsys, "penetrate", "--resistance", resistance, "--out", str(tmp_path))
     assert document["table2"] and offending_keys(document) == []
 
 

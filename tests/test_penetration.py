@@ -29,9 +29,18 @@ from cavex.analytic.penetration.integrator import (
     integrate,
     penetrate,
 )
-from cavex.analytic.penetration.resistance import ClosedFormResistance, Resistance
+from cavex.analytic.penetration.resistance import (
+    MODEL_LABELS,
+    OLD_LABELS,
+    ClosedFormResistance,
+    Resistance,
+    make_resistance,
+    model_label,
+    parse_model_label,
+)
 from cavex.analytic.penetration.tabulated import TabulatedResistance
 from cavex.config import load_config
+from cavex.errors import CavexInputError
 from cavex.materials import Material, Projectile
 from cavex.verification.studies.table2_study import CraterAsTunnel, Reading, ReadingResistance
 
@@ -375,3 +384,49 @@ def test_paper_model_phases_follow_paper_phase_depths(default, epsilon):
         assert stop.label == "Eq. 26 (f)"
         assert depths["H1"] < stop.end_depth < depths["H2"]
     _assert_monotone(trajectory)
+
+
+# --- the one resistance vocabulary (issue 18) ---------------------------------------------------
+
+def test_model_labels_round_trip_and_old_labels_name_the_new_one():
+    for label in MODEL_LABELS:
+        assert model_label(*parse_model_label(label)) == label
+    assert [parse_model_label(label) for label in MODEL_LABELS] == [
+        ("derived", "quasi-static"), ("derived", "dynamic"), ("paper", None), ("table", None)]
+    assert model_label("derived") == "derived-dynamic"  # the default boundary
+    assert model_label("paper", "quasi-static") == "paper"
+    assert model_label("table", "quasi-static") == "table"  # the FE has no convention
+    for old, new in OLD_LABELS.items():
+        with pytest.raises(CavexInputError,
+                           match=f"must be '{new}' \\(the label '{old}' was replaced\\)$"):
+            parse_model_label(old)
+    for bad, name in ((("paper", "dynamic"), "'boundary'"), (("derived", "static"),
+                                                             "'boundary'"),
+                      (("closed-form", None), "'resistance'")):
+        with pytest.raises(CavexInputError, match=name):
+            model_label(*bad)
+
+
+def test_make_resistance_builds_the_chosen_resistance(default, tmp_path):
+    from cavex.analytic.penetration.tabulated import TabulatedResistance
+    from cavex.verification.fedata.table import analytic_table, write_table
+
+    target, projectile = default
+    derived = make_resistance(target, projectile)
+    assert isinstance(derived, ClosedFormResistance)
+    assert (derived.model, derived.boundary) == ("derived", "dynamic")
+    quasi = make_resistance(target, projectile, resistance="derived", boundary="quasi-static")
+    assert quasi.force(0.3, 500.0) == ClosedFormResistance(
+        target, projectile, "derived", "quasi-static").force(0.3, 500.0)
+    paper = make_resistance(target, projectile, resistance="paper", epsilon="cylindrical")
+    assert (paper.model, paper.boundary, paper.epsilon) == ("paper", "quasi-static",
+                                                            "cylindrical")
+    table = analytic_table(target, projectile, [0.0, 600.0, 1200.0], [0.1, 0.5, 1.3])
+    path = write_table(table, tmp_path / "t.nc")
+    for given in (table, path, str(path)):
+        tabulated = make_resistance(target, projectile, resistance="table", table=given)
+        assert isinstance(tabulated, TabulatedResistance)
+    with pytest.raises(CavexInputError, match="'table'"):
+        make_resistance(target, projectile, resistance="table")
+    with pytest.raises(CavexInputError, match="'resistance'"):
+        make_resistance(target, projectile, resistance="law")

@@ -312,6 +312,7 @@ def test_validity_matches_recomputed_errors(quick_report):
 
 
 def test_failed_cell_and_renderer_failure(tmp_path, monkeypatch, capsys):
+    from cavex.verification.commands import verify as verify_command
     from cavex.verification.fedata.cases import fe_cases
 
     def failing(chunk):
@@ -329,7 +330,7 @@ def test_failed_cell_and_renderer_failure(tmp_path, monkeypatch, capsys):
     summary = report.verify(target, projectile, out_dir=tmp_path, workers=1,
                             velocities=(0.0, 1000.0), depths=(0.3, 0.5),
                             numerics=dict(report.QUICK_NUMERICS))
-    print(report.summary_text(summary))
+    print(verify_command.text(summary))
     md = (tmp_path / "report.md").read_text()
     message = "stress figure not drawn (RuntimeError: cannot draw)"
     assert summary["picture"] == message and message in md

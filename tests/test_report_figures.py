@@ -166,15 +166,16 @@ def test_penetration_titles(runway, figures, tmp_path):
     path = tmp_path / "a" / "very" / "long" / "folder" / "table.nc"
     write_table(analytic_table(target, projectile, [0.0, 300.0, 700.0, 1200.0],
                                [0.1, 0.4, 0.8, 1.2, 1.3]), path)
-    job = penetration_report.penetration_job(target, projectile, table_path=path)
-    assert str(path) in job["model"]  # the command's own output keeps the full path
+    job = penetration_report.penetration_job(target, projectile, resistance="table", table=path)
+    assert job["table"] == str(path)  # the command's own output keeps the full path
+    assert (job["model"], job["first_layer_model"]) == ("table", "derived-dynamic")
     penetration_report._write_figures(job, tmp_path)
     for name in ("velocity_time.png", "deceleration_depth.png"):
         ax = figures[name].axes[0]
         assert str(tmp_path) not in ax.get_title() and "table.nc" in ax.get_title()
         assert "runway (layered, FE table)" in [t.get_text() for t in ax.get_legend().texts]
     assert figures["deceleration_depth.png"].axes[0].get_ylabel() == r"deceleration ($10^3$ g)"
-    job = penetration_report.penetration_job(target, projectile, model="paper")
+    job = penetration_report.penetration_job(target, projectile, resistance="paper")
     penetration_report._write_figures(job, tmp_path)
     titles = [figures[n].axes[0].get_title() for n in ("velocity_time.png",
                                                         "deceleration_depth.png")]

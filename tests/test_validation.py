@@ -225,8 +225,14 @@ def test_bad_calibration_files_are_refused(capsys, tmp_path):
     cases = [(text.replace("lam = ", "lamb = ", 1),
               "calibration.lamb is not a known key (accepted: evaluations, lam, "),
              (text.replace('model = "derived-dynamic"', 'model = "quick"'),
-              "calibration.model must be one of derived-quasi-static, derived-dynamic, paper, "
-              "fe-table (got 'quick')"),
+              "calibration.model must be 'derived-quasi-static' or 'derived-dynamic' or "
+              "'paper' or 'table' (got 'quick')"),
+             # the labels before issue 18, refused with the label that replaced them
+             (text.replace('model = "derived-dynamic"', 'model = "fe-table"'),
+              "calibration.model must be 'table' (the label 'fe-table' was replaced)"),
+             (text.replace('model = "derived-dynamic"', 'model = "derived dynamic"'),
+              "calibration.model must be 'derived-dynamic' (the label 'derived dynamic' was "
+              "replaced)"),
              (text.replace('params = ["strength_factor"]', 'params = ["tau"]'),
               "calibration.params must be names from lam, strength_factor, modulus_factor "
               "(got 'tau')"),
@@ -249,7 +255,8 @@ def test_bad_calibration_files_are_refused(capsys, tmp_path):
         assert not out_dir.exists()
     for argv, message in ((["--params", "lam", "lam"], "names without repeats"),
                           (["--params", "tau"], "parameter 'params' must be names from"),
-                          (["--model", "fem"], "parameter 'model' must be one of"),
+                          (["--resistance", "fem"], "option --resistance must be one of "
+                           "derived, paper, table (got 'fem')"),
                           (["--ids", "F94-1"], "shot id(s) 'F94-1' not in shots file")):
         out = tmp_path / "never.toml"
         code, _, err = run(capsys, "calibrate", "--shots", SHOTS, "--out", str(out), *argv)
@@ -288,7 +295,7 @@ def test_table_grid_reproduces_the_closed_form_it_tabulates():
         table = analytic_table(target, projectile, velocities, TABLE_DEPTHS, boundary="dynamic")
         tabulated = penetration_depth(target, projectile,
                                       TabulatedResistance(table, target, projectile))
-        closed = closed_form_depth(shot, "derived dynamic")
+        closed = closed_form_depth(shot, "derived", boundary="dynamic")
         assert tabulated == pytest.approx(closed, rel=1e-4)
 
 
@@ -304,7 +311,7 @@ def test_ratio_statistics():
 
 # --- calibration ------------------------------------------------------------------------------
 
-def synthetic_file(path, mapping, model="derived quasi-static"):
+def synthetic_file(path, mapping, resistance="derived", boundary="quasi-static"):
     """The committed shots' inputs with depths predicted by cavex's own model."""
     data = read_shots(SHOTS)
     with open(path, "w", newline="") as handle:
@@ -313,7 +320,8 @@ def synthetic_file(path, mapping, model="derived quasi-static"):
         writer.writerow(COLUMNS.split(","))
         for s in data.shots:
             writer.writerow([s.id, s.mass, s.diameter, s.length, s.crh, s.V0, s.fc, s.rho,
-                             repr(closed_form_depth(s, model, mapping))])
+                             repr(closed_form_depth(s, resistance, boundary=boundary,
+                                                    mapping=mapping))])
 
 
 def test_synthetic_shots_calibrate_back_to_their_parameters(capsys, tmp_path):
@@ -322,7 +330,7 @@ def test_synthetic_shots_calibrate_back_to_their_parameters(capsys, tmp_path):
     synthetic_file(shots_path, truth)
     cal = tmp_path / "cal.toml"
     code, out, err = run(capsys, "calibrate", "--shots", str(shots_path), "--out", str(cal),
-                         "--model", "derived-quasi-static")
+                         "--resistance", "derived", "--boundary", "quasi-static")
     assert (code, err) == (0, "")
     fitted = read_calibration(cal)
     assert fitted.params == ("lam", "strength_factor")
@@ -333,7 +341,7 @@ def test_synthetic_shots_calibrate_back_to_their_parameters(capsys, tmp_path):
     truth3 = Mapping(lam=0.8, strength_factor=0.6, modulus_factor=1.5)
     shots = read_shots(SHOTS).shots[::3]
     synthetic = [Shot(s.id, s.mass, s.diameter, s.length, s.crh, s.V0, s.fc, s.rho,
-                      closed_form_depth(s, "paper", truth3)) for s in shots]
+                      closed_form_depth(s, "paper", mapping=truth3)) for s in shots]
     got = fit(synthetic, "paper", ("lam", "strength_factor", "modulus_factor")).mapping
     assert (got.lam, got.strength_factor, got.modulus_factor) == pytest.approx(
         (0.8, 0.6, 1.5), rel=1e-5)
@@ -348,7 +356,8 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     small.write_text("\n".join(lines) + "\n")
     cal = tmp_path / "cal.toml"
     assert run(capsys, "calibrate", "--shots", str(small), "--out", str(cal), "--ids",
-               "F94-52", "--params", "strength_factor", "--model", "derived-quasi-static")[0] == 0
+               "F94-52", "--params", "strength_factor", "--resistance", "derived", "--boundary",
+               "quasi-static")[0] == 0
     data = tomllib.loads(cal.read_text())
     assert data["calibration"]["shots"] == ["F94-52"]
     assert abs(math.log(data["calibration"]["strength_factor"])) > 0.1  # it moved
@@ -363,12 +372,13 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     assert (code, err) == (0, "")
     result = json.loads(out)
     rows = {row["id"]: row for row in result["shots"]}
-    assert rows["F94-52"]["predicted_m"]["derived quasi-static calibrated"] == pytest.approx(
+    assert data["calibration"]["model"] == "derived-quasi-static"
+    assert rows["F94-52"]["predicted_m"]["derived-quasi-static calibrated"] == pytest.approx(
         final, rel=DIGITS_6)
     # the JSON of the issue, and the statistics recomputed from it
-    assert set(result["summary"]) == {"derived quasi-static", "derived dynamic", "paper",
-                                      "FE table", "Forrestal 1994",
-                                      "derived quasi-static calibrated"}
+    assert set(result["summary"]) == {"derived-quasi-static", "derived-dynamic", "paper",
+                                      "table", "forrestal-1994",
+                                      "derived-quasi-static calibrated"}
     for model, stats in result["summary"].items():
         ratios = [row["predicted_m"][model] / row["measured_m"] for row in result["shots"]]
         assert stats["n"] == 2
@@ -379,10 +389,10 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     assert result["held_out"] == ["F94-50"]
     assert result["held_out_summary"]["paper"]["n"] == 1
     # the calibrated model fits its one shot (one parameter, one shot: exactly)
-    assert rows["F94-52"]["ratio"]["derived quasi-static calibrated"] == pytest.approx(1.0,
+    assert rows["F94-52"]["ratio"]["derived-quasi-static calibrated"] == pytest.approx(1.0,
                                                                                       abs=1e-5)
     empirical_depth = empirical.shot_depth(read_shots(small).by_id(["F94-50"])[0])
-    assert rows["F94-50"]["predicted_m"]["Forrestal 1994"] == pytest.approx(empirical_depth,
+    assert rows["F94-50"]["predicted_m"]["forrestal-1994"] == pytest.approx(empirical_depth,
                                                                           rel=DIGITS_6)
     # files; one FE table per distinct target (two here), reused by a rerun
     names = {p.name for p in out_dir.iterdir()}
@@ -437,7 +447,7 @@ def test_committed_validation_report_is_consistent():
             assert stats["mean_abs_log_ratio"] == pytest.approx(
                 np.mean(np.abs(np.log(ratios))), rel=DIGITS_6)
     for row, shot in zip(result["shots"], data.shots, strict=True):
-        assert row["predicted_m"]["Forrestal 1994"] == pytest.approx(
+        assert row["predicted_m"]["forrestal-1994"] == pytest.approx(
             empirical.shot_depth(shot), rel=DIGITS_6)
     sentence = verdict(result["held_out_summary"], result["calibrations"])
     assert sentence in (folder / "report.md").read_text()

@@ -1,46 +1,103 @@
-"""The ``cavex penetrate`` job: trajectories, the Table 2 comparison, CSV and PNG outputs.
+"""``cavex penetrate``: trajectories, the Table 2 comparison, CSV and PNG outputs.
 
 The CSV files carry :data:`~cavex.verification.output.number_format.TRAJECTORY_DIGITS` significant
 digits (the integrator's tolerance; see :mod:`cavex.verification.output.number_format`), so that
 they are the same when regenerated on another CPU.
 """
 
+import json
 from pathlib import Path
 
 from cavex.analytic.penetration.integrator import crater_depth, penetrate
-from cavex.analytic.penetration.resistance import ClosedFormResistance, check_model, model_boundary
+from cavex.analytic.penetration.resistance import make_resistance, model_boundary, model_label
 from cavex.config import load_config
 from cavex.verification.output.files import save_figure, write_columns_csv
+from cavex.verification.output.paths import check_output_dir, write_staged
 from cavex.verification.studies.table2 import table2_comparison
 
 
-def penetration_job(target, projectile, *, model="derived", boundary=None,
-                    epsilon="quasi-static", crater="nose-base", table_path=None):
+def run(args, target, projectile):
+    """``cavex penetrate``: fly, write every file or none (also on Ctrl-C or kill), return the
+    text or JSON to print."""
+    from cavex.verification.commands.options import resistance_settings
+
+    settings = resistance_settings(args)
+    folder = check_output_dir(args.out, "out")
+    job = penetration_job(target, projectile, crater=args.crater, **settings)
+    written = write_staged(folder, lambda stage: write_outputs(job, stage))
+    document = summary(job, written)
+    return json.dumps(document, indent=2) if args.json else text(document)
+
+
+def penetration_job(target, projectile, *, resistance="derived", boundary=None,
+                    epsilon="quasi-static", crater="nose-base", table=None):
     """Run the target and its first layer alone (the paper's Fig. 4 pair); nothing is written.
 
-    ``boundary`` None is the model's default: dynamic for the derived model, the paper's own
+    ``resistance`` is one of :data:`cavex.analytic.penetration.resistance.RESISTANCES`;
+    ``boundary`` None is the default: dynamic for the derived model, the paper's own
     quasi-static for the paper model (:func:`cavex.analytic.penetration.resistance.model_boundary`).
 
-    With ``table_path`` the runway uses the FE-tabulated resistance of that table (which must
-    have been built for this target); the first layer alone keeps the closed form ``model``.
+    With ``resistance="table"`` the runway uses the FE-tabulated resistance of ``table`` (the
+    path of a table built for this target); the first layer alone keeps the derived closed
+    form with ``boundary``.
     """
-    check_model(model, boundary)
-    boundary = model_boundary(model, boundary)
+    model = model_label(resistance, boundary)
+    closed = "derived" if resistance == "table" else resistance
+    first = model_label(closed, boundary)
+    boundary = model_boundary(closed, boundary)
     single = target.single(0)
-    runs = {"runway": _runway(target, projectile, model, boundary, epsilon, crater, table_path),
-            "first_layer_only": penetrate(single, projectile, ClosedFormResistance(
-                single, projectile, model, boundary, epsilon=epsilon), crater=crater)}
-    title = resistance_title(model, boundary, epsilon, table_path)
-    if table_path is not None:
-        model = f"FE table {table_path} (first layer alone: {model})"
+    runs = {"runway": penetrate(target, projectile, make_resistance(
+                target, projectile, resistance, boundary, epsilon, table), crater=crater),
+            "first_layer_only": penetrate(single, projectile, make_resistance(
+                single, projectile, closed, boundary, epsilon), crater=crater)}
     paper = (target, projectile) == load_config()
-    return {"model": model, "boundary": boundary, "epsilon": epsilon, "crater": crater,
+    return {"model": model, "first_layer_model": first, "resistance": resistance,
+            "boundary": boundary, "epsilon": epsilon,
+            "table": None if table is None else str(table), "crater": crater,
             "runs": runs, "table2": table2_comparison(runs["runway"]) if paper else None,
             "target_label": "runway (the paper's Table 1)" if paper else "layered target",
             "notes": crater_notes(target, projectile, crater),
-            "interface_depths": target.interface_depths, "title": title,
-            "table": None if table_path is None else str(table_path),
+            "interface_depths": target.interface_depths,
+            "title": resistance_title(resistance, boundary, epsilon, table),
             "layer_names": target.layer_names()}
+
+
+SETTINGS = ("model", "first_layer_model", "resistance", "boundary", "epsilon", "table",
+            "crater", "target_label", "notes")
+
+
+def summary(job, written=()):
+    """What ``cavex penetrate --json`` prints: the settings, the runway's phases, the rows
+    beside the paper's Table 2 (None for another target) and the files written."""
+    return {**{key: job[key] for key in SETTINGS},
+            "phases": phases_as_dicts(job["runs"]["runway"]), "table2": job["table2"],
+            "outputs": list(written)}
+
+
+def text(summary):
+    """The phase table, the rows beside the paper's Table 2 and the files written."""
+    s = summary
+    settings = {"paper": f", epsilon {s['epsilon']}",
+                "table": f" ({s['table']}; first layer alone: {s['first_layer_model']})"}
+    lines = [f"model {s['model']}{settings.get(s['resistance'], '')}, crater from {s['crater']}"]
+    lines += [f"note: {note}" for note in s["notes"]]
+    lines += ["", f"phases ({s['target_label']}):",
+              f"{'#':>2} {'label':<24} {'L (m)':>8} {'V (m/s)':>9} {'t (ms)':>8}  ends because"]
+    lines += [f"{p['phase']:>2} {p['label']:<24} {p['end_depth_m']:8.4f} "
+              f"{p['end_velocity_m_s']:9.2f} {p['end_time_s'] * 1e3:8.3f}  {p['end_reason']}"
+              for p in s["phases"]]
+    if s["table2"] is not None:
+        lines += ["", "beside the paper's Table 2:",
+                  f"{'row':<32} {'L ours':>7} {'paper':>6} {'V ours':>8} {'paper':>7} "
+                  f"{'t ours':>7} {'paper':>6}"]
+    for row in s["table2"] or []:
+        ours, paper = row["ours"], row["paper"]
+        mine = ("{:7.3f} {:>6} {:8.1f} {:>7} {:7.2f} {:>6.2f}".format(
+            ours["depth_m"], paper["depth_m"], ours["velocity_m_s"], paper["velocity_m_s"],
+            ours["time_s"] * 1e3, paper["time_s"] * 1e3) if ours else "(phase not reached)")
+        lines.append(f"{row['phase']} {row['name']:<30} {mine}")
+    lines += ["", "wrote: " + ", ".join(s["outputs"])]
+    return "\n".join(lines)
 
 
 def crater_notes(target, projectile, crater):
@@ -56,24 +113,15 @@ def crater_notes(target, projectile, crater):
             "throughout"]
 
 
-def resistance_title(model, boundary, epsilon, table_path=None):
-    """What the figures say about the resistance: the settings the model uses (the paper's
-    model has its own quasi-static boundary and an epsilon reading; the derived model has a
-    boundary convention), and only the file name of an FE table."""
-    closed = (f"paper model (She 2020), epsilon: {epsilon}" if model == "paper"
+def resistance_title(resistance, boundary, epsilon, table=None):
+    """What the figures say about the resistance: the settings the closed form uses (the
+    paper's model has its own quasi-static boundary and an epsilon reading; the derived model
+    has a boundary convention), and for a table (``resistance`` "table") only its file name."""
+    closed = (f"paper model (She 2020), epsilon: {epsilon}" if resistance == "paper"
               else f"derived model, {boundary} boundary")
-    if table_path is None:
+    if resistance != "table":
         return closed
-    return f"FE table {Path(table_path).name} (first layer alone: {closed})"
-
-
-def _runway(target, projectile, model, boundary, epsilon, crater, table_path):
-    if table_path is None:
-        resistance = ClosedFormResistance(target, projectile, model, boundary, epsilon=epsilon)
-        return penetrate(target, projectile, resistance, crater=crater)
-    from cavex.analytic.penetration.tabulated import penetrate_with_table
-
-    return penetrate_with_table(target, projectile, table_path, crater=crater)
+    return f"FE table {Path(str(table)).name} (first layer alone: {closed})"
 
 
 def phases_as_dicts(trajectory):
@@ -109,7 +157,7 @@ def _write_figures(job, out):
     import matplotlib.pyplot as plt
 
     runway, single = job["runs"]["runway"], job["runs"]["first_layer_only"]
-    subtitle = textwrap.fill(job.get("title", job["model"]), 70)
+    subtitle = textwrap.fill(job["title"], 70)
     names = job.get("layer_names", [])
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     runway_label = "runway (layered)" if job.get("table") is None else \

@@ -29,8 +29,8 @@ MIN_CONTACT_RAMP = 0.001
 
 
 def trajectory_job(target, projectile, strike, resistance="derived", *, boundary="dynamic",
-                   free_surface=True, table=None, law_A=None, law_B=None,
-                   compare_homogeneous=False, contact_ramp=None, progress=False):
+                   epsilon="quasi-static", free_surface=True, table=None, law_A=None,
+                   law_B=None, compare_homogeneous=False, contact_ramp=None, progress=False):
     """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``;
     ``progress``: a tqdm bar per run on stderr (steps, simulated time, speed)."""
     contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
@@ -38,8 +38,8 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
     # oblique shot's sliding shank needs millions of steps (docs/oblique.md)
     require(is_finite_number(contact_ramp) and MIN_CONTACT_RAMP <= contact_ramp <= 100.0,
             "contact_ramp", f"in [{MIN_CONTACT_RAMP:g}, 100] m/s", contact_ramp)
-    options = {"boundary": boundary, "free_surface": free_surface, "table": table,
-               "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp}
+    options = {"boundary": boundary, "epsilon": epsilon, "free_surface": free_surface,
+               "table": table, "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp}
     if table is not None:
         from cavex.analytic.penetration.tabulated import load_table
         options["table"] = load_table(table)
@@ -58,7 +58,8 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
     settings = {"speed_m_s": strike.speed, "obliquity_deg": strike.obliquity,
                 "attack_deg": strike.attack, "attack_plane_deg": strike.attack_plane,
                 "spin_rad_s": strike.spin, "resistance": resistance, "boundary": boundary,
-                "free_surface": free_surface, "contact_ramp_m_s": contact_ramp}
+                "epsilon": epsilon, "free_surface": free_surface,
+                "contact_ramp_m_s": contact_ramp}
     return {"runs": runs, "settings": settings, "target": target}
 
 
@@ -83,21 +84,41 @@ def _steps(name, enabled):
         bar.close()
 
 
-def summary(result):
-    """End state and phases (JSON-ready), plus the largest pitch rate and overloads."""
+def run_summary(result):
+    """End state and phases of one run (JSON-ready), plus the largest pitch rate and
+    overloads."""
     return {"end": result.end, "phases": result.phases, **peaks(result.history)}
 
 
-def write_outputs(job, runs, out, draw=True):
-    """CSV histories, the summary JSON (``runs``: :func:`summary` of each run) and, if
-    ``draw``, the figures into ``out``; returns the paths written."""
+def summary(job, written=None):
+    """What ``cavex trajectory --json`` prints: the runway's end and phases, the settings,
+    :func:`run_summary` of every run and (``written``) the files written; a number that is not
+    finite (a repeated time sample gives an infinite rate) is a numerical failure."""
+    from cavex.errors import CavexNumericalError
+
+    runs = {name: run_summary(result) for name, result in job["runs"].items()}
+    try:
+        json.dumps(runs, allow_nan=False)
+    except ValueError:
+        raise CavexNumericalError("the trajectory summary is not finite (peaks, pitch "
+                                  "rate)") from None
+    main = runs["runway"]
+    document = {"end": main["end"], "phases": main["phases"], "settings": job["settings"],
+                "runs": runs}
+    return document if written is None else {**document, "outputs": written}
+
+
+def write_outputs(job, out, draw=True):
+    """CSV histories, ``summary.json`` (the settings and :func:`run_summary` of each run) and,
+    if ``draw``, the figures into ``out``; returns the paths written."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     written = [str(write_columns_csv(folder / f"history_{name.replace(' ', '_')}.csv",
                                      result.history))
                for name, result in job["runs"].items()]
     path = folder / "summary.json"
-    text = json.dumps({"settings": job["settings"], "runs": runs}, indent=2)
+    document = summary(job)
+    text = json.dumps({"settings": document["settings"], "runs": document["runs"]}, indent=2)
     write_text_atomic(path, text + "\n")
     written.append(str(path))
     if draw:
@@ -272,16 +293,17 @@ def view_3d(job, path):
     return str(path)
 
 
-# --- CLI --------------------------------------------------------------------------------------
+# --- the command -----------------------------------------------------------------------------
 
-def trajectory_main(args, target, projectile):
-    """``cavex trajectory``: checks, runs, writes, returns the text to print."""
+def run(args, target, projectile):
+    """``cavex trajectory``: checks, runs, writes (every file or none, also on Ctrl-C or
+    kill), returns the text or JSON to print."""
+    from cavex.analytic.penetration.resistance import RESISTANCES
     from cavex.errors import CavexInputError, CavexNumericalError
     from cavex.materials import MAX_VELOCITY
+    from cavex.verification.commands.options import resistance_settings
 
-    if (args.resistance == "table") != (args.table is not None):
-        raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
-                              "neither)")
+    settings = resistance_settings(args, (*RESISTANCES, "law"))
     law = [args.law_A is not None, args.law_B is not None]
     if not all(law) if args.resistance == "law" else any(law):
         raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
@@ -299,9 +321,10 @@ def trajectory_main(args, target, projectile):
     projectile.body_length  # noqa: B018 (a projectile without a length refuses here)
     try:  # forces beyond the body's mass and inertia overflow (warnings, then a bogus end)
         with np.errstate(over="raise", invalid="raise"):
-            job = trajectory_job(target, projectile, strike, args.resistance,
-                                 boundary=args.boundary, free_surface=not args.no_free_surface,
-                                 table=args.table, law_A=args.law_A, law_B=args.law_B,
+            job = trajectory_job(target, projectile, strike, settings["resistance"],
+                                 boundary=settings["boundary"], epsilon=settings["epsilon"],
+                                 free_surface=not args.no_free_surface,
+                                 table=settings["table"], law_A=args.law_A, law_B=args.law_B,
                                  compare_homogeneous=args.compare_homogeneous,
                                  contact_ramp=args.contact_ramp,
                                  progress=show_progress(args.progress))
@@ -315,22 +338,16 @@ def trajectory_main(args, target, projectile):
                 f"the {name} trajectory " + ("is not finite" if not finite else
                 "ended at t = 0 s: the integrator could not advance (a shot too slow, or "
                 "forces far beyond the projectile's mass and inertia)"))
-    runs = {k: summary(v) for k, v in job["runs"].items()}
-    try:  # the peaks and rates too (a repeated time sample gives an infinite rate)
-        json.dumps(runs, allow_nan=False)
-    except ValueError:
-        raise CavexNumericalError("the trajectory summary is not finite (peaks, pitch "
-                                  "rate)") from None
-    # every file or none, also on Ctrl-C or kill
-    written = write_staged(folder, lambda stage: write_outputs(job, runs, stage,
-                                                              draw=args.figures))
-    if args.json:
-        main = runs["runway"]
-        return json.dumps({"end": main["end"], "phases": main["phases"],
-                           "settings": job["settings"], "runs": runs, "outputs": written},
-                          indent=2)
-    lines = [_title(job)]
-    for name, s in runs.items():
+    summary(job)  # the peaks and rates are finite too, before anything is written
+    written = write_staged(folder, lambda stage: write_outputs(job, stage, draw=args.figures))
+    document = summary(job, written)
+    return json.dumps(document, indent=2) if args.json else text(document)
+
+
+def text(summary):
+    """The settings, each run's phase table, end state and peaks, the files written."""
+    lines = [_title(summary)]
+    for name, s in summary["runs"].items():
         e = s["end"]
         lines += ["", f"{name}:",
                   f"{'phase':<10} {'ends at t (ms)':>14} {'tip z (m)':>10} {'pitch':>8} "
@@ -342,5 +359,5 @@ def trajectory_main(args, target, projectile):
         lines.append(f"end: {e['state']}, nose tip ({tip}) m, pitch "
                      f"{e['pitch_deg']:.2f} deg; peaks: axial {s['max_axial_g']:.0f} g, "
                      f"lateral {s['max_lateral_g']:.0f} g")
-    lines += ["", "wrote: " + ", ".join(written)]
+    lines += ["", "wrote: " + ", ".join(summary["outputs"])]
     return "\n".join(lines)

@@ -1,4 +1,4 @@
-"""The ``cavex validate`` job: predictions against measurements, written as JSON, CSV, a
+"""``cavex validate``: predictions against measurements, written as JSON, CSV, a
 markdown report and two figures.
 
 Files (in ``--out``, default ``results/validation``): ``validation.json`` (what ``--json``
@@ -23,7 +23,6 @@ from cavex.verification.fedata.runner import check_execution
 from cavex.verification.output.files import save_figure, write_text_atomic
 from cavex.verification.output.paths import check_output_dir, write_staged
 from cavex.verification.validation.predict import (
-    CLOSED_FORMS,
     EMPIRICAL,
     FE_MODEL,
     MODELS,
@@ -35,15 +34,17 @@ from cavex.verification.validation.predict import (
 from cavex.verification.validation.shots import read_shots
 
 DEFAULT_OUT = "results/validation"
-COMPRESSIBILITY_COLUMN = "FE table, derived dynamic calibration"
+COMPRESSIBILITY_COLUMN = f"{FE_MODEL}, derived-dynamic calibration"
 BAND = 0.2  # +-20 % band on the predicted-against-measured figure
 
 
-def validate_main(shots_path, calibration_paths=(), out_dir=None, as_json=False, workers=None,
-                  scheduler=None, progress=None, command=None):
-    """Check every input, run :func:`run`, write the files; return the text to print."""
+def run(args, target, projectile):
+    """Check every input, run :func:`job`, write the files (every file or none, also on Ctrl-C
+    or kill); return the text or JSON to print."""
     from cavex.verification.validation.calibration import read_calibration
 
+    shots_path, calibration_paths = args.shots, args.calibration
+    workers, scheduler = args.workers, args.scheduler
     shot_file = read_shots(shots_path)
     calibrations = [read_calibration(p) for p in calibration_paths or ()]
     columns = [c.column for c in calibrations]
@@ -51,21 +52,20 @@ def validate_main(shots_path, calibration_paths=(), out_dir=None, as_json=False,
     if repeated:
         raise CavexInputError(f"two calibrations of the same model ({', '.join(repeated)}); "
                               "give one per model")
-    out = check_output_dir(DEFAULT_OUT if out_dir is None else out_dir, "out")
+    out = check_output_dir(DEFAULT_OUT if args.out is None else args.out, "out")
     check_execution(workers, scheduler)
     began = time.monotonic()
-    result = run(shot_file, calibrations, tables_dir=out / "tables", workers=workers,
-                 scheduler=scheduler, progress=progress)
+    result = job(shot_file, calibrations, tables_dir=out / "tables", workers=workers,
+                 scheduler=scheduler, progress=args.progress)
     seconds = time.monotonic() - began
-    result["command"] = command or command_line(shots_path, calibration_paths, out)
-    # every file or none, also on Ctrl-C or kill
+    result["command"] = command_line(shots_path, calibration_paths, out)
     written = write_staged(out, lambda stage: write_outputs(result, stage))
-    if as_json:
-        return json.dumps(public(result), indent=2)
-    return summary_text(result, seconds, written)
+    if args.json:
+        return json.dumps(summary(result), indent=2)
+    return text(result, seconds, written)
 
 
-def run(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=None,
+def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=None,
         progress=None):
     """:func:`cavex.verification.validation.predict.validate` plus the compressibility column and
     the shots file's description."""
@@ -75,7 +75,7 @@ def run(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
                         progress=show_progress(progress))
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
                       progress=progress)
-    dynamic = [c for c in calibrations if c.model == "derived dynamic"]
+    dynamic = [c for c in calibrations if c.model == "derived-dynamic"]
     if dynamic:
         columns = {COMPRESSIBILITY_COLUMN: (FE_MODEL, dynamic[0].mapping)}
         depths, failures = predictions(shot_file.shots, columns, tables, progress)
@@ -96,8 +96,9 @@ def run(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
     return result
 
 
-def public(result):
-    """The JSON document: everything but the run's bookkeeping (tables built or reused)."""
+def summary(result):
+    """The JSON document (``validation.json``, ``--json``): everything but the run's
+    bookkeeping (tables built or reused)."""
     return {k: v for k, v in result.items() if k != "tables"}
 
 
@@ -107,10 +108,10 @@ def write_outputs(result, out):
     """Write the JSON, CSV, report and figures into ``out``; return the paths."""
     out.mkdir(parents=True, exist_ok=True)
     written = []
-    for name, text in (("validation.json", json.dumps(public(result), indent=2) + "\n"),
-                       ("predictions.csv", predictions_csv(result)),
-                       ("report.md", report_markdown(result))):
-        write_text_atomic(out / name, text)
+    for name, content in (("validation.json", json.dumps(summary(result), indent=2) + "\n"),
+                          ("predictions.csv", predictions_csv(result)),
+                          ("report.md", report_markdown(result))):
+        write_text_atomic(out / name, content)
         written.append(out / name)
     written += write_figures(result, out)
     return [str(p) for p in written]
@@ -150,7 +151,8 @@ def ranking(summary):
 
 
 def verdict(summary, calibrations):
-    """One sentence: the best calibrated cavex model against Forrestal 1994 on ``summary``."""
+    """One sentence: the best calibrated cavex model against the empirical one on
+    ``summary``."""
     calibrated = [c["column"] for c in calibrations
                   if summary.get(c["column"], {}).get("mean_abs_log_ratio") is not None]
     empirical = summary.get(EMPIRICAL, {}).get("mean_abs_log_ratio")
@@ -174,11 +176,11 @@ def _summary_table(summary):
 
 
 def compressibility(result, column):
-    """FE over derived dynamic depth per shot, same material: ``(min, median, max)`` or None.
+    """FE over derived-dynamic depth per shot, same material: ``(min, median, max)`` or None.
 
-    ``column`` is the FE column; its closed-form partner is ``derived dynamic`` (uncalibrated
-    mapping) or ``derived dynamic calibrated`` (the compressibility column)."""
-    partner = "derived dynamic" if column == FE_MODEL else "derived dynamic calibrated"
+    ``column`` is the FE column; its closed-form partner is ``derived-dynamic`` (uncalibrated
+    mapping) or ``derived-dynamic calibrated`` (the compressibility column)."""
+    partner = "derived-dynamic" if column == FE_MODEL else "derived-dynamic calibrated"
     ratios = [row["predicted_m"][column] / row["predicted_m"][partner]
               for row in result["shots"]
               if row["predicted_m"].get(column) and row["predicted_m"].get(partner)]
@@ -198,7 +200,7 @@ def report_markdown(result):
     lines += [f"Shots: `{info['path']}`, {info['n']} shots. Its header:", ""]
     lines += [f"> {c}" for c in info["comments"]] + [""]
     lines += ["## Models", "",
-              "- `derived quasi-static`, `derived dynamic`, `paper`: cavex's incompressible "
+              "- `derived-quasi-static`, `derived-dynamic`, `paper`: cavex's incompressible "
               "closed forms with the penetration integrator (crater 4.5 r from the nose base);",
               f"- `{FE_MODEL}`: the FE-tabulated resistance, compressible (nu = "
               f"{mapping['nu']:g}) and finite-strain, one FE table per distinct target;",
@@ -235,12 +237,12 @@ def report_markdown(result):
     lines += ["## Compressibility: the FE table against the incompressible closed forms", ""]
     for column, what in ((FE_MODEL, "uncalibrated mapping"),
                          (result.get("compressibility_column"),
-                          "the derived dynamic calibration's mapping")):
+                          "the derived-dynamic calibration's mapping")):
         spread = compressibility(result, column) if column else None
         if spread:
-            lines.append(f"- {what}: FE table depth / derived dynamic depth, same material, "
+            lines.append(f"- {what}: {FE_MODEL} depth / derived-dynamic depth, same material, "
                          f"min {spread[0]:.3f}, median {spread[1]:.3f}, max {spread[2]:.3f}.")
-    lines += ["", "Same E, lam, tau and rho: the FE differs from the derived dynamic closed form "
+    lines += ["", "Same E, lam, tau and rho: the FE differs from the derived-dynamic closed form "
               "only by compressibility (nu) and finite strain (docs/validation.md).", ""]
     lines += ["## Per shot: predicted depth (mm) and predicted / measured", "",
               "| shot | V0 (m/s) | f_c (MPa) | measured (mm) | "
@@ -268,10 +270,9 @@ def write_figures(result, out):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    markers = {"derived quasi-static": "o", "derived dynamic": "s", "paper": "^",
-               FE_MODEL: "D", EMPIRICAL: "*"}
-    colours = dict(zip([*CLOSED_FORMS, FE_MODEL, EMPIRICAL],
-                       ["tab:blue", "tab:orange", "tab:green", "tab:red", "black"], strict=True))
+    markers = dict(zip(MODELS, ["o", "s", "^", "D", "*"], strict=True))
+    colours = dict(zip(MODELS, ["tab:blue", "tab:orange", "tab:green", "tab:red", "black"],
+                       strict=True))
     measured = np.array([row["measured_m"] for row in result["shots"]])
     velocity = np.array([row["V0_m_s"] for row in result["shots"]])
     held = set(result.get("held_out", []))
@@ -321,7 +322,7 @@ def _save(fig, path, plt):
     return save_figure(fig, path, dpi=110)
 
 
-def summary_text(result, seconds, written):
+def text(result, seconds, written):
     """What ``cavex validate`` prints without ``--json``."""
     lines = [f"{result['shots_file']['n']} shots from {result['shots_file']['path']}; "
              f"FE tables built {result['tables']['built']}, reused "

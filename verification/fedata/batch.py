@@ -13,8 +13,6 @@ import itertools
 import json
 import os
 import re
-import sys
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -26,7 +24,6 @@ from cavex.input_files import in_file, read_toml
 from cavex.materials import MAX_VELOCITY
 from cavex.verification.fedata.cases import (
     CaseBuilder,
-    check_run_size,
     config_tables,
     fe_case_id,
     fe_cases,
@@ -508,62 +505,3 @@ def _values(results, path):
                 value = value[key]
             out[i] = np.nan if value is None else value
     return out
-
-
-# --- the command --------------------------------------------------------------------------------
-
-def batch_main(path, out_dir=None, scheduler=None, workers=None, progress=None,
-               allow_large=False, as_json=False):
-    """Run a sweep for ``cavex batch`` and return the printable summary (``as_json``:
-    :func:`summary_dict` as JSON).
-
-    ``out_dir`` defaults to ``results/batch/<sweep name>``. The size and an estimate of the
-    run time go to stderr first; more than :data:`cavex.verification.fedata.cases.LARGE_RUN` cases
-    need ``allow_large``.
-    """
-    sweep = parse_sweep(path)
-    out_dir = os.fspath(out_dir) if out_dir is not None else os.path.join("results", "batch",
-                                                                          sweep.name)
-    cases = sweep_cases(sweep)
-    check_output_dir(out_dir, "out")
-    scheduler = scheduler if scheduler is not None else sweep.scheduler
-    workers = workers if workers is not None else sweep.workers
-    check_execution(workers, scheduler)
-    estimate = check_run_size(len(cases), workers or os.cpu_count() or 1, allow_large)
-    check_store(os.path.join(out_dir, STORE_DIR), cases)
-    print(f"sweep '{sweep.name}': {estimate}", file=sys.stderr)
-    ids = {case["id"] for case in cases}
-    before = len(ids & set(read_store(os.path.join(out_dir, STORE_DIR))))
-    start = time.perf_counter()
-    dataset = run_sweep(path, out_dir, scheduler=scheduler, workers=workers, progress=progress)
-    summary = summary_dict(dataset, out_dir, before, time.perf_counter() - start)
-    if as_json:
-        return json.dumps(summary, indent=2)
-    return _summary(summary)
-
-
-def summary_dict(dataset, out_dir, loaded, seconds):
-    """What ``cavex batch --json`` prints: the sweep's name, its cases (run now, loaded from
-    the store, failed, with the reasons), the Dataset's dimensions, the wall time and the
-    files written."""
-    cases = int(dataset.attrs["cases"])
-    reasons = json.loads(dataset.attrs["failure_reasons"])
-    return {"sweep": dataset.attrs["sweep"], "cases": cases, "run": cases - loaded,
-            "loaded": loaded, "failed": len(reasons), "failure_reasons": reasons,
-            "dimension_sizes": dict(dataset.sizes), "wall_time_s": float(seconds),
-            "output": os.path.join(out_dir, RESULTS_FILE),
-            "store": os.path.join(out_dir, STORE_DIR)}
-
-
-def _summary(s):
-    sizes = ", ".join(f"{name}={size}" for name, size in s["dimension_sizes"].items())
-    reasons = s["failure_reasons"]
-    lines = [f"sweep '{s['sweep']}': {s['cases']} cases ({s['run']} run, "
-             f"{s['loaded']} loaded from the store), {s['failed']} failed, "
-             f"{s['wall_time_s']:.1f} s",
-             f"dimensions: {sizes}"]
-    lines += [f"  failed {case_id}: {reason}" for case_id, reason in list(reasons.items())[:10]]
-    if len(reasons) > 10:
-        lines.append(f"  ... and {len(reasons) - 10} more (attribute failure_reasons)")
-    lines.append(f"wrote {s['output']} (cases in {s['store']}/)")
-    return "\n".join(lines)

@@ -24,10 +24,7 @@ from :func:`cavex.verification.fedata.cases.make_fe_cases`.
 """
 
 import json
-import math
 import os
-import shutil
-import time
 from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
@@ -43,10 +40,9 @@ from cavex.materials import MAX_VELOCITY
 from cavex.problem import BOUNDARIES
 from cavex.verification.fedata.cases import CaseBuilder, fe_cases, make_fe_cases
 from cavex.verification.fedata.comparison import closed_forms
-from cavex.verification.fedata.runner import check_execution, run_cases
+from cavex.verification.fedata.runner import run_cases
 from cavex.verification.output.cf_metadata import CONVENTIONS, UNITS, boolean_attrs, flag_attrs
 from cavex.verification.output.number_format import round_dataset
-from cavex.verification.output.paths import check_output_file
 
 DEFAULT_VELOCITIES = tuple(np.linspace(0.0, 1200.0, 13))
 DEFAULT_DEPTHS = tuple(np.round(np.linspace(0.10, 1.30, 31), 6))
@@ -339,70 +335,3 @@ def write_table(ds, path, *, reproducible=True):
         if tmp.exists():
             tmp.unlink()
     return path
-
-
-# --- command-line job -------------------------------------------------------------------------
-
-STORE_SUFFIX = ".cases"  # cavex table's resumable case store: <out>.cases/ until it is written
-
-
-def table_main(config_path=None, velocities=None, depths=None, out_path="results/table.nc",
-               nu=None, workers=None, scheduler=None, numerics=None, progress=None,
-               as_json=False):
-    """The ``cavex table`` job: build, write and summarise a table; returns the summary text
-    (``as_json``: :func:`summary_dict` as JSON).
-
-    The output location, the grid, ``workers`` and ``scheduler`` are checked before any FE
-    work; finished cells are kept in ``<out>.cases/`` while the table is built, so that a killed
-    run resumes where it stopped (the folder is removed once the table is written).
-
-    Defaults: velocities 0, 100, ..., 1200 m/s (13), depths 0.10 ... 1.30 m every 0.04 m (31,
-    plus the two wall-layer switch depths): concrete, macadam and into the soil.
-    """
-    from cavex.config import load_config
-
-    target, projectile = load_config(config_path)
-    velocities = DEFAULT_VELOCITIES if velocities is None else velocities
-    depths = DEFAULT_DEPTHS if depths is None else depths
-    check_grid(velocities, depths)
-    out_path = check_output_file(out_path, "out")
-    check_execution(workers, scheduler)
-    store = out_path.with_name(out_path.name + STORE_SUFFIX)
-    start = time.perf_counter()
-    ds = build_table(target, projectile, velocities, depths, nu=nu, numerics=numerics,
-                     scheduler=scheduler, workers=workers, progress=progress, store=store)
-    seconds = time.perf_counter() - start
-    written = write_table(ds, out_path)
-    shutil.rmtree(store, ignore_errors=True)  # the table holds every cell now
-    if as_json:
-        return json.dumps(summary_dict(ds, seconds, written), indent=2)
-    return summary_text(ds, seconds, written)
-
-
-def summary_dict(ds, seconds, path):
-    """What ``cavex table --json`` prints: FE cases (the grid plus the first layer alone),
-    the grid's axes, failed cells, the largest error estimate (None: none estimated), the wall
-    time and the file written."""
-    estimate = float(np.nanmax(ds["error_estimate"])) if np.any(
-        np.isfinite(ds["error_estimate"])) else None
-    return {"cases": ds.sizes["velocity"] * (ds.sizes["depth"] + 1),
-            "velocities_m_s": [float(x) for x in ds["velocity"].values],
-            "depths_m": [float(x) for x in ds["depth"].values],
-            "failed": int(ds["failed"].sum()) + int(ds["failed_first_layer"].sum()),
-            "max_error_estimate": estimate, "wall_time_s": float(seconds),
-            "output": str(path)}
-
-
-def summary_text(ds, seconds, path):
-    """Cases, failed cells, time and path of a built table, one item per line."""
-    s = summary_dict(ds, seconds, path)
-    v, d = s["velocities_m_s"], s["depths_m"]
-    estimate = math.nan if s["max_error_estimate"] is None else s["max_error_estimate"]
-    return "\n".join([
-        f"cases   {s['cases']} ({len(v)} velocities {v[0]:g}..{v[-1]:g} m/s x "
-        f"{len(d)} depths {d[0]:g}..{d[-1]:g} m, + first layer alone)",
-        f"failed  {s['failed']}",
-        f"largest FE error estimate {estimate:.3%}",
-        f"time    {seconds:.1f} s",
-        f"wrote   {path}",
-    ])

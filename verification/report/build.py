@@ -5,7 +5,8 @@ shared case runner), adds the closed forms (derived dynamic, derived quasi-stati
 printed model), and writes ``report.md``, ``report.html`` (self-contained: the figures are
 embedded), PNG figures (matplotlib; among them the FE stresses around the cavity at one
 (V, L) and the trajectories of the closed forms against the FE table) and ``grid.nc`` (every
-number the report prints) into ``out_dir``. :func:`verify_main` is the ``cavex verify`` job.
+number the report prints) into ``out_dir``.
+:mod:`cavex.verification.commands.verify` is the ``cavex verify`` command.
 
 The written files are reproducible: the FE table is rounded to the digits the numerics support
 (:mod:`cavex.verification.output.number_format`) before anything is computed from it, the trajectory
@@ -22,10 +23,8 @@ import numpy as np
 
 from cavex.errors import CavexInputError
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
-from cavex.verification.fedata.runner import check_execution
 from cavex.verification.fedata.table import build_table, write_table
 from cavex.verification.output.number_format import TRAJECTORY_DIGITS, round_dataset, round_nested
-from cavex.verification.output.paths import check_output_dir, staged_output
 from cavex.verification.report import plots, text
 from cavex.verification.report.analysis import (
     RESOLVED_FRACTION,
@@ -51,7 +50,6 @@ QUICK_DEPTH_MARGIN = 0.15  # m past the last switch depth
 QUICK_NUMERICS = {"elements_per_decade": 15.0, "growth_per_step": 0.06}
 PICTURE_VELOCITY = 600.0
 CURVE_VELOCITIES = (200.0, 600.0, 1000.0)
-DEFAULT_OUT = "results/verification"
 
 
 def quick_axes(target, projectile):
@@ -323,54 +321,4 @@ def report_markdown(grid, target, stats, lines, trajectory, pic, paths, info):
     return "\n".join(md)
 
 
-def summary_dict(summary):
-    """What ``cavex verify --json`` prints: :func:`verify`'s result without ``stats`` (the
-    report and ``grid.nc`` hold the statistics)."""
-    return {k: summary[k] for k in ("out_dir", "files", "quick", "cells", "failed", "picture",
-                                    "conclusions", "wall_time_s", "table_wall_time_s",
-                                    "created")}
-
-
-def summary_text(summary):
-    """Printable summary of :func:`verify`'s result."""
-    return "\n".join([
-        f"cells   {summary['cells']} ({summary['failed']} failed)",
-        f"time    {summary['wall_time_s']:.1f} s (FE table {summary['table_wall_time_s']:.1f} s, "
-        f"created {summary.get('created') or '?'})",
-        f"figure  {summary['picture']}",
-        *(f"- {line}" for line in summary["conclusions"]),
-        f"wrote   {summary['files']['report']} (+ html, PNGs, grid.nc) in {summary['out_dir']}",
-    ])
-
-
-def _moved(summary, stage, out_dir):
-    """``summary`` with the paths of the staged files in ``stage`` moved to ``out_dir``."""
-    files = {k: str(Path(out_dir) / Path(v).relative_to(stage))
-             for k, v in summary["files"].items()}
-    return {**summary, "out_dir": str(out_dir), "files": files}
-
-
-def verify_main(config_path=None, quick=False, out_dir=None, scheduler=None, workers=None,
-                progress=None, as_json=False):
-    """The ``cavex verify`` job: load the config, write the report, return a printable summary
-    (``as_json``: :func:`summary_dict` as JSON)."""
-    from cavex.config import default_config_text, load_config
-
-    target, projectile = load_config(config_path)
-    config = default_config_text() if config_path is None else Path(config_path).read_text(
-        encoding="utf-8")
-    out_dir = check_output_dir(DEFAULT_OUT if out_dir is None else out_dir, "out")
-    check_execution(workers, scheduler)
-    # the report is written into a hidden folder and moved in complete: Ctrl-C or kill leaves
-    # the previous report as it was, or (if that was removed) no report, never a partial one
-    with staged_output(out_dir) as stage:
-        summary = verify(target, projectile, quick=quick, out_dir=stage, scheduler=scheduler,
-                         workers=workers, config_text=config, progress=progress)
-        remove_report_files(out_dir)  # an old report never mixes with this one
-    summary = _moved(summary, stage, out_dir)
-    if as_json:
-        return json.dumps(summary_dict(summary), indent=2)
-    return summary_text(summary)
-
-
-__all__ = ["verify", "verify_main", "DEFAULT_VELOCITIES", "DEFAULT_DEPTHS"]
+__all__ = ["verify", "DEFAULT_VELOCITIES", "DEFAULT_DEPTHS"]

@@ -20,21 +20,20 @@ statistics, and is what ``cavex validate --calibration CAL.toml`` reads.
 """
 
 import math
-import shlex
 import sys
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from scipy.optimize import least_squares
 
+from cavex.analytic.penetration.resistance import model_label, parse_model_label
 from cavex.errors import CavexInputError, CavexNumericalError, check_keys, prefixed, require
 from cavex.input_files import in_file, read_toml
 from cavex.verification.output.number_format import round_significant
 from cavex.verification.validation.concrete import BOUNDS, FREE_PARAMETERS, Mapping, shot_target
-from cavex.verification.validation.predict import FE_MODEL, MODEL_OPTIONS, TableCache, predict
-from cavex.verification.validation.shots import read_shots, shot_projectile
+from cavex.verification.validation.predict import FE_MODEL, TableCache, predict
+from cavex.verification.validation.shots import shot_projectile
 
 PARAMETER_DIGITS = 6
 DEFAULT_PARAMETERS = ("lam", "strength_factor")
@@ -50,18 +49,15 @@ CALIBRATION_REQUIRED = {"model", "params", "lam", "strength_factor", "modulus_fa
 
 @dataclass(frozen=True)
 class Calibration:
-    """A fitted model: its command-line name, mapping, fitted parameter names and shot ids."""
+    """A fitted model: its label (:data:`cavex.analytic.penetration.resistance.MODEL_LABELS`),
+    mapping, fitted parameter names and shot ids."""
 
-    option: str
+    model: str
     mapping: Mapping
     params: tuple
     shots: tuple
     source: str = ""
     statistics: tuple = ()
-
-    @property
-    def model(self):
-        return MODEL_OPTIONS[self.option]
 
     @property
     def column(self):
@@ -83,12 +79,6 @@ def check_parameters(params):
     return params
 
 
-def check_option(option):
-    require(isinstance(option, str) and option in MODEL_OPTIONS, "model",
-            f"one of {', '.join(MODEL_OPTIONS)}", option)
-    return option
-
-
 def _to_variables(mapping, params):
     return np.array([math.log(getattr(mapping, p)) if p in LOG_PARAMETERS
                      else getattr(mapping, p) for p in params])
@@ -105,25 +95,27 @@ def _bounds(params):
 
 
 def log_ratios(shots, model, mapping, tables=None):
-    """``ln(predicted / measured)`` per shot for ``model`` (a :data:`MODELS` name)."""
+    """``ln(predicted / measured)`` per shot for ``model`` (a model label)."""
     return np.array([math.log(predict(s, model, mapping, tables) / s.depth) for s in shots])
 
 
-def fit(shots, option="derived-dynamic", params=None, start=None, tables=None,
-        progress=False):
-    """Least-squares fit of ``params`` of the mapping for model ``option`` to ``shots``.
+def fit(shots, resistance="derived", params=None, start=None, tables=None, progress=False, *,
+        boundary=None):
+    """Least-squares fit of ``params`` of the mapping for ``resistance`` to ``shots``.
 
     Parameters
     ----------
     shots : sequence of Shot
-    option : str
-        A key of :data:`cavex.verification.validation.predict.MODEL_OPTIONS`.
+    resistance : {"derived", "paper", "table"}
+        :data:`cavex.analytic.penetration.resistance.RESISTANCES`.
+    boundary : {"dynamic", "quasi-static"}, optional
+        The derived model's convention (default dynamic; the paper model has its own).
     params : sequence of str, optional
         Free parameters (default ``lam``, ``strength_factor``).
     start : Mapping, optional
         Starting point and the fixed parameters (default :class:`Mapping`).
     tables : TableCache, optional
-        FE tables (``fe-table`` only; default an in-memory cache).
+        FE tables (``table`` only; default an in-memory cache).
     progress : bool
         One line per evaluation on stderr.
 
@@ -134,10 +126,9 @@ def fit(shots, option="derived-dynamic", params=None, start=None, tables=None,
         (``n``, ``mean_abs_log_ratio``, ``rms_log_ratio``, ``evaluations``) at the rounded
         parameters.
     """
-    option, params = check_option(option), check_parameters(params)
+    model, params = model_label(resistance, boundary), check_parameters(params)
     require(len(shots) >= len(params), "shots",
             f"at least as many shots as free parameters ({len(params)})", len(shots))
-    model = MODEL_OPTIONS[option]
     start = start or Mapping()
     kind = FE_MODEL if model == FE_MODEL else "closed form"
     tables = tables or TableCache(progress=False)
@@ -152,7 +143,7 @@ def fit(shots, option="derived-dynamic", params=None, start=None, tables=None,
         if progress:
             values = ", ".join(f"{p} = {v:.6g}" for p, v in zip(params, _to_values(x, params),
                                                                strict=True))
-            print(f"cavex: calibrate {option} evaluation {count[0]}: {values}: mean |ln ratio| "
+            print(f"cavex: calibrate {model} evaluation {count[0]}: {values}: mean |ln ratio| "
                   f"{np.abs(r).mean():.4f} ({time.monotonic() - began:.0f} s)", file=sys.stderr,
                   flush=True)
         return r
@@ -165,7 +156,7 @@ def fit(shots, option="derived-dynamic", params=None, start=None, tables=None,
         solution = least_squares(jacobian.residuals, x0, jac=jacobian, bounds=(lower, upper),
                                  method="trf", xtol=tol, ftol=tol, gtol=tol)
     except CavexInputError as exc:
-        raise CavexNumericalError(f"calibration of {option} left the models' range: {exc}") \
+        raise CavexNumericalError(f"calibration of {model} left the models' range: {exc}") \
             from None
     values = [round_significant(v, PARAMETER_DIGITS) for v in _to_values(solution.x, params)]
     mapping = start.with_values(params, values)
@@ -174,7 +165,7 @@ def fit(shots, option="derived-dynamic", params=None, start=None, tables=None,
                   ("mean_abs_log_ratio", round_significant(float(np.abs(r).mean()), 6)),
                   ("rms_log_ratio", round_significant(float(np.sqrt((r ** 2).mean())), 6)),
                   ("evaluations", count[0]))
-    return Calibration(option, mapping, params, tuple(s.id for s in shots),
+    return Calibration(model, mapping, params, tuple(s.id for s in shots),
                        statistics=statistics)
 
 
@@ -220,10 +211,10 @@ def calibration_text(calibration, shots_file, reference, command=None):
              *([f"# command: {command}"] if command else []),
              f"# [projectile] and [[layers]]: the calibrated target of shot '{reference.id}', so",
              "# `cavex penetrate --config THIS_FILE` runs it (derived-quasi-static: add",
-             "# --boundary quasi-static; paper: --model paper). `cavex validate --calibration",
+             "# --boundary quasi-static; paper: --resistance paper). `cavex validate --calibration",
              "# THIS_FILE` reads [calibration] and applies its mapping to every shot.",
              "", "[calibration]",
-             f"model = {_toml_string(calibration.option)}",
+             f"model = {_toml_string(calibration.model)}",
              f"params = [{', '.join(_toml_string(p) for p in calibration.params)}]",
              *(f"{name} = {getattr(m, name)!r}" for name in ("lam", "strength_factor",
                                                               "modulus_factor", "nu")),
@@ -257,7 +248,7 @@ def parse_calibration(data, source=""):
                               "calibrate`)", "calibration")
     table = data["calibration"]
     check_keys(table, CALIBRATION_KEYS, "calibration.", required=CALIBRATION_REQUIRED)
-    option = prefixed(check_option, "calibration.", table["model"])
+    prefixed(parse_model_label, "calibration.", table["model"])
     require(isinstance(table["params"], list) and all(isinstance(p, str)
                                                       for p in table["params"]),
             "calibration.params", "an array of names", table["params"])
@@ -269,65 +260,5 @@ def parse_calibration(data, source=""):
             "calibration.shots", "a non-empty array of shot ids", shots)
     statistics = tuple((k, table[k]) for k in ("n", "mean_abs_log_ratio", "rms_log_ratio",
                                                "evaluations") if k in table)
-    return Calibration(option, mapping, params, tuple(shots), source=source,
+    return Calibration(table["model"], mapping, params, tuple(shots), source=source,
                        statistics=statistics)
-
-
-# --- command-line job -------------------------------------------------------------------------
-
-def calibrate_main(shots_path, out_path, params=None, option="derived-dynamic", ids=None,
-                   workers=None, scheduler=None, progress=None, command=None, as_json=False):
-    """The ``cavex calibrate`` job: read and check everything, fit, write ``out_path``.
-
-    Returns the summary text (``as_json``: :func:`summary_dict` as JSON). Nothing is written
-    when an input is refused or the fit fails.
-    """
-    from cavex.verification.fedata.runner import check_execution, show_progress
-    from cavex.verification.output.files import write_text_atomic
-    from cavex.verification.output.paths import check_output_file
-
-    shot_file = read_shots(shots_path)
-    shots = shot_file.by_id(ids) if ids else shot_file.shots
-    option, params = check_option(option), check_parameters(params)
-    out = check_output_file(out_path, "out")
-    check_execution(workers, scheduler)
-    require(out.suffix == ".toml", "out", "a path ending in .toml", str(out_path))
-    show = show_progress(progress)
-    tables = TableCache(workers=workers, scheduler=scheduler, progress=show)
-    began = time.monotonic()
-    calibration = fit(shots, option, params, tables=tables, progress=show)
-    seconds = time.monotonic() - began
-    if command is None:
-        words = ["cavex", "calibrate", "--shots", str(shots_path), "--out", str(out_path),
-                 "--model", option, "--params", *params, *(["--ids", *ids] if ids else [])]
-        command = " ".join(shlex.quote(w) for w in words)
-    text = calibration_text(calibration, shots_path, shots[0], command)
-    if out.parent != Path(""):
-        out.parent.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(out, text)
-    summary = summary_dict(calibration, seconds, out)
-    if as_json:
-        import json
-
-        return json.dumps(summary, indent=2)
-    values = ", ".join(f"{p} = {v:.6g}" for p, v in summary["fitted"].items())
-    return "\n".join([
-        f"model   {option} ({calibration.model}), {len(shots)} shots: "
-        f"{', '.join(calibration.shots)}",
-        f"fitted  {values}",
-        f"fit     mean |ln(predicted/measured)| {summary['mean_abs_log_ratio']:.4f}, rms "
-        f"{summary['rms_log_ratio']:.4f}, {summary['evaluations']} evaluations, "
-        f"{seconds:.1f} s",
-        f"wrote   {out}",
-    ])
-
-
-def summary_dict(calibration, seconds, out):
-    """What ``cavex calibrate --json`` prints: the model, the fitted parameters (all
-    dimensionless), the mapping, the shots fitted, the fit statistics, the wall time and the
-    file written."""
-    return {"model": calibration.option, "params": list(calibration.params),
-            "fitted": {p: getattr(calibration.mapping, p) for p in calibration.params},
-            "mapping": calibration.mapping.as_dict(), "shots": list(calibration.shots),
-            **dict(calibration.statistics), "wall_time_s": float(seconds),
-            "output": str(out)}

@@ -3,15 +3,16 @@
 For each shot (:mod:`cavex.verification.validation.shots`) the target is one semi-infinite concrete
 layer from the shot's ``(f_c, rho)`` (:mod:`cavex.verification.validation.concrete`) and the
 projectile the shot's (:func:`~cavex.verification.validation.shots.shot_projectile`). The models
-(:data:`MODELS`):
+(:data:`MODELS`, labelled as everywhere in cavex:
+:data:`cavex.analytic.penetration.resistance.MODEL_LABELS`):
 
-- ``derived quasi-static``, ``derived dynamic``, ``paper``: the closed forms
+- ``derived-quasi-static``, ``derived-dynamic``, ``paper``: the closed forms
   (:class:`cavex.analytic.penetration.resistance.ClosedFormResistance`), incompressible;
-- ``FE table``: the FE-tabulated resistance
+- ``table``: the FE-tabulated resistance
   (:class:`cavex.analytic.penetration.tabulated.TabulatedResistance`) of a table built by
   :func:`cavex.verification.fedata.table.build_table` for the shot's target with the mapping's
   Poisson's ratio (0.2): compressible, finite strain, which no closed form gives;
-- ``Forrestal 1994``: the empirical model (:mod:`cavex.verification.validation.empirical`).
+- ``forrestal-1994``: the empirical model (:mod:`cavex.verification.validation.empirical`).
 
 cavex's models run the penetration integrator
 (:func:`cavex.analytic.penetration.integrator.penetrate`,
@@ -34,23 +35,18 @@ import numpy as np
 
 from cavex.analytic.penetration.integrator import crater_depth, penetrate
 from cavex.analytic.penetration.nose import nose_rule
-from cavex.analytic.penetration.resistance import ClosedFormResistance
+from cavex.analytic.penetration.resistance import MODEL_LABELS, make_resistance, parse_model_label
+from cavex.analytic.penetration.resistance import MODELS as CLOSED_FORMS
 from cavex.errors import CavexInputError, CavexNumericalError, require_choice
 from cavex.verification.output.number_format import FE_DIGITS, round_dataset, round_significant
 from cavex.verification.validation import empirical
 from cavex.verification.validation.concrete import Mapping, shot_target
 from cavex.verification.validation.shots import shot_projectile
 
-CLOSED_FORMS = {"derived quasi-static": ("derived", "quasi-static"),
-                "derived dynamic": ("derived", "dynamic"),
-                "paper": ("paper", "quasi-static")}
-FE_MODEL = "FE table"
-EMPIRICAL = "Forrestal 1994"
-CAVEX_MODELS = (*CLOSED_FORMS, FE_MODEL)
+FE_MODEL = "table"
+EMPIRICAL = "forrestal-1994"
+CAVEX_MODELS = MODEL_LABELS  # the closed forms and the FE table: what a calibration can fit
 MODELS = (*CAVEX_MODELS, EMPIRICAL)
-# command-line names of the models a calibration can fit
-MODEL_OPTIONS = {"derived-quasi-static": "derived quasi-static",
-                 "derived-dynamic": "derived dynamic", "paper": "paper", "fe-table": FE_MODEL}
 DEPTH_DIGITS = FE_DIGITS  # predicted depths and statistics in the result files
 TABLE_VELOCITY_STEP = 50.0  # m/s between FE table velocities (interpolated by PCHIP in V^2)
 TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on depth
@@ -68,35 +64,34 @@ def penetration_depth(target, projectile, resistance):
     return float(penetrate(target, projectile, resistance).depth[-1])
 
 
-def closed_form_depth(shot, model, mapping=None):
-    """Depth (m) of a closed-form model for ``shot`` under ``mapping``."""
-    require_choice(model, tuple(CLOSED_FORMS), "model")
+def closed_form_depth(shot, resistance="derived", *, boundary=None, mapping=None):
+    """Depth (m) of the closed form ``resistance`` ("derived" with ``boundary``, or "paper")
+    for ``shot`` under ``mapping``."""
+    require_choice(resistance, CLOSED_FORMS, "resistance")
     target, projectile = shot_target(shot, mapping), shot_projectile(shot)
-    kind, boundary = CLOSED_FORMS[model]
     return penetration_depth(target, projectile,
-                             ClosedFormResistance(target, projectile, kind, boundary))
+                             make_resistance(target, projectile, resistance, boundary))
 
 
 def table_depth(shot, table, mapping=None):
     """Depth (m) with the FE-tabulated resistance of ``table`` (built for the shot's target)."""
-    from cavex.analytic.penetration.tabulated import TabulatedResistance
-
     target, projectile = shot_target(shot, mapping), shot_projectile(shot)
-    return penetration_depth(target, projectile, TabulatedResistance(table, target, projectile))
+    return penetration_depth(target, projectile,
+                             make_resistance(target, projectile, "table", table=table))
 
 
 def predict(shot, model, mapping=None, tables=None):
     """Predicted depth (m) of ``model`` (one of :data:`MODELS`) for ``shot``.
 
-    ``tables`` (a :class:`TableCache`) gives the FE tables of the ``FE table`` model.
+    ``tables`` (a :class:`TableCache`) gives the FE tables of the ``table`` model.
     """
-    require_choice(model, MODELS, "model")
     if model == EMPIRICAL:
         return empirical.shot_depth(shot)
-    if model == FE_MODEL:
+    resistance, boundary = parse_model_label(model)
+    if resistance == "table":
         tables = tables or TableCache()
         return table_depth(shot, tables.table(shot, mapping), mapping)
-    return closed_form_depth(shot, model, mapping)
+    return closed_form_depth(shot, resistance, boundary=boundary, mapping=mapping)
 
 
 # --- FE tables --------------------------------------------------------------------------------

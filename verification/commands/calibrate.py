@@ -1,0 +1,97 @@
+"""``cavex calibrate``: fit a model's free material parameters to measured depths, written as a
+calibration file (:mod:`cavex.verification.validation.calibration`, docs/validation.md)."""
+
+import json
+import shlex
+import time
+from pathlib import Path
+
+
+def run(args, target, projectile):
+    """Check everything, fit, write ``--out``; return the summary as text or JSON. Nothing is
+    written when an input is refused or the fit fails."""
+    from cavex.verification.commands.options import resistance_settings
+    from cavex.verification.output.paths import check_output_file
+    from cavex.verification.validation.calibration import check_parameters
+    from cavex.verification.validation.shots import read_shots
+
+    settings = resistance_settings(args)
+    shot_file = read_shots(args.shots)
+    shots = shot_file.by_id(args.ids) if args.ids else shot_file.shots
+    params = check_parameters(args.params)
+    out = check_output_file(args.out, "out")
+    result = job(shots, resistance=settings["resistance"], boundary=settings["boundary"],
+                 params=params, workers=args.workers, scheduler=args.scheduler,
+                 progress=args.progress, out=out)
+    command = command_line(args.shots, args.out, result["calibration"].model, params, args.ids)
+    document = summary(result, write_outputs(result, args.shots, shots[0], command, out))
+    return json.dumps(document, indent=2) if args.json else text(document)
+
+
+def job(shots, *, resistance="derived", boundary=None, params=None, workers=None,
+        scheduler=None, progress=None, out=None):
+    """Fit (:func:`cavex.verification.validation.calibration.fit`) after checking the execution
+    settings and that ``out`` (if given) ends in .toml: ``{"calibration", "seconds"}``."""
+    from cavex.errors import require
+    from cavex.verification.fedata.runner import check_execution, show_progress
+    from cavex.verification.validation.calibration import fit
+    from cavex.verification.validation.predict import TableCache
+
+    check_execution(workers, scheduler)
+    require(out is None or Path(out).suffix == ".toml", "out", "a path ending in .toml",
+            str(out))
+    show = show_progress(progress)
+    tables = TableCache(workers=workers, scheduler=scheduler, progress=show)
+    began = time.monotonic()
+    calibration = fit(shots, resistance, params, tables=tables, progress=show,
+                      boundary=boundary)
+    return {"calibration": calibration, "seconds": time.monotonic() - began}
+
+
+def command_line(shots_path, out_path, model, params, ids=None):
+    """The ``cavex calibrate`` command that writes this file (its comment)."""
+    from cavex.analytic.penetration.resistance import label_options
+
+    words = ["cavex", "calibrate", "--shots", str(shots_path), "--out", str(out_path),
+             *label_options(model).split(), "--params", *params,
+             *(["--ids", *ids] if ids else [])]
+    return " ".join(shlex.quote(w) for w in words)
+
+
+def write_outputs(job, shots_path, reference, command, out):
+    """Write the calibration file ``out`` (reference shot ``reference``); return its path."""
+    from cavex.verification.output.files import write_text_atomic
+    from cavex.verification.validation.calibration import calibration_text
+
+    out = Path(out)
+    text = calibration_text(job["calibration"], shots_path, reference, command)
+    if out.parent != Path(""):
+        out.parent.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(out, text)
+    return out
+
+
+def summary(job, out):
+    """What ``cavex calibrate --json`` prints: the model, the fitted parameters (all
+    dimensionless), the mapping, the shots fitted, the fit statistics, the wall time and the
+    file written."""
+    calibration = job["calibration"]
+    return {"model": calibration.model, "params": list(calibration.params),
+            "fitted": {p: getattr(calibration.mapping, p) for p in calibration.params},
+            "mapping": calibration.mapping.as_dict(), "shots": list(calibration.shots),
+            **dict(calibration.statistics), "wall_time_s": float(job["seconds"]),
+            "output": str(out)}
+
+
+def text(summary):
+    """The model and its shots, the fitted values, the fit, the file."""
+    s = summary
+    values = ", ".join(f"{p} = {v:.6g}" for p, v in s["fitted"].items())
+    return "\n".join([
+        f"model   {s['model']}, {len(s['shots'])} shots: {', '.join(s['shots'])}",
+        f"fitted  {values}",
+        f"fit     mean |ln(predicted/measured)| {s['mean_abs_log_ratio']:.4f}, rms "
+        f"{s['rms_log_ratio']:.4f}, {s['evaluations']} evaluations, "
+        f"{s['wall_time_s']:.1f} s",
+        f"wrote   {s['output']}",
+    ])

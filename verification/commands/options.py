@@ -1,0 +1,95 @@
+"""The one choice "which resistance" on the command line, shared by every command that makes it.
+
+Options (``penetrate``, ``stress``, ``trajectory``, ``calibrate``): ``--resistance`` one of
+:data:`cavex.analytic.penetration.resistance.RESISTANCES` (``trajectory`` also ``law``; ``stress``
+only the closed forms), ``--boundary {dynamic,quasi-static}`` (the derived model's convention;
+default dynamic; the paper model keeps its own quasi-static and refuses another), ``--table
+FILE`` with ``table``, ``--epsilon`` (the paper model's reading of epsilon). Together they name
+one model label (:func:`cavex.analytic.penetration.resistance.model_label`).
+
+The earlier spellings (``--model derived|paper``, ``--resistance closed-form``, ``calibrate
+--model derived-dynamic|derived-quasi-static|paper|fe-table``) are refused with one line that
+names the new options (exit code 2).
+"""
+
+import argparse
+
+from cavex.analytic.paper_model import EPSILON_READINGS
+from cavex.analytic.penetration.resistance import (
+    MODEL_LABELS,
+    MODELS,
+    OLD_LABELS,
+    RESISTANCES,
+    check_model,
+    label_options,
+    model_boundary,
+)
+from cavex.errors import CavexInputError
+from cavex.problem import BOUNDARIES
+
+CLOSED_FORMS = MODELS  # the resistances that are closed forms
+NEW_OPTIONS = "--resistance derived|paper|table (with --boundary dynamic|quasi-static)"
+#: old values of --resistance and --model that are no label, with what replaced them
+OLD_VALUES = {"closed-form": "--resistance derived or --resistance paper",
+              "derived": "--resistance derived"}
+
+
+def add_resistance_options(command, offered=RESISTANCES, table=True, epsilon=True):
+    """``--resistance`` (one of ``offered``), ``--boundary``, ``--table`` (if ``table``),
+    ``--epsilon`` (if ``epsilon``) and the refused ``--model``."""
+    command.add_argument("--resistance", default="derived", metavar="{" + ",".join(offered) + "}",
+                         help="the resistance: the derived closed form (--boundary), the "
+                         "paper's printed model" + (" (--epsilon)" if epsilon else "")
+                         + (", an FE table (--table)" if "table" in offered else "")
+                         + (", sigma_n = A + B V_n^2 (--law-A, --law-B)" if "law" in offered
+                            else ""))
+    command.add_argument("--boundary", choices=BOUNDARIES,
+                         help="yield-at-boundary convention of the derived model (default: "
+                         "dynamic; the paper model has its own, quasi-static)")
+    if table:
+        command.add_argument("--table", help="NetCDF table from `cavex table` (--resistance "
+                             "table; the first layer alone: the derived model)")
+    if epsilon:
+        command.add_argument("--epsilon", choices=EPSILON_READINGS, default="quasi-static",
+                             help="the paper model's reading of epsilon (docs/table2.md)")
+    command.add_argument("--model", dest="old_model", help=argparse.SUPPRESS)
+
+
+def replaced(value):
+    """What replaced the old option value ``value`` (None: ``value`` is no old spelling)."""
+    if value in OLD_VALUES:
+        return OLD_VALUES[value]
+    label = OLD_LABELS.get(value, value)
+    return label_options(label) if label in MODEL_LABELS else None
+
+
+def resistance_settings(args, offered=RESISTANCES):
+    """``{"resistance", "boundary", "epsilon", "table"}`` of the parsed options, checked: no
+    old spelling, the resistance is one of ``offered``, ``--table FILE`` goes with
+    ``--resistance table`` (both or neither, where the command has ``--table``: ``calibrate``
+    builds its own tables), the paper model takes only its own boundary. ``boundary`` is
+    resolved (for a table or a law the derived model's default: the first layer alone, where
+    it is flown, is derived)."""
+    if args.old_model is not None:
+        hint = replaced(args.old_model)
+        raise CavexInputError(f"option --model was replaced by {NEW_OPTIONS}"
+                              + (f"; for '{args.old_model}' use {hint}" if hint else ""))
+    resistance = args.resistance
+    if resistance not in offered:
+        hint = None if resistance in (*RESISTANCES, "law") else replaced(resistance)
+        if hint:
+            raise CavexInputError(f"option --resistance {resistance} was replaced by {hint}")
+        raise CavexInputError(f"option --resistance must be one of {', '.join(offered)} (got "
+                              f"{resistance!r})" + ("; a table is no closed form: `cavex fem` "
+                                                    "gives the FE wall stress"
+                                                    if resistance == "table" else ""))
+    table = getattr(args, "table", None)
+    if "table" in args and (resistance == "table") != (table is not None):
+        raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
+                              "neither)")
+    if resistance in CLOSED_FORMS:
+        check_model(resistance, args.boundary)
+    return {"resistance": resistance,
+            "boundary": model_boundary(resistance if resistance in CLOSED_FORMS else "derived",
+                                       args.boundary),
+            "epsilon": getattr(args, "epsilon", "quasi-static"), "table": table}

@@ -1,0 +1,94 @@
+"""``cavex table``: the FE-tabulated ``sigma_r(V, L)`` of the target, written as NetCDF.
+
+Defaults: velocities 0, 100, ..., 1200 m/s (13), depths 0.10 ... 1.30 m every 0.04 m (31, plus
+the two wall-layer switch depths): concrete, macadam and into the soil
+(:data:`cavex.verification.fedata.table.DEFAULT_VELOCITIES`, ``DEFAULT_DEPTHS``).
+"""
+
+import json
+import math
+import shutil
+import time
+
+import numpy as np
+
+STORE_SUFFIX = ".cases"  # the resumable case store: <out>.cases/ until the table is written
+
+
+def run(args, target, projectile):
+    """Build, write and summarise the table; return the text or JSON to print."""
+    result = job(target, projectile, args.velocities, args.depths, args.out, nu=args.nu,
+                 workers=args.workers, scheduler=args.scheduler, progress=args.progress)
+    document = summary(result, write_outputs(result))
+    return json.dumps(document, indent=2) if args.json else text(document)
+
+
+def job(target, projectile, velocities=None, depths=None, out_path="results/table.nc", *,
+        nu=None, workers=None, scheduler=None, numerics=None, progress=None):
+    """Build the table: ``{"dataset", "seconds", "output", "store"}``; nothing is written but
+    the case store.
+
+    The output location, the grid, ``workers`` and ``scheduler`` are checked before any FE
+    work; finished cells are kept in ``<out>.cases/`` while the table is built, so that a killed
+    run resumes where it stopped (:func:`write_outputs` removes it once the table is written).
+    """
+    from cavex.verification.fedata.runner import check_execution
+    from cavex.verification.fedata.table import (
+        DEFAULT_DEPTHS,
+        DEFAULT_VELOCITIES,
+        build_table,
+        check_grid,
+    )
+    from cavex.verification.output.paths import check_output_file
+
+    velocities = DEFAULT_VELOCITIES if velocities is None else velocities
+    depths = DEFAULT_DEPTHS if depths is None else depths
+    check_grid(velocities, depths)
+    out_path = check_output_file(out_path, "out")
+    check_execution(workers, scheduler)
+    store = out_path.with_name(out_path.name + STORE_SUFFIX)
+    start = time.perf_counter()
+    ds = build_table(target, projectile, velocities, depths, nu=nu, numerics=numerics,
+                     scheduler=scheduler, workers=workers, progress=progress, store=store)
+    return {"dataset": ds, "seconds": time.perf_counter() - start, "output": out_path,
+            "store": store}
+
+
+def write_outputs(job):
+    """Write the table, remove the case store (the table holds every cell now); return the
+    path written."""
+    from cavex.verification.fedata.table import write_table
+
+    written = write_table(job["dataset"], job["output"])
+    shutil.rmtree(job["store"], ignore_errors=True)
+    return written
+
+
+def summary(job, path):
+    """What ``cavex table --json`` prints: FE cases (the grid plus the first layer alone),
+    the grid's axes, failed cells, the largest error estimate (None: none estimated), the wall
+    time and the file written."""
+    ds = job["dataset"]
+    estimate = float(np.nanmax(ds["error_estimate"])) if np.any(
+        np.isfinite(ds["error_estimate"])) else None
+    return {"cases": ds.sizes["velocity"] * (ds.sizes["depth"] + 1),
+            "velocities_m_s": [float(x) for x in ds["velocity"].values],
+            "depths_m": [float(x) for x in ds["depth"].values],
+            "failed": int(ds["failed"].sum()) + int(ds["failed_first_layer"].sum()),
+            "max_error_estimate": estimate, "wall_time_s": float(job["seconds"]),
+            "output": str(path)}
+
+
+def text(summary):
+    """Cases, failed cells, time and path of a built table, one item per line."""
+    s = summary
+    v, d = s["velocities_m_s"], s["depths_m"]
+    estimate = math.nan if s["max_error_estimate"] is None else s["max_error_estimate"]
+    return "\n".join([
+        f"cases   {s['cases']} ({len(v)} velocities {v[0]:g}..{v[-1]:g} m/s x "
+        f"{len(d)} depths {d[0]:g}..{d[-1]:g} m, + first layer alone)",
+        f"failed  {s['failed']}",
+        f"largest FE error estimate {estimate:.3%}",
+        f"time    {s['wall_time_s']:.1f} s",
+        f"wrote   {s['output']}",
+    ])

@@ -1,0 +1,68 @@
+"""``cavex verify``: the analytic-against-FE report of the target
+(:mod:`cavex.verification.report`).
+
+The report is written into a hidden folder and moved in complete: Ctrl-C or kill leaves the
+previous report as it was, or (if that was removed) no report, never a partial one.
+"""
+
+import json
+from pathlib import Path
+
+DEFAULT_OUT = "results/verification"
+
+
+def run(args, target, projectile):
+    """Write the report; return its summary as text or JSON."""
+    document = summary(job(target, projectile, config_path=args.config, quick=args.quick,
+                           out_dir=args.out, scheduler=args.scheduler, workers=args.workers,
+                           progress=args.progress))
+    return json.dumps(document, indent=2) if args.json else text(document)
+
+
+def job(target, projectile, *, config_path=None, quick=False, out_dir=None, scheduler=None,
+        workers=None, progress=None):
+    """Check the output folder and the execution settings, build and write the report
+    (:func:`cavex.verification.report.build.verify`, staged); return its result with the
+    paths of the folder it was moved to. ``config_path``: the file the target was read from
+    (None: the default target), whose text the report quotes."""
+    from cavex.config import default_config_text
+    from cavex.verification.fedata.runner import check_execution
+    from cavex.verification.output.paths import check_output_dir, staged_output
+    from cavex.verification.report import build
+
+    config = default_config_text() if config_path is None else Path(config_path).read_text(
+        encoding="utf-8")
+    out_dir = check_output_dir(DEFAULT_OUT if out_dir is None else out_dir, "out")
+    check_execution(workers, scheduler)
+    with staged_output(out_dir) as stage:
+        result = build.verify(target, projectile, quick=quick, out_dir=stage,
+                              scheduler=scheduler, workers=workers, config_text=config,
+                              progress=progress)
+        build.remove_report_files(out_dir)  # an old report never mixes with this one
+    return _moved(result, stage, out_dir)
+
+
+def _moved(result, stage, out_dir):
+    """``result`` with the paths of the staged files in ``stage`` moved to ``out_dir``."""
+    files = {k: str(Path(out_dir) / Path(v).relative_to(stage))
+             for k, v in result["files"].items()}
+    return {**result, "out_dir": str(out_dir), "files": files}
+
+
+def summary(job):
+    """What ``cavex verify --json`` prints: the report's result without ``stats`` (the
+    report and ``grid.nc`` hold the statistics)."""
+    return {k: job[k] for k in ("out_dir", "files", "quick", "cells", "failed", "picture",
+                                "conclusions", "wall_time_s", "table_wall_time_s", "created")}
+
+
+def text(summary):
+    """Cells, times, the picture's cell, the conclusions and where the report is."""
+    return "\n".join([
+        f"cells   {summary['cells']} ({summary['failed']} failed)",
+        f"time    {summary['wall_time_s']:.1f} s (FE table {summary['table_wall_time_s']:.1f} s, "
+        f"created {summary.get('created') or '?'})",
+        f"figure  {summary['picture']}",
+        *(f"- {line}" for line in summary["conclusions"]),
+        f"wrote   {summary['files']['report']} (+ html, PNGs, grid.nc) in {summary['out_dir']}",
+    ])
