@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Regenerate every committed result with the commands a user runs (from the repository root, with
+# cavex installed): penetration (derived and the paper's model), the calibrations and the
+# validation against the Forrestal et al. (1994) shots, the verification report and the oblique
+# study. Afterwards `git status results` shows what changed (on another CPU: nothing; see
+# cavex.verification.output.number_format for the digits written).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cavex penetrate --out results/penetration > results/penetration/summary.txt
+cavex penetrate --resistance paper --epsilon cylindrical-sigma_c --out results/penetration_paper \
+  > results/penetration_paper/summary.txt
+ids="F94-52 F94-49 F94-51 F94-40 F94-48 F94-39 F94-42 F94-53 F94-47"
+for spec in "derived-dynamic:--resistance derived --boundary dynamic" \
+            "derived-quasi-static:--resistance derived --boundary quasi-static" \
+            "table:--resistance table" "paper:--resistance paper"; do
+  label=${spec%%:*}
+  # shellcheck disable=SC2086  # the options are words
+  cavex calibrate --shots examples/shots_forrestal1994.csv \
+    --out "results/validation/calibration_$label.toml" ${spec#*:} \
+    --params lam strength_factor --ids $ids --no-progress > /dev/null
+done
+cavex validate --shots examples/shots_forrestal1994.csv --calibration \
+  results/validation/calibration_derived-quasi-static.toml results/validation/calibration_paper.toml \
+  results/validation/calibration_table.toml results/validation/calibration_derived-dynamic.toml \
+  --out results/validation --no-progress > /dev/null
+cavex verify --no-progress > /dev/null
+python -m cavex.verification.studies.oblique_study --no-progress > /dev/null
+git status --short results
