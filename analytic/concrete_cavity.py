@@ -1,0 +1,526 @@
+r"""Dynamic spherical cavity expansion in concrete: elastic, radially cracked and comminuted zones.
+
+After Forrestal and Tzou (1997, Int. J. Solids Struct. 34(31-32), 4127-4146), with the locked
+hydrostat of Luk, Forrestal and Amos (1991). A spherical cavity opens from zero radius at the
+constant velocity ``V`` in one semi-infinite concrete. Compression is positive; ``f_c`` (the
+unconfined compressive strength) normalises every stress, ``s = sigma/f_c``, and the inertia
+number is ``phi = rho V^2 / f_c`` (``rho`` the undisturbed density). The solution is
+self-similar in ``xi = r/(V t)`` (cavity wall ``xi = 1``); ``U = v/V`` is the particle
+velocity and ``R = rho/rho_0`` the density ratio. docs/concrete.md derives every equation below.
+
+Zones, from the wall outward:
+
+- comminuted (plastic), ``1 <= xi <= beta``: exact (Eulerian) balance of mass and momentum,
+
+  .. math:: (U - \xi) R' + R (U' + 2U/\xi) = 0, \qquad
+            s' + 2D/\xi = \phi R (\xi - U) U',
+
+  with ``D = s_r - s_theta = min(tau_0 + lam p, tau_max)``, ``p = s_r - 2D/3``,
+  ``tau_0 = f_c (1 - lam/3)`` (uniaxial compression yields at ``f_c``), and the hydrostat
+  ``eta = 1 - 1/R = eta_lock + p/K``: ``K`` finite is the linear pressure-volumetric strain law,
+  ``K = inf`` the locked hydrostat (density ``rho_0/(1 - eta_lock)`` behind the front),
+  ``K = inf, eta_lock = 0`` incompressible. Solved for ``U'`` and ``s'``:
+
+  .. math:: U' = -\frac{2 (R U + (\xi - U) R_s D)}{\xi R (1 - \phi R_s (\xi - U)^2)},
+
+  ``R_s = dR/ds = R^2 p_s / K``; the flow behind the front must stay subsonic
+  (``phi R_s (xi - U)^2 < 1``).
+- radially cracked, ``beta <= xi <= gamma``: ``sigma_theta = 0``, ``sigma_r = -E eps_r``, small
+  strain ``u = V t F(xi)``, ``U = F - xi F'``, density ``rho_0``. The linear momentum balance
+  ``(xi^2 s)' = -phi xi^3 F''`` integrates to ``F' = K_1 (1/xi^2 - w_b^2)``,
+  ``F = K_0 - K_1 (1/xi + w_b^2 xi)``, ``w_b = V/c_b``, ``c_b^2 = E/rho``.
+- elastic, ``xi >= gamma`` (or ``beta``): linear elastodynamics, the wave front at
+  ``xi = 1/w``, ``w = V/c_d``; the solution that vanishes with its slope at the front is
+  ``F = C (1/xi^2 - 3 w^2 + 2 w^3 xi)``, so ``U = 3C (1/xi^2 - w^2)``,
+  ``D = 6 mu C (1/xi^3 - w^2/xi)`` and
+
+  .. math:: s = 4\mu F/\xi + 6 C \phi (1/\xi - w) - \phi U^2/2,
+
+  written so that ``nu -> 1/2`` (``w = 0``) is finite; the last term is the integral of the
+  convective acceleration ``U U'`` (second order in the strain; with it the incompressible
+  limit is cavex's derived closed form exactly).
+
+Fronts:
+
+- crack front ``gamma``: the elastic hoop stress reaches the tensile strength,
+  ``s_theta = -f_t/f_c``; ``F`` is continuous and momentum jumps by the linear Rankine-Hugoniot
+  condition ``[s_r] = -phi gamma^2 [F']``;
+- plastic front ``beta``: the material ahead is at yield (cracked: uniaxial,
+  ``s_r = min(1, tau_max/f_c)``; elastic: ``D = min(tau_0 + lam p, tau_max)``), and mass and
+  momentum jump by the exact Rankine-Hugoniot conditions ``R^-(beta - U^-) = R^+(beta - U^+)
+  = j``, ``s^- = s^+ + phi j (U^- - U^+)`` (a shock where the hydrostat compacts);
+- a plastic front faster than the elastic wave (``beta >= 1/w``) runs into undisturbed concrete.
+
+The wall condition ``U(1) = 1`` closes the problem: one unknown front speed (``beta`` without
+cracking, ``gamma`` with it) is found by bracketing and Brent's method; every evaluation
+integrates the comminuted zone inward from ``beta`` with classical Runge-Kutta (RK4) at a fixed
+number of steps in ``ln xi``, the step that crosses the cap ``tau_max`` split at the crossing
+so that the order stays 4 (``tests/test_concrete_cavity.py`` measures it).
+
+Which structure (:data:`STRUCTURES`): the elastic-comminuted solution when its hoop tension at
+``beta`` stays within ``f_t``; else the cracked one (crack front slower than the bar wave
+``c_b``); else the crack front riding on the comminution front (the cracked zone's limit of zero
+width: elastic hoop stress ``-f_t/f_c`` just ahead of ``beta``); a comminuted shock into
+undisturbed concrete when no elastic precursor fits.
+
+Public: :class:`ConcreteCavity` (the dimensionless material), :func:`solve` (one ``phi``),
+:func:`wall_stress` (arrays of velocities), :func:`resistance_table` and :func:`fit_AB`
+(``sigma_r/f_c ~ A + B rho V^2/f_c``). The ``(material, phi)`` answers are cached.
+"""
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from numba import njit
+from scipy.optimize import brentq
+
+from cavex.errors import CavexNumericalError, is_finite_number, require
+
+# structure codes of a solution
+ELASTIC_PLASTIC, CRACKED, JOINT_FRONT, SUPERSEISMIC = 0, 1, 2, 3
+STRUCTURES = {ELASTIC_PLASTIC: "elastic-comminuted", CRACKED: "elastic-cracked-comminuted",
+              JOINT_FRONT: "elastic-comminuted, cracking at the comminution front",
+              SUPERSEISMIC: "comminuted shock into undisturbed concrete"}
+DEFAULT_STEPS = 256  # RK4 steps across the comminuted zone (see the convergence test)
+# columns of the parameter vector of the compiled functions
+(E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, TENSILE, W, WB, PHI) = range(11)
+NPAR = 11
+
+
+@dataclass(frozen=True)
+class ConcreteCavity:
+    """Concrete for the cavity expansion, in units of ``f_c`` (dimensionless).
+
+    Parameters
+    ----------
+    modulus : float
+        ``E / f_c`` (> 1).
+    nu : float
+        Poisson's ratio of the elastic zone, in [0, 0.5] (0.5: incompressible elastic zone).
+    lam : float
+        Pressure slope of the comminuted strength ``D = tau_0 + lam p``, in [0, 3).
+    tau_max : float
+        Tresca limit ``tau_max / f_c`` of ``D`` (>= 1; ``inf``: no limit).
+    bulk : float
+        Bulk modulus ``K / f_c`` of the comminuted hydrostat (> 0; ``inf``: locked).
+    eta_lock : float
+        Volumetric strain (compaction) at the plastic front, in [0, 0.9].
+    tensile : float
+        Tensile strength ``f_t / f_c`` (> 0; ``inf``: no cracking).
+    """
+
+    modulus: float
+    nu: float
+    lam: float
+    tau_max: float = math.inf
+    bulk: float = math.inf
+    eta_lock: float = 0.0
+    tensile: float = math.inf
+
+    def __post_init__(self):
+        for name in ("modulus", "nu", "lam", "eta_lock"):
+            require(is_finite_number(getattr(self, name)), name, "a finite number",
+                    getattr(self, name))
+        require(self.modulus > 1.0, "modulus", "E/f_c > 1", self.modulus)
+        require(0.0 <= self.nu <= 0.5, "nu", "in [0, 0.5]", self.nu)
+        require(0.0 <= self.lam < 3.0, "lam", "in [0, 3)", self.lam)
+        require(self.tau_max >= 1.0, "tau_max", "tau_max/f_c >= 1 (inf: none)", self.tau_max)
+        require(self.bulk > 0.0, "bulk", "K/f_c > 0 (inf: locked)", self.bulk)
+        require(0.0 <= self.eta_lock <= 0.9, "eta_lock", "in [0, 0.9]", self.eta_lock)
+        require(self.tensile > 0.0, "tensile", "f_t/f_c > 0 (inf: no cracking)", self.tensile)
+
+    @property
+    def shear(self):
+        """``mu / f_c = E / (2 (1 + nu) f_c)``."""
+        return self.modulus / (2.0 * (1.0 + self.nu))
+
+    def wave_numbers(self, phi):
+        """``(w, w_b) = (V/c_d, V/c_b)`` at ``phi = rho V^2/f_c``:
+        ``w^2 = phi (1 + nu)(1 - 2 nu)/(e (1 - nu))``, ``w_b^2 = phi/e``."""
+        e, nu = self.modulus, self.nu
+        return (math.sqrt(phi * (1.0 + nu) * (1.0 - 2.0 * nu) / (e * (1.0 - nu))),
+                math.sqrt(phi / e))
+
+    def parameters(self, phi):
+        """The parameter vector of the compiled functions."""
+        w, wb = self.wave_numbers(phi)
+        p = np.empty(NPAR)
+        p[E_], p[MU], p[LAM] = self.modulus, self.shear, self.lam
+        p[TAU0], p[TAU_MAX], p[BULK] = 1.0 - self.lam / 3.0, self.tau_max, self.bulk
+        p[ETA], p[TENSILE], p[W], p[WB], p[PHI] = self.eta_lock, self.tensile, w, wb, phi
+        return p
+
+
+@dataclass(frozen=True)
+class CavitySolution:
+    """One self-similar solution: wall stress ``S = sigma_r(a)/f_c`` and its structure."""
+
+    S: float
+    phi: float
+    structure: int
+    plastic_front: float  # beta = c_plastic / V
+    crack_front: float  # gamma (NaN without a cracked zone)
+    amplitude: float  # C of the elastic zone (NaN if none)
+
+    @property
+    def name(self):
+        return STRUCTURES[self.structure]
+
+
+# ------------------------------------------------------------------------------------------
+# Compiled pieces
+# ------------------------------------------------------------------------------------------
+
+@njit(cache=True)
+def elastic_state(p, C, x):
+    """``(s_r, D, U, F, F', eps_v)`` of the elastic zone at ``xi = x``, amplitude ``C``."""
+    w, phi, mu = p[W], p[PHI], p[MU]
+    F = C * (1.0 / x ** 2 - 3.0 * w ** 2 + 2.0 * w ** 3 * x)
+    dF = C * (-2.0 / x ** 3 + 2.0 * w ** 3)
+    U = 3.0 * C * (1.0 / x ** 2 - w ** 2)
+    D = 6.0 * mu * C * (1.0 / x ** 3 - w ** 2 / x)
+    s = 4.0 * mu * F / x + 6.0 * C * phi * (1.0 / x - w) - 0.5 * phi * U * U
+    return s, D, U, F, dF, 6.0 * C * w ** 2 * (w - 1.0 / x)
+
+
+@njit(cache=True)
+def _quadratic_root(c2, c1, c0):
+    """The root of ``c2 C^2 + c1 C + c0 = 0`` that tends to ``-c0/c1`` as ``c2 -> 0``."""
+    disc = c1 * c1 - 4.0 * c2 * c0
+    if disc < 0.0:
+        return np.nan
+    q = c1 + math.copysign(math.sqrt(disc), c1)
+    return -2.0 * c0 / q
+
+
+@njit(cache=True)
+def _elastic_parts(p, x):
+    """``s_r``, ``D`` and ``s_theta`` of the elastic zone as ``(linear, quadratic)`` parts in C."""
+    w, phi, mu = p[W], p[PHI], p[MU]
+    f = 1.0 / x ** 2 - 3.0 * w ** 2 + 2.0 * w ** 3 * x
+    s1 = 4.0 * mu * f / x + 6.0 * phi * (1.0 / x - w)
+    s2 = -0.5 * phi * 9.0 * (1.0 / x ** 2 - w ** 2) ** 2
+    d1 = 6.0 * mu * (1.0 / x ** 3 - w ** 2 / x)
+    return s1, s2, d1
+
+
+@njit(cache=True)
+def yield_amplitude(p, x):
+    """Elastic amplitude ``C`` at which the elastic state at ``xi = x`` first yields:
+    ``D = tau_0 + lam (s - 2D/3)`` or ``D = tau_max``, whichever comes first."""
+    s1, s2, d1 = _elastic_parts(p, x)
+    lam = p[LAM]
+    # D (1 + 2 lam/3) - lam s = tau_0
+    c_mc = _quadratic_root(-lam * s2, d1 * (1.0 + 2.0 * lam / 3.0) - lam * s1, -p[TAU0])
+    c_cap = p[TAU_MAX] / d1
+    if c_cap < c_mc or not c_mc > 0.0:
+        return c_cap
+    return c_mc
+
+
+@njit(cache=True)
+def crack_amplitude(p, x):
+    """Elastic amplitude ``C`` with the hoop stress ``s - D = -f_t/f_c`` at ``xi = x``."""
+    s1, s2, d1 = _elastic_parts(p, x)
+    return _quadratic_root(s2, s1 - d1, p[TENSILE])
+
+
+@njit(cache=True)
+def constitutive(p, s):
+    """``(D, R, dR/ds)`` of the comminuted zone at radial stress ``s``; ``R = nan`` if the
+    hydrostat is past full compaction."""
+    lam, tau0, cap = p[LAM], p[TAU0], p[TAU_MAX]
+    pressure = (s - 2.0 * tau0 / 3.0) / (1.0 + 2.0 * lam / 3.0)
+    D = tau0 + lam * pressure
+    dp = 1.0 / (1.0 + 2.0 * lam / 3.0)
+    if D > cap:
+        D = cap
+        pressure = s - 2.0 * cap / 3.0
+        dp = 1.0
+    eta = p[ETA] + pressure / p[BULK]
+    if eta >= 1.0:
+        return D, np.nan, np.nan
+    R = 1.0 / (1.0 - eta)
+    return D, R, R * R * dp / p[BULK]
+
+
+@njit(cache=True)
+def _rhs(p, x, s, U):
+    """``(ds/d ln xi, dU/d ln xi)`` of the comminuted zone; NaN where the flow is sonic."""
+    D, R, Rs = constitutive(p, s)
+    phi = p[PHI]
+    gap = x - U
+    den = R * (1.0 - phi * Rs * gap * gap)
+    if not den > 0.0:
+        return np.nan, np.nan
+    dU = -(2.0 * R * U + 2.0 * gap * Rs * D) / (x * den)
+    ds = -2.0 * D / x + phi * R * gap * dU
+    return x * ds, x * dU
+
+
+@njit(cache=True)
+def _rk4(p, t, s, U, h):
+    x = math.exp(t)
+    k1s, k1u = _rhs(p, x, s, U)
+    x2 = math.exp(t + 0.5 * h)
+    k2s, k2u = _rhs(p, x2, s + 0.5 * h * k1s, U + 0.5 * h * k1u)
+    k3s, k3u = _rhs(p, x2, s + 0.5 * h * k2s, U + 0.5 * h * k2u)
+    k4s, k4u = _rhs(p, math.exp(t + h), s + h * k3s, U + h * k3u)
+    return (s + h * (k1s + 2.0 * k2s + 2.0 * k3s + k4s) / 6.0,
+            U + h * (k1u + 2.0 * k2u + 2.0 * k3u + k4u) / 6.0)
+
+
+@njit(cache=True)
+def cap_stress(p):
+    """Radial stress at which ``tau_0 + lam p`` reaches ``tau_max`` (inf if never)."""
+    lam = p[LAM]
+    if lam == 0.0 or not math.isfinite(p[TAU_MAX]):
+        return np.inf if p[TAU0] < p[TAU_MAX] else -np.inf
+    pressure = (p[TAU_MAX] - p[TAU0]) / lam
+    return pressure + 2.0 * p[TAU_MAX] / 3.0
+
+
+@njit(cache=True)
+def integrate(p, beta, s, U, steps):
+    """RK4 from ``xi = beta`` to the wall ``xi = 1`` in ``ln xi``; returns ``(s, U)`` there.
+
+    A step that crosses the cap stress is split at the crossing (secant on the step length), so
+    that the kink of ``D(s)`` falls on a step boundary.
+    """
+    t = math.log(beta)
+    h = -t / steps
+    s_cap = cap_stress(p)
+    for _ in range(steps):
+        s_new, U_new = _rk4(p, t, s, U, h)
+        if (s - s_cap) * (s_new - s_cap) < 0.0:
+            lo, f_lo, hi, f_hi = 0.0, s - s_cap, h, s_new - s_cap
+            for _ in range(60):  # regula falsi (Illinois) on the length of the first part
+                mid = hi - f_hi * (hi - lo) / (f_hi - f_lo)
+                f_mid = _rk4(p, t, s, U, mid)[0] - s_cap
+                if f_mid * f_hi < 0.0:
+                    lo, f_lo = hi, f_hi
+                else:
+                    f_lo *= 0.5
+                hi, f_hi = mid, f_mid
+                if abs(f_mid) <= 1e-15 * abs(s_cap) or abs(hi - lo) <= 1e-15 * abs(h):
+                    break
+            s_mid, U_mid = _rk4(p, t, s, U, hi)
+            s_new, U_new = _rk4(p, t + hi, s_mid, U_mid, h - hi)
+        s, U = s_new, U_new
+        t += h
+        if not (math.isfinite(s) and math.isfinite(U)):
+            return np.nan, np.nan
+    return s, U
+
+
+@njit(cache=True)
+def jump(p, beta, s_ahead, U_ahead, R_ahead):
+    """State ``(s, U)`` just behind a plastic front at ``xi = beta`` (Rankine-Hugoniot)."""
+    j = R_ahead * (beta - U_ahead)
+    phi = p[PHI]
+    if not j > 0.0:
+        return np.nan, np.nan
+    s = s_ahead
+    for _ in range(100):  # Newton on h(s) = s - s_ahead - phi j (beta - j/R(s) - U_ahead)
+        D, R, Rs = constitutive(p, s)
+        if not R > 0.0:
+            return np.nan, np.nan
+        h = s - s_ahead - phi * j * (beta - j / R - U_ahead)
+        dh = 1.0 - phi * j * j * Rs / (R * R)
+        step = h / dh
+        s -= step
+        if abs(step) <= 1e-15 * (1.0 + abs(s)):
+            break
+    D, R, Rs = constitutive(p, s)
+    return s, beta - j / R
+
+
+@njit(cache=True)
+def elastic_plastic(p, beta, steps):
+    """Wall ``(U(1) - 1, s(1), C)`` with the elastic zone directly ahead of ``beta``."""
+    C = yield_amplitude(p, beta)
+    s_a, D_a, U_a, F_a, dF_a, ev_a = elastic_state(p, C, beta)
+    s0, U0 = jump(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a))
+    s1, U1 = integrate(p, beta, s0, U0, steps)
+    return U1 - 1.0, s1, C
+
+
+@njit(cache=True)
+def cracking_plastic(p, beta, steps):
+    """Wall ``(U(1) - 1, s(1), C)`` with the crack and comminution fronts together at ``beta``:
+    the elastic state ahead has the hoop stress ``-f_t/f_c`` (the limit of a cracked zone of
+    vanishing width)."""
+    C = crack_amplitude(p, beta)
+    s_a, D_a, U_a, F_a, dF_a, ev_a = elastic_state(p, C, beta)
+    s0, U0 = jump(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a))
+    s1, U1 = integrate(p, beta, s0, U0, steps)
+    return U1 - 1.0, s1, C
+
+
+@njit(cache=True)
+def superseismic(p, beta, steps):
+    """Wall ``(U(1) - 1, s(1))`` of a plastic front into undisturbed concrete."""
+    s0, U0 = jump(p, beta, 0.0, 0.0, 1.0)
+    s1, U1 = integrate(p, beta, s0, U0, steps)
+    return U1 - 1.0, s1
+
+
+@njit(cache=True)
+def cracked_front(p, gamma):
+    """``(beta, s, U, eps_v, C)`` at the plastic front of the cracked solution with the crack
+    front at ``gamma`` (``beta = nan`` when it does not lie in ``(1, gamma)``)."""
+    e, phi, wb = p[E_], p[PHI], p[WB]
+    C = crack_amplitude(p, gamma)
+    s_e, D_e, U_e, F_e, dF_e, ev_e = elastic_state(p, C, gamma)
+    stiff = e - phi * gamma * gamma
+    if not (C > 0.0 and stiff > 0.0):
+        return np.nan, 0.0, 0.0, 0.0, C
+    dF_c = -(s_e + phi * gamma * gamma * dF_e) / stiff
+    K1 = dF_c / (1.0 / gamma ** 2 - wb ** 2)
+    K0 = F_e + K1 * (1.0 / gamma + wb ** 2 * gamma)
+    s_yield = min(1.0, p[TAU_MAX])
+    inverse_square = wb ** 2 - s_yield / (e * K1)
+    if not (K1 < 0.0 and inverse_square > 0.0):
+        return np.nan, 0.0, 0.0, 0.0, C
+    beta = 1.0 / math.sqrt(inverse_square)
+    if not (1.0 < beta < gamma):
+        return np.nan, 0.0, 0.0, 0.0, C
+    F = K0 - K1 * (1.0 / beta + wb ** 2 * beta)
+    dF = K1 * (1.0 / beta ** 2 - wb ** 2)
+    return beta, s_yield, K0 - 2.0 * K1 / beta, dF + 2.0 * F / beta, C
+
+
+@njit(cache=True)
+def cracked(p, gamma, steps):
+    """Wall ``(U(1) - 1, s(1), beta, C)`` of the cracked solution with crack front ``gamma``."""
+    beta, s_a, U_a, ev_a, C = cracked_front(p, gamma)
+    if not beta > 1.0:
+        return np.nan, np.nan, beta, C
+    s0, U0 = jump(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a))
+    s1, U1 = integrate(p, beta, s0, U0, steps)
+    return U1 - 1.0, s1, beta, C
+
+
+# ------------------------------------------------------------------------------------------
+# Root finding (Python: brentq on the compiled residuals)
+# ------------------------------------------------------------------------------------------
+
+XTOL = 1e-14
+BRACKET_POINTS = 96
+
+
+def _bracket(residual, lo, hi, points=BRACKET_POINTS):
+    """First sign change of ``residual`` on a grid of ``(lo, hi)`` geometric in ``xi``, or None.
+
+    Where the residual turns NaN (no admissible state) after a finite value, the edge of the
+    finite part is found by bisection and checked for a sign change too.
+    """
+    previous = None
+    for x in np.geomspace(lo, hi, points):
+        value = residual(x)
+        if previous is not None and math.isfinite(value) and value * previous[1] <= 0.0:
+            return previous[0], x
+        if previous is not None and not math.isfinite(value):
+            edge = _finite_edge(residual, previous, x)
+            if edge is not None:
+                return previous[0], edge
+        if math.isfinite(value):
+            previous = (x, value)
+    return None
+
+
+def _finite_edge(residual, finite, beyond, halvings=50):
+    """Bisect between a finite ``(x, value)`` and ``beyond`` (NaN) for a sign change."""
+    x0, v0 = finite
+    x1 = beyond
+    for _ in range(halvings):
+        mid = 0.5 * (x0 + x1)
+        value = residual(mid)
+        if not math.isfinite(value):
+            x1 = mid
+        elif value * v0 <= 0.0:
+            return mid
+        else:
+            x0 = mid
+    return None
+
+
+def _root(residual, lo, hi):
+    bracket = _bracket(residual, lo, hi)
+    if bracket is None:
+        return None
+    a, b = bracket
+    return brentq(residual, a, b, xtol=XTOL * b, rtol=1e-15, maxiter=200)
+
+
+def _upper_front(p):
+    """Largest admissible front (the elastic wave front ``1/w``; 1e4 when ``w = 0``)."""
+    return (1.0 / p[W]) * (1.0 - 1e-12) if p[W] > 0.0 else 1e4
+
+
+def solve(material, phi, steps=DEFAULT_STEPS):
+    """The self-similar solution at ``phi = rho V^2 / f_c`` (see the module docstring).
+
+    Raises
+    ------
+    CavexNumericalError
+        No structure satisfies the wall condition (e.g. sonic flow in the comminuted zone).
+    """
+    require(is_finite_number(phi) and phi >= 0.0, "phi", "rho V^2/f_c, a finite number >= 0", phi)
+    return _solve(material, float(phi), int(steps))
+
+
+@lru_cache(maxsize=65536)
+def _solve(material, phi, steps):
+    p = material.parameters(phi)
+    upper = _upper_front(p)
+    beta = _root(lambda b: elastic_plastic(p, b, steps)[0], 1.0 + 1e-6, upper)
+    if beta is not None:
+        _, S, C = elastic_plastic(p, beta, steps)
+        s_a, D_a = elastic_state(p, C, beta)[:2]
+        if s_a - D_a >= -p[TENSILE] * (1.0 + 1e-12):
+            return CavitySolution(S, phi, ELASTIC_PLASTIC, beta, math.nan, C)
+    if math.isfinite(p[TENSILE]):
+        gamma_hi = min(upper, (1.0 / p[WB]) * (1.0 - 1e-12) if p[WB] > 0.0 else 1e6)
+        gamma = _root(lambda g: cracked(p, g, steps)[0], 1.0 + 1e-6, gamma_hi)
+        if gamma is not None:
+            _, S, beta, C = cracked(p, gamma, steps)
+            return CavitySolution(S, phi, CRACKED, beta, gamma, C)
+        beta = _root(lambda b: cracking_plastic(p, b, steps)[0], 1.0 + 1e-6, upper)
+        if beta is not None:
+            _, S, C = cracking_plastic(p, beta, steps)
+            return CavitySolution(S, phi, JOINT_FRONT, beta, beta, C)
+    if p[W] > 0.0:
+        beta = _root(lambda b: superseismic(p, b, steps)[0], 1.0 / p[W], 1e4)
+        if beta is not None:
+            return CavitySolution(superseismic(p, beta, steps)[1], phi, SUPERSEISMIC, beta,
+                                  math.nan, math.nan)
+    raise CavexNumericalError(f"no self-similar concrete cavity solution at rho V^2/f_c = {phi:g} "
+                              f"({material})")
+
+
+def wall_stress(material, phi, steps=DEFAULT_STEPS):
+    """``S = sigma_r(a)/f_c`` for an array (or scalar) of ``phi = rho V^2/f_c``."""
+    phi = np.asarray(phi, dtype=float)
+    out = np.array([solve(material, float(x), steps).S for x in phi.reshape(-1)])
+    return float(out[0]) if phi.ndim == 0 else out.reshape(phi.shape)
+
+
+def resistance_table(material, phi_max, points=17, steps=DEFAULT_STEPS):
+    """``(phi, S)`` at ``phi = phi_max (i/(points - 1))^2``, ``i = 0 .. points - 1`` (uniform
+    in ``V``)."""
+    require(is_finite_number(phi_max) and phi_max > 0.0, "phi_max", "a finite number > 0",
+            phi_max)
+    phi = phi_max * np.linspace(0.0, 1.0, points) ** 2
+    return phi, wall_stress(material, phi, steps)
+
+
+def fit_AB(phi, S):
+    """``(A, B)`` of ``S ~ A + B phi``: ``A = S(0)`` (the quasi-static solution, ``phi[0]``
+    must be 0) and ``B`` by least squares of ``S - A`` on ``phi``."""
+    phi, S = np.asarray(phi, dtype=float), np.asarray(S, dtype=float)
+    require(phi[0] == 0.0, "phi", "a table starting at 0", phi[0])
+    A = float(S[0])
+    return A, float(np.dot(phi, S - A) / np.dot(phi, phi))
