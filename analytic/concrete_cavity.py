@@ -17,13 +17,17 @@ Zones, from the wall outward:
 
   with ``D = s_r - s_theta = min(tau_0 + lam p, tau_max)``, ``p = s_r - 2D/3``,
   ``tau_0 = f_c (1 - lam/3)`` (uniaxial compression yields at ``f_c``), and the hydrostat
-  ``eta = 1 - 1/R = eta_lock + p/K``: ``K`` finite is the linear pressure-volumetric strain law,
-  ``K = inf`` the locked hydrostat (density ``rho_0/(1 - eta_lock)`` behind the front),
-  ``K = inf, eta_lock = 0`` incompressible. Solved for ``U'`` and ``s'``:
+  (volumetric strain ``eta = 1 - 1/R``) linear up to the locking strain, then stiff:
+
+  .. math:: \eta = \min(p/K, \eta_l) + \max(0, p - K\eta_l)/K_l
+
+  (``K`` the compaction modulus, ``eta_l`` the locking strain, ``K_l`` the locked modulus;
+  ``K = 0`` is the locked hydrostat of Luk et al., compacted to ``eta_l`` at the front;
+  ``eta_l = 0, K_l = inf`` is incompressible). Solved for ``U'`` and ``s'``:
 
   .. math:: U' = -\frac{2 (R U + (\xi - U) R_s D)}{\xi R (1 - \phi R_s (\xi - U)^2)},
 
-  ``R_s = dR/ds = R^2 p_s / K``; the flow behind the front must stay subsonic
+  ``R_s = dR/ds = R^2 p_s d eta/dp``; the flow behind the front must stay subsonic
   (``phi R_s (xi - U)^2 < 1``).
 - radially cracked, ``beta <= xi <= gamma``: ``sigma_theta = 0``, ``sigma_r = -E eps_r``, small
   strain ``u = V t F(xi)``, ``U = F - xi F'``, density ``rho_0``. The linear momentum balance
@@ -54,8 +58,9 @@ Fronts:
 The wall condition ``U(1) = 1`` closes the problem: one unknown front speed (``beta`` without
 cracking, ``gamma`` with it) is found by bracketing and Brent's method; every evaluation
 integrates the comminuted zone inward from ``beta`` with classical Runge-Kutta (RK4) at a fixed
-number of steps in ``ln xi``, the step that crosses the cap ``tau_max`` split at the crossing
-so that the order stays 4 (``tests/test_concrete_cavity.py`` measures it).
+number of steps in ``ln xi``, a step that crosses a kink of the constitutive law (the cap
+``tau_max``, the locking pressure) split at the crossing so that the order stays 4
+(``tests/test_concrete_cavity.py`` measures it).
 
 Which structure (:data:`STRUCTURES`): the elastic-comminuted solution when its hoop tension at
 ``beta`` stays within ``f_t``; else the cracked one (crack front slower than the bar wave
@@ -74,7 +79,6 @@ from functools import lru_cache
 
 import numpy as np
 from numba import njit
-from scipy.optimize import brentq
 
 from cavex.errors import CavexNumericalError, is_finite_number, require
 
@@ -85,8 +89,8 @@ STRUCTURES = {ELASTIC_PLASTIC: "elastic-comminuted", CRACKED: "elastic-cracked-c
               SUPERSEISMIC: "comminuted shock into undisturbed concrete"}
 DEFAULT_STEPS = 256  # RK4 steps across the comminuted zone (see the convergence test)
 # columns of the parameter vector of the compiled functions
-(E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, TENSILE, W, WB, PHI) = range(11)
-NPAR = 11
+(E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, LOCKED, TENSILE, W, WB, PHI) = range(12)
+NPAR = 12
 
 
 @dataclass(frozen=True)
@@ -104,9 +108,12 @@ class ConcreteCavity:
     tau_max : float
         Tresca limit ``tau_max / f_c`` of ``D`` (>= 1; ``inf``: no limit).
     bulk : float
-        Bulk modulus ``K / f_c`` of the comminuted hydrostat (> 0; ``inf``: locked).
+        Compaction modulus ``K / f_c`` of the comminuted hydrostat (>= 0; 0: compacted to
+        ``eta_lock`` at the front).
     eta_lock : float
-        Volumetric strain (compaction) at the plastic front, in [0, 0.9].
+        Locking volumetric strain ``eta_l``, in [0, 0.9].
+    bulk_locked : float
+        Modulus ``K_l / f_c`` past the locking strain (> 0; ``inf``: rigid).
     tensile : float
         Tensile strength ``f_t / f_c`` (> 0; ``inf``: no cracking).
     """
@@ -117,6 +124,7 @@ class ConcreteCavity:
     tau_max: float = math.inf
     bulk: float = math.inf
     eta_lock: float = 0.0
+    bulk_locked: float = math.inf
     tensile: float = math.inf
 
     def __post_init__(self):
@@ -127,7 +135,9 @@ class ConcreteCavity:
         require(0.0 <= self.nu <= 0.5, "nu", "in [0, 0.5]", self.nu)
         require(0.0 <= self.lam < 3.0, "lam", "in [0, 3)", self.lam)
         require(self.tau_max >= 1.0, "tau_max", "tau_max/f_c >= 1 (inf: none)", self.tau_max)
-        require(self.bulk > 0.0, "bulk", "K/f_c > 0 (inf: locked)", self.bulk)
+        require(self.bulk >= 0.0, "bulk", "K/f_c >= 0", self.bulk)
+        require(self.bulk_locked > 0.0, "bulk_locked", "K_l/f_c > 0 (inf: rigid)",
+                self.bulk_locked)
         require(0.0 <= self.eta_lock <= 0.9, "eta_lock", "in [0, 0.9]", self.eta_lock)
         require(self.tensile > 0.0, "tensile", "f_t/f_c > 0 (inf: no cracking)", self.tensile)
 
@@ -149,7 +159,8 @@ class ConcreteCavity:
         p = np.empty(NPAR)
         p[E_], p[MU], p[LAM] = self.modulus, self.shear, self.lam
         p[TAU0], p[TAU_MAX], p[BULK] = 1.0 - self.lam / 3.0, self.tau_max, self.bulk
-        p[ETA], p[TENSILE], p[W], p[WB], p[PHI] = self.eta_lock, self.tensile, w, wb, phi
+        p[ETA], p[LOCKED], p[TENSILE] = self.eta_lock, self.bulk_locked, self.tensile
+        p[W], p[WB], p[PHI] = w, wb, phi
         return p
 
 
@@ -214,7 +225,7 @@ def yield_amplitude(p, x):
     lam = p[LAM]
     # D (1 + 2 lam/3) - lam s = tau_0
     c_mc = _quadratic_root(-lam * s2, d1 * (1.0 + 2.0 * lam / 3.0) - lam * s1, -p[TAU0])
-    c_cap = p[TAU_MAX] / d1
+    c_cap = p[TAU_MAX] / d1 if d1 > 0.0 else np.inf
     if c_cap < c_mc or not c_mc > 0.0:
         return c_cap
     return c_mc
@@ -239,11 +250,26 @@ def constitutive(p, s):
         D = cap
         pressure = s - 2.0 * cap / 3.0
         dp = 1.0
-    eta = p[ETA] + pressure / p[BULK]
+    eta, compliance = hydrostat(p, pressure)
     if eta >= 1.0:
         return D, np.nan, np.nan
     R = 1.0 / (1.0 - eta)
-    return D, R, R * R * dp / p[BULK]
+    return D, R, R * R * dp * compliance
+
+
+@njit(cache=True)
+def lock_pressure(p):
+    """Pressure ``K eta_l`` at which the hydrostat locks (0 without compaction)."""
+    return p[BULK] * p[ETA] if p[ETA] > 0.0 else 0.0
+
+
+@njit(cache=True)
+def hydrostat(p, pressure):
+    """``(eta, d eta/dp)``: linear to the locking strain, then the locked modulus."""
+    p_lock = lock_pressure(p)
+    if pressure < p_lock:
+        return pressure / p[BULK], 1.0 / p[BULK]
+    return p[ETA] + (pressure - p_lock) / p[LOCKED], 1.0 / p[LOCKED]
 
 
 @njit(cache=True)
@@ -273,68 +299,158 @@ def _rk4(p, t, s, U, h):
 
 
 @njit(cache=True)
-def cap_stress(p):
-    """Radial stress at which ``tau_0 + lam p`` reaches ``tau_max`` (inf if never)."""
-    lam = p[LAM]
-    if lam == 0.0 or not math.isfinite(p[TAU_MAX]):
-        return np.inf if p[TAU0] < p[TAU_MAX] else -np.inf
-    pressure = (p[TAU_MAX] - p[TAU0]) / lam
-    return pressure + 2.0 * p[TAU_MAX] / 3.0
+def kink_stresses(p):
+    """Radial stresses of the comminuted zone's kinks: where ``tau_0 + lam p`` reaches
+    ``tau_max`` and where the hydrostat locks (inf: none)."""
+    lam, cap = p[LAM], p[TAU_MAX]
+    s_cap = np.inf
+    if lam > 0.0 and math.isfinite(cap):
+        s_cap = (cap - p[TAU0]) / lam + 2.0 * cap / 3.0
+    p_lock = lock_pressure(p)
+    s_lock = np.inf
+    if p_lock > 0.0 and math.isfinite(p_lock):
+        s_lock = p_lock + 2.0 * min(p[TAU0] + lam * p_lock, cap) / 3.0
+    return s_cap, s_lock
+
+
+@njit(cache=True)
+def _split_step(p, t, s, U, h, s_kink, s_new):
+    """The RK4 step from ``t`` split where ``s`` crosses ``s_kink`` (regula falsi, Illinois,
+    on the length of the first part)."""
+    lo, f_lo, hi, f_hi = 0.0, s - s_kink, h, s_new - s_kink
+    for _ in range(60):
+        mid = hi - f_hi * (hi - lo) / (f_hi - f_lo)
+        f_mid = _rk4(p, t, s, U, mid)[0] - s_kink
+        if f_mid * f_hi < 0.0:
+            lo, f_lo = hi, f_hi
+        else:
+            f_lo *= 0.5
+        hi, f_hi = mid, f_mid
+        if abs(f_mid) <= 1e-15 * abs(s_kink) or abs(hi - lo) <= 1e-15 * abs(h):
+            break
+    s_mid, U_mid = _rk4(p, t, s, U, hi)
+    return hi, s_mid, U_mid
 
 
 @njit(cache=True)
 def integrate(p, beta, s, U, steps):
     """RK4 from ``xi = beta`` to the wall ``xi = 1`` in ``ln xi``; returns ``(s, U)`` there.
 
-    A step that crosses the cap stress is split at the crossing (secant on the step length), so
-    that the kink of ``D(s)`` falls on a step boundary.
+    A step that crosses a kink (:func:`kink_stresses`) is split at the crossing, so that the
+    kinks of ``D(s)`` and ``R(s)`` fall on step boundaries. Where the flow turns sonic
+    (``phi R_s (xi - U)^2 = 1``: the compaction cannot keep up continuously), the sonic point is
+    located by bisection on the step length and a compaction shock is put there (:func:`jump`,
+    strong root); at most a few such shocks.
     """
-    t = math.log(beta)
-    h = -t / steps
-    s_cap = cap_stress(p)
-    for _ in range(steps):
-        s_new, U_new = _rk4(p, t, s, U, h)
-        if (s - s_cap) * (s_new - s_cap) < 0.0:
-            lo, f_lo, hi, f_hi = 0.0, s - s_cap, h, s_new - s_cap
-            for _ in range(60):  # regula falsi (Illinois) on the length of the first part
-                mid = hi - f_hi * (hi - lo) / (f_hi - f_lo)
-                f_mid = _rk4(p, t, s, U, mid)[0] - s_cap
-                if f_mid * f_hi < 0.0:
-                    lo, f_lo = hi, f_hi
-                else:
-                    f_lo *= 0.5
-                hi, f_hi = mid, f_mid
-                if abs(f_mid) <= 1e-15 * abs(s_cap) or abs(hi - lo) <= 1e-15 * abs(h):
+    t0 = math.log(beta)
+    h = -t0 / steps
+    t = t0
+    kinks = kink_stresses(p)
+    shocks = 0
+    for k in range(steps):
+        t_end = t0 + (k + 1) * h
+        for _ in range(16):  # pieces of this step: kinks, sonic points
+            rest = t_end - t
+            if rest >= -1e-15 * abs(h):
+                break
+            s_new, U_new = _rk4(p, t, s, U, rest)
+            if not (math.isfinite(s_new) and math.isfinite(U_new)):
+                lo, hi = 0.0, rest
+                for _ in range(60):
+                    mid = 0.5 * (lo + hi)
+                    if math.isfinite(_rk4(p, t, s, U, mid)[0]):
+                        lo = mid
+                    else:
+                        hi = mid
+                if lo != 0.0:
+                    s, U = _rk4(p, t, s, U, lo)
+                    t += lo
+                shocks += 1
+                if shocks > 4:
+                    return np.nan, np.nan
+                s, U = jump(p, math.exp(t), s, U, constitutive(p, s)[1], True)
+                if not math.isfinite(s):
+                    return np.nan, np.nan
+                continue
+            crossed = False
+            for s_kink in (min(kinks), max(kinks)):  # s grows inward: in the order met
+                if (s - s_kink) * (s_new - s_kink) < 0.0:
+                    part, s, U = _split_step(p, t, s, U, rest, s_kink, s_new)
+                    t += part
+                    crossed = True
                     break
-            s_mid, U_mid = _rk4(p, t, s, U, hi)
-            s_new, U_new = _rk4(p, t + hi, s_mid, U_mid, h - hi)
-        s, U = s_new, U_new
-        t += h
-        if not (math.isfinite(s) and math.isfinite(U)):
-            return np.nan, np.nan
+            if not crossed:
+                s, U = s_new, U_new
+                t = t_end
     return s, U
 
 
 @njit(cache=True)
-def jump(p, beta, s_ahead, U_ahead, R_ahead):
-    """State ``(s, U)`` just behind a plastic front at ``xi = beta`` (Rankine-Hugoniot)."""
+def _jump_balance(p, beta, j, s_ahead, U_ahead, s):
+    """Momentum balance across the front, ``s - s^+ - phi j (U^-(s) - U^+)``, with
+    ``U^-(s) = beta - j/R(s)`` from the mass balance (NaN past full compaction)."""
+    R = constitutive(p, s)[1]
+    return s - s_ahead - p[PHI] * j * (beta - j / R - U_ahead)
+
+
+@njit(cache=True)
+def jump(p, beta, s_ahead, U_ahead, R_ahead, strong=False):
+    """State ``(s, U)`` just behind a front at ``xi = beta`` (Rankine-Hugoniot).
+
+    The mass flux ``j = R^+ (beta - U^+)`` fixes the Rayleigh line; the state behind is its first
+    intersection with the comminuted hydrostat going up from ``s^+`` (where the Rayleigh line
+    crosses from above, the flow behind is subsonic): the continuous state when the front is
+    slower than the compaction wave, else the compaction shock. ``strong``: the ahead state is
+    comminuted material at its sonic point (then ``s^+`` itself is a root, tangent); the next
+    intersection up is returned.
+    """
     j = R_ahead * (beta - U_ahead)
-    phi = p[PHI]
     if not j > 0.0:
         return np.nan, np.nan
-    s = s_ahead
-    for _ in range(100):  # Newton on h(s) = s - s_ahead - phi j (beta - j/R(s) - U_ahead)
-        D, R, Rs = constitutive(p, s)
-        if not R > 0.0:
+    scale = 1.0 + abs(s_ahead)
+    lo = s_ahead
+    if strong:
+        lo += 1e-9 * scale
+    f_lo = _jump_balance(p, beta, j, s_ahead, U_ahead, lo)
+    if f_lo > 0.0:
+        D, R, Rs = constitutive(p, lo)
+        if strong and p[PHI] * j * j * Rs < R * R:  # subsonic after all: no shock
+            return s_ahead, U_ahead
+        step = 1e-9 * scale
+        if p[PHI] * j * j * Rs < R * R:  # subsonic: the root lies just below (rarefying)
+            while f_lo > 0.0:
+                lo -= step
+                step *= 2.0
+                f_lo = _jump_balance(p, beta, j, s_ahead, U_ahead, lo)
+                if not math.isfinite(f_lo) or step > 1e3 * scale:
+                    return np.nan, np.nan
+        else:  # supersonic: the balance dips below zero further up (compaction shock)
+            while f_lo > 0.0:
+                lo += step
+                step *= 2.0
+                f_lo = _jump_balance(p, beta, j, s_ahead, U_ahead, lo)
+                if not math.isfinite(f_lo) or step > 1e6 * scale:
+                    return np.nan, np.nan
+    hi, f_hi = lo, f_lo
+    step = 1e-6 * scale
+    while f_hi <= 0.0:
+        lo, f_lo = hi, f_hi
+        hi = lo + step
+        step *= 2.0
+        f_hi = _jump_balance(p, beta, j, s_ahead, U_ahead, hi)
+        if not math.isfinite(f_hi):
             return np.nan, np.nan
-        h = s - s_ahead - phi * j * (beta - j / R - U_ahead)
-        dh = 1.0 - phi * j * j * Rs / (R * R)
-        step = h / dh
-        s -= step
-        if abs(step) <= 1e-15 * (1.0 + abs(s)):
+    for _ in range(200):  # Illinois regula falsi
+        mid = hi - f_hi * (hi - lo) / (f_hi - f_lo)
+        f_mid = _jump_balance(p, beta, j, s_ahead, U_ahead, mid)
+        if f_mid * f_hi < 0.0:
+            lo, f_lo = hi, f_hi
+        else:
+            f_lo *= 0.5
+        hi, f_hi = mid, f_mid
+        if f_mid == 0.0 or abs(hi - lo) <= 4e-16 * abs(hi):
             break
-    D, R, Rs = constitutive(p, s)
-    return s, beta - j / R
+    return hi, beta - j / constitutive(p, hi)[1]
 
 
 @njit(cache=True)
@@ -448,11 +564,29 @@ def _finite_edge(residual, finite, beyond, halvings=50):
 
 
 def _root(residual, lo, hi):
+    """A root of ``residual`` in ``(lo, hi)`` (:func:`_bracket`, then Illinois regula falsi that
+    bisects where the residual is NaN), or None."""
     bracket = _bracket(residual, lo, hi)
     if bracket is None:
         return None
     a, b = bracket
-    return brentq(residual, a, b, xtol=XTOL * b, rtol=1e-15, maxiter=200)
+    fa, fb = residual(a), residual(b)
+    for _ in range(200):
+        if fb == 0.0 or abs(b - a) <= XTOL * abs(b):
+            return b
+        c = b - fb * (b - a) / (fb - fa) if fb != fa else 0.5 * (a + b)
+        fc = residual(c)
+        if not math.isfinite(fc):
+            c = 0.5 * (a + b)
+            fc = residual(c)
+            if not math.isfinite(fc):
+                return None
+        if fc * fb < 0.0:
+            a, fa = b, fb
+        else:
+            fa *= 0.5
+        b, fb = c, fc
+    return b
 
 
 def _upper_front(p):
