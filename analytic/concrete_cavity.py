@@ -314,22 +314,21 @@ def kink_stresses(p):
 
 
 @njit(cache=True)
-def _split_step(p, t, s, U, h, s_kink, s_new):
-    """The RK4 step from ``t`` split where ``s`` crosses ``s_kink`` (regula falsi, Illinois,
-    on the length of the first part)."""
-    lo, f_lo, hi, f_hi = 0.0, s - s_kink, h, s_new - s_kink
-    for _ in range(60):
-        mid = hi - f_hi * (hi - lo) / (f_hi - f_lo)
-        f_mid = _rk4(p, t, s, U, mid)[0] - s_kink
-        if f_mid * f_hi < 0.0:
-            lo, f_lo = hi, f_hi
+def _split_step(p, t, s, U, h, s_kink):
+    """The part of the RK4 step from ``t`` (length ``h``) that ends where ``s`` reaches
+    ``s_kink``, by bisection on its length (a NaN end counts as past the kink); returns
+    ``(length, s, U)`` there."""
+    below = s < s_kink
+    lo, hi = 0.0, h
+    for _ in range(64):
+        mid = 0.5 * (lo + hi)
+        s_mid = _rk4(p, t, s, U, mid)[0]
+        if math.isfinite(s_mid) and (s_mid < s_kink) == below:
+            lo = mid
         else:
-            f_lo *= 0.5
-        hi, f_hi = mid, f_mid
-        if abs(f_mid) <= 1e-15 * abs(s_kink) or abs(hi - lo) <= 1e-15 * abs(h):
-            break
-    s_mid, U_mid = _rk4(p, t, s, U, hi)
-    return hi, s_mid, U_mid
+            hi = mid
+    s_end, U_end = _rk4(p, t, s, U, lo)
+    return lo, s_end, U_end
 
 
 @njit(cache=True)
@@ -374,8 +373,9 @@ def integrate(p, beta, s, U, steps):
                 continue
             crossed = False
             for s_kink in (min(kinks), max(kinks)):  # s grows inward: in the order met
-                if (s - s_kink) * (s_new - s_kink) < 0.0:
-                    part, s, U = _split_step(p, t, s, U, rest, s_kink, s_new)
+                if ((s - s_kink) * (s_new - s_kink) < 0.0
+                        and abs(s - s_kink) > 1e-12 * abs(s_kink)):
+                    part, s, U = _split_step(p, t, s, U, rest, s_kink)
                     t += part
                     crossed = True
                     break
