@@ -184,7 +184,7 @@ class CavitySolution:
 # Compiled pieces
 # ------------------------------------------------------------------------------------------
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def elastic_state(p, C, x):
     """``(s_r, D, U, F, F', eps_v)`` of the elastic zone at ``xi = x``, amplitude ``C``."""
     w, phi, mu = p[W], p[PHI], p[MU]
@@ -196,17 +196,22 @@ def elastic_state(p, C, x):
     return s, D, U, F, dF, 6.0 * C * w ** 2 * (w - 1.0 / x)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _quadratic_root(c2, c1, c0):
-    """The root of ``c2 C^2 + c1 C + c0 = 0`` that tends to ``-c0/c1`` as ``c2 -> 0``."""
+    """The smallest positive root of ``c2 C^2 + c1 C + c0 = 0`` (NaN if none); as ``c2 -> 0``
+    the root ``-c0/c1`` (the quadratic terms are the small convective ones)."""
     disc = c1 * c1 - 4.0 * c2 * c0
     if disc < 0.0:
         return np.nan
-    q = c1 + math.copysign(math.sqrt(disc), c1)
-    return -2.0 * c0 / q
+    q = -0.5 * (c1 + math.copysign(math.sqrt(disc), c1))
+    best = np.nan
+    for root in (c0 / q if q != 0.0 else np.nan, q / c2 if c2 != 0.0 else np.nan):
+        if root > 0.0 and not root >= best:
+            best = root
+    return best
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _elastic_parts(p, x):
     """``s_r``, ``D`` and ``s_theta`` of the elastic zone as ``(linear, quadratic)`` parts in C."""
     w, phi, mu = p[W], p[PHI], p[MU]
@@ -217,7 +222,7 @@ def _elastic_parts(p, x):
     return s1, s2, d1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def yield_amplitude(p, x):
     """Elastic amplitude ``C`` at which the elastic state at ``xi = x`` first yields:
     ``D = tau_0 + lam (s - 2D/3)`` or ``D = tau_max``, whichever comes first."""
@@ -231,51 +236,60 @@ def yield_amplitude(p, x):
     return c_mc
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def crack_amplitude(p, x):
     """Elastic amplitude ``C`` with the hoop stress ``s - D = -f_t/f_c`` at ``xi = x``."""
     s1, s2, d1 = _elastic_parts(p, x)
     return _quadratic_root(s2, s1 - d1, p[TENSILE])
 
 
-@njit(cache=True)
-def constitutive(p, s):
+@njit(cache=True, error_model="numpy")
+def constitutive(p, s, branch=np.nan):
     """``(D, R, dR/ds)`` of the comminuted zone at radial stress ``s``; ``R = nan`` if the
-    hydrostat is past full compaction."""
+    hydrostat is past full compaction. The pieces of the law (below or above the cap and the
+    locking pressure) are chosen at ``branch`` (default ``s``), so that a step ending or
+    starting at a kink stays on one side of it."""
     lam, tau0, cap = p[LAM], p[TAU0], p[TAU_MAX]
-    pressure = (s - 2.0 * tau0 / 3.0) / (1.0 + 2.0 * lam / 3.0)
-    D = tau0 + lam * pressure
-    dp = 1.0 / (1.0 + 2.0 * lam / 3.0)
-    if D > cap:
+    b = s if math.isnan(branch) else branch
+    scale = 1.0 / (1.0 + 2.0 * lam / 3.0)
+    capped = tau0 + lam * (b - 2.0 * tau0 / 3.0) * scale > cap
+    if capped:
         D = cap
         pressure = s - 2.0 * cap / 3.0
         dp = 1.0
-    eta, compliance = hydrostat(p, pressure)
+    else:
+        pressure = (s - 2.0 * tau0 / 3.0) * scale
+        D = tau0 + lam * pressure
+        dp = scale
+    b_pressure = b - 2.0 * cap / 3.0 if capped else (b - 2.0 * tau0 / 3.0) * scale
+    eta, compliance = hydrostat(p, pressure, b_pressure)
     if eta >= 1.0:
         return D, np.nan, np.nan
     R = 1.0 / (1.0 - eta)
     return D, R, R * R * dp * compliance
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def lock_pressure(p):
     """Pressure ``K eta_l`` at which the hydrostat locks (0 without compaction)."""
     return p[BULK] * p[ETA] if p[ETA] > 0.0 else 0.0
 
 
-@njit(cache=True)
-def hydrostat(p, pressure):
-    """``(eta, d eta/dp)``: linear to the locking strain, then the locked modulus."""
+@njit(cache=True, error_model="numpy")
+def hydrostat(p, pressure, branch):
+    """``(eta, d eta/dp)``: linear to the locking strain, then the locked modulus (the piece
+    chosen at the pressure ``branch``)."""
     p_lock = lock_pressure(p)
-    if pressure < p_lock:
+    if branch < p_lock:
         return pressure / p[BULK], 1.0 / p[BULK]
     return p[ETA] + (pressure - p_lock) / p[LOCKED], 1.0 / p[LOCKED]
 
 
-@njit(cache=True)
-def _rhs(p, x, s, U):
-    """``(ds/d ln xi, dU/d ln xi)`` of the comminuted zone; NaN where the flow is sonic."""
-    D, R, Rs = constitutive(p, s)
+@njit(cache=True, error_model="numpy")
+def _rhs(p, x, s, U, floor, ceiling):
+    """``(ds/d ln xi, dU/d ln xi)`` of the comminuted zone; NaN where the flow is sonic. The
+    law's pieces are chosen at ``s`` clamped to ``[floor, ceiling]``."""
+    D, R, Rs = constitutive(p, s, min(max(s, floor), ceiling))
     phi = p[PHI]
     gap = x - U
     den = R * (1.0 - phi * Rs * gap * gap)
@@ -286,19 +300,19 @@ def _rhs(p, x, s, U):
     return x * ds, x * dU
 
 
-@njit(cache=True)
-def _rk4(p, t, s, U, h):
+@njit(cache=True, error_model="numpy")
+def _rk4(p, t, s, U, h, floor=-np.inf, ceiling=np.inf):
     x = math.exp(t)
-    k1s, k1u = _rhs(p, x, s, U)
+    k1s, k1u = _rhs(p, x, s, U, floor, ceiling)
     x2 = math.exp(t + 0.5 * h)
-    k2s, k2u = _rhs(p, x2, s + 0.5 * h * k1s, U + 0.5 * h * k1u)
-    k3s, k3u = _rhs(p, x2, s + 0.5 * h * k2s, U + 0.5 * h * k2u)
-    k4s, k4u = _rhs(p, math.exp(t + h), s + h * k3s, U + h * k3u)
+    k2s, k2u = _rhs(p, x2, s + 0.5 * h * k1s, U + 0.5 * h * k1u, floor, ceiling)
+    k3s, k3u = _rhs(p, x2, s + 0.5 * h * k2s, U + 0.5 * h * k2u, floor, ceiling)
+    k4s, k4u = _rhs(p, math.exp(t + h), s + h * k3s, U + h * k3u, floor, ceiling)
     return (s + h * (k1s + 2.0 * k2s + 2.0 * k3s + k4s) / 6.0,
             U + h * (k1u + 2.0 * k2u + 2.0 * k3u + k4u) / 6.0)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def kink_stresses(p):
     """Radial stresses of the comminuted zone's kinks: where ``tau_0 + lam p`` reaches
     ``tau_max`` and where the hydrostat locks (inf: none)."""
@@ -313,33 +327,34 @@ def kink_stresses(p):
     return s_cap, s_lock
 
 
-@njit(cache=True)
-def _split_step(p, t, s, U, h, s_kink):
+@njit(cache=True, error_model="numpy")
+def _split_step(p, t, s, U, h, s_kink, floor):
     """The part of the RK4 step from ``t`` (length ``h``) that ends where ``s`` reaches
-    ``s_kink``, by bisection on its length (a NaN end counts as past the kink); returns
-    ``(length, s, U)`` there."""
-    below = s < s_kink
+    ``s_kink`` (``s`` below it), by bisection on its length with the law's pieces kept below
+    the kink; returns ``(length, s, U)`` there."""
+    ceiling = s_kink - 1e-12 * (1.0 + abs(s_kink))
     lo, hi = 0.0, h
     for _ in range(64):
         mid = 0.5 * (lo + hi)
-        s_mid = _rk4(p, t, s, U, mid)[0]
-        if math.isfinite(s_mid) and (s_mid < s_kink) == below:
+        s_mid = _rk4(p, t, s, U, mid, floor, ceiling)[0]
+        if math.isfinite(s_mid) and s_mid < s_kink:
             lo = mid
         else:
             hi = mid
-    s_end, U_end = _rk4(p, t, s, U, lo)
-    return lo, s_end, U_end
+    s_end, U_end = _rk4(p, t, s, U, hi, floor, ceiling)
+    return hi, s_end, U_end
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def integrate(p, beta, s, U, steps):
     """RK4 from ``xi = beta`` to the wall ``xi = 1`` in ``ln xi``; returns ``(s, U)`` there.
 
-    A step that crosses a kink (:func:`kink_stresses`) is split at the crossing, so that the
-    kinks of ``D(s)`` and ``R(s)`` fall on step boundaries. Where the flow turns sonic
-    (``phi R_s (xi - U)^2 = 1``: the compaction cannot keep up continuously), the sonic point is
-    located by bisection on the step length and a compaction shock is put there (:func:`jump`,
-    strong root); at most a few such shocks.
+    ``s`` grows inward. A step that crosses a kink (:func:`kink_stresses`) is split where ``s``
+    reaches it, the part before computed with the law's pieces below the kink and the rest with
+    those above, so that RK4 never differentiates across a kink (order 4 kept). Where the flow
+    turns sonic (``phi R_s (xi - U)^2 = 1``: the compaction cannot keep up continuously), the
+    sonic point is located by bisection on the step length and a compaction shock is put there
+    (:func:`jump`, strong root); at most a few such shocks.
     """
     t0 = math.log(beta)
     h = -t0 / steps
@@ -348,35 +363,36 @@ def integrate(p, beta, s, U, steps):
     shocks = 0
     for k in range(steps):
         t_end = t0 + (k + 1) * h
+        floor = -np.inf
         for _ in range(16):  # pieces of this step: kinks, sonic points
             rest = t_end - t
             if rest >= -1e-15 * abs(h):
                 break
-            s_new, U_new = _rk4(p, t, s, U, rest)
+            s_new, U_new = _rk4(p, t, s, U, rest, floor)
             if not (math.isfinite(s_new) and math.isfinite(U_new)):
                 lo, hi = 0.0, rest
                 for _ in range(60):
                     mid = 0.5 * (lo + hi)
-                    if math.isfinite(_rk4(p, t, s, U, mid)[0]):
+                    if math.isfinite(_rk4(p, t, s, U, mid, floor)[0]):
                         lo = mid
                     else:
                         hi = mid
                 if lo != 0.0:
-                    s, U = _rk4(p, t, s, U, lo)
+                    s, U = _rk4(p, t, s, U, lo, floor)
                     t += lo
                 shocks += 1
                 if shocks > 4:
                     return np.nan, np.nan
-                s, U = jump(p, math.exp(t), s, U, constitutive(p, s)[1], True)
+                s, U = jump(p, math.exp(t), s, U, constitutive(p, s, max(s, floor))[1], True)
                 if not math.isfinite(s):
                     return np.nan, np.nan
                 continue
             crossed = False
-            for s_kink in (min(kinks), max(kinks)):  # s grows inward: in the order met
-                if ((s - s_kink) * (s_new - s_kink) < 0.0
-                        and abs(s - s_kink) > 1e-12 * abs(s_kink)):
-                    part, s, U = _split_step(p, t, s, U, rest, s_kink)
+            for s_kink in (min(kinks), max(kinks)):  # in the order met
+                if s < s_kink < s_new:
+                    part, s, U = _split_step(p, t, s, U, rest, s_kink, floor)
                     t += part
+                    floor = s_kink + 1e-12 * (1.0 + abs(s_kink))
                     crossed = True
                     break
             if not crossed:
@@ -385,7 +401,7 @@ def integrate(p, beta, s, U, steps):
     return s, U
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _jump_balance(p, beta, j, s_ahead, U_ahead, s):
     """Momentum balance across the front, ``s - s^+ - phi j (U^-(s) - U^+)``, with
     ``U^-(s) = beta - j/R(s)`` from the mass balance (NaN past full compaction)."""
@@ -393,7 +409,7 @@ def _jump_balance(p, beta, j, s_ahead, U_ahead, s):
     return s - s_ahead - p[PHI] * j * (beta - j / R - U_ahead)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def jump(p, beta, s_ahead, U_ahead, R_ahead, strong=False):
     """State ``(s, U)`` just behind a front at ``xi = beta`` (Rankine-Hugoniot).
 
@@ -453,7 +469,7 @@ def jump(p, beta, s_ahead, U_ahead, R_ahead, strong=False):
     return hi, beta - j / constitutive(p, hi)[1]
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def elastic_plastic(p, beta, steps):
     """Wall ``(U(1) - 1, s(1), C)`` with the elastic zone directly ahead of ``beta``."""
     C = yield_amplitude(p, beta)
@@ -463,7 +479,7 @@ def elastic_plastic(p, beta, steps):
     return U1 - 1.0, s1, C
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cracking_plastic(p, beta, steps):
     """Wall ``(U(1) - 1, s(1), C)`` with the crack and comminution fronts together at ``beta``:
     the elastic state ahead has the hoop stress ``-f_t/f_c`` (the limit of a cracked zone of
@@ -475,7 +491,7 @@ def cracking_plastic(p, beta, steps):
     return U1 - 1.0, s1, C
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def superseismic(p, beta, steps):
     """Wall ``(U(1) - 1, s(1))`` of a plastic front into undisturbed concrete."""
     s0, U0 = jump(p, beta, 0.0, 0.0, 1.0)
@@ -483,7 +499,7 @@ def superseismic(p, beta, steps):
     return U1 - 1.0, s1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cracked_front(p, gamma):
     """``(beta, s, U, eps_v, C)`` at the plastic front of the cracked solution with the crack
     front at ``gamma`` (``beta = nan`` when it does not lie in ``(1, gamma)``)."""
@@ -508,7 +524,7 @@ def cracked_front(p, gamma):
     return beta, s_yield, K0 - 2.0 * K1 / beta, dF + 2.0 * F / beta, C
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def cracked(p, gamma, steps):
     """Wall ``(U(1) - 1, s(1), beta, C)`` of the cracked solution with crack front ``gamma``."""
     beta, s_a, U_a, ev_a, C = cracked_front(p, gamma)
