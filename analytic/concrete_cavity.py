@@ -485,6 +485,8 @@ def cracking_plastic(p, beta, steps):
     the elastic state ahead has the hoop stress ``-f_t/f_c`` (the limit of a cracked zone of
     vanishing width)."""
     C = crack_amplitude(p, beta)
+    if not C <= yield_amplitude(p, beta):  # the elastic state would yield before cracking
+        return np.nan, np.nan, C
     s_a, D_a, U_a, F_a, dF_a, ev_a = elastic_state(p, C, beta)
     s0, U0 = jump(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a))
     s1, U1 = integrate(p, beta, s0, U0, steps)
@@ -507,7 +509,7 @@ def cracked_front(p, gamma):
     C = crack_amplitude(p, gamma)
     s_e, D_e, U_e, F_e, dF_e, ev_e = elastic_state(p, C, gamma)
     stiff = e - phi * gamma * gamma
-    if not (C > 0.0 and stiff > 0.0):
+    if not (0.0 < C <= yield_amplitude(p, gamma) and stiff > 0.0):
         return np.nan, 0.0, 0.0, 0.0, C
     dF_c = -(s_e + phi * gamma * gamma * dF_e) / stiff
     K1 = dF_c / (1.0 / gamma ** 2 - wb ** 2)

@@ -53,7 +53,7 @@ DEFAULT_OUT = ROOT / "results" / "concrete"
 DIGITS = 6
 FITTED = ("cap", "lock_pressure")
 # the grid of the fitted constants: S_max = tau_max/f_c and the locking pressure p_l (Pa)
-GRID = tuple(itertools.product((4.0, 5.5, 7.0, 10.0, 14.0), (0.4e9, 0.8e9, 1.6e9)))
+GRID = tuple(itertools.product((4.0, 5.5, 7.0, 10.0, 14.0), (0.3e9, 0.5e9, 0.8e9, 1.2e9)))
 PUBLISHED = (Constants().cap, Constants().lock_pressure)
 MODEL = "concrete (published)"
 FIT = "concrete (fitted)"
@@ -77,10 +77,16 @@ def source(shot):
 
 
 def grid_depths(shots, point):
-    """Depths (m) of the model for ``shots`` with ``(S_max, p_l) = point``."""
+    """Depths (m) of the model for ``shots`` with ``(S_max, p_l) = point`` (NaN where the cavity
+    expansion has no self-similar solution: the point is then left out of the fits)."""
     constants = Constants().with_values(FITTED, point)
-    return [round_significant(table_depth(s, TableResistance(s, constants)), DIGITS)
-            for s in shots]
+    out = []
+    for s in shots:
+        try:
+            out.append(round_significant(table_depth(s, TableResistance(s, constants)), DIGITS))
+        except CavexNumericalError:
+            out.append(math.nan)
+    return out
 
 
 def all_grid_depths(shots, workers=1):
@@ -93,8 +99,9 @@ def all_grid_depths(shots, workers=1):
 
 
 def mean_abs_log(depths, shots, indices):
-    """Mean ``|ln(depth/measured)|`` over ``indices``."""
-    return float(np.mean([abs(math.log(depths[i] / shots[i].depth)) for i in indices]))
+    """Mean ``|ln(depth/measured)|`` over ``indices`` (inf if a depth is missing)."""
+    values = [abs(math.log(depths[i] / shots[i].depth)) for i in indices]
+    return float(np.mean(values)) if all(map(math.isfinite, values)) else math.inf
 
 
 def best_point(grid, shots, indices):
