@@ -53,6 +53,9 @@ Fronts:
   ``s_r = min(1, tau_max/f_c)``; elastic: ``D = min(tau_0 + lam p, tau_max)``), and mass and
   momentum jump by the exact Rankine-Hugoniot conditions ``R^-(beta - U^-) = R^+(beta - U^+)
   = j``, ``s^- = s^+ + phi j (U^- - U^+)`` (a shock where the hydrostat compacts);
+- the state behind a front is the first intersection of the Rayleigh line with the hydrostat
+  going up from the state ahead (subsonic behind it); where the flow inside the comminuted zone
+  turns sonic (``phi R_s (xi - U)^2 = 1``), a compaction shock is put at the sonic point;
 - a plastic front faster than the elastic wave (``beta >= 1/w``) runs into undisturbed concrete.
 
 The wall condition ``U(1) = 1`` closes the problem: one unknown front speed (``beta`` without

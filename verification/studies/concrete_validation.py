@@ -104,9 +104,16 @@ def mean_abs_log(depths, shots, indices):
     return float(np.mean(values)) if all(map(math.isfinite, values)) else math.inf
 
 
+def admissible(grid):
+    """The grid points at which every shot has a depth (the cavity expansion has a solution for
+    every shot's inputs; no measured depth enters)."""
+    return [point for point in GRID if all(map(math.isfinite, grid[point]))]
+
+
 def best_point(grid, shots, indices):
-    """The grid point with the smallest mean ``|ln ratio|`` over ``indices`` (first on ties)."""
-    return min(GRID, key=lambda point: mean_abs_log(grid[point], shots, indices))
+    """The admissible grid point with the smallest mean ``|ln ratio|`` over ``indices`` (first
+    on ties)."""
+    return min(admissible(grid), key=lambda point: mean_abs_log(grid[point], shots, indices))
 
 
 def loro(grid, shots):
@@ -205,9 +212,13 @@ def report_md(result, shots_file):
         lines.append(f"| {m}{' (some shots failed)' if missing else ''} | "
                      + " | ".join(cells) + " |")
     c, p = result["fitted"]
+    left_out = [f"S_max = {c:g}, p_l = {p / 1e9:g} GPa" for c, p in GRID
+                if (c, p) not in admissible(result["grid"])]
     lines += ["", f"Published constants: S_max = {PUBLISHED[0]:g}, p_l = {PUBLISHED[1] / 1e9:g} "
               "GPa. Fitted on all shots (grid "
-              f"S_max x p_l = {len(GRID)} points): S_max = {c:g}, p_l = {p / 1e9:g} GPa.", "",
+              f"S_max x p_l = {len(GRID)} points): S_max = {c:g}, p_l = {p / 1e9:g} GPa. "
+              "Grid points left out (no self-similar solution for some shot's inputs): "
+              f"{'; '.join(left_out) or 'none'}.", "",
               "Leave-one-reference-out choices:", "", "| left out | S_max | p_l (GPa) |",
               "|---|---:|---:|"]
     for ref, (c, p) in result["chosen"].items():

@@ -16,8 +16,10 @@ From a shot's columns (``f_c``, ``rho``, projectile mass, diameter, CRH, ``V0``)
      (``eta_l = mu_l/(1 + mu_l)``) at the locking pressure ``p_l = 0.8`` GPa, so ``K = p_l/eta_l``;
      then the solid's ``K_1 = 85`` GPa.
 2. **Resistance** (:class:`TableResistance`): the wall stress ``sigma_r(V) = f_c S(rho V^2/f_c)``
-   of :mod:`cavex.analytic.concrete_cavity`, tabulated once per shot at 17 velocities uniform
-   in ``[0, V0]`` and interpolated (PCHIP in ``V``), integrated over the tangent ogive by cavex's
+   of :mod:`cavex.analytic.concrete_cavity`, tabulated once per concrete (``f_c``, ``rho``) at
+   33 velocities uniform in ``V`` up to ``phi = 16 2^n`` (:func:`material_table`, shared by all
+   the shots into that concrete) and interpolated (PCHIP in ``V``), integrated over the tangent
+   ogive by cavex's
    nose quadrature (:func:`cavex.analytic.penetration.nose.nose_rule`); the fitted ``A, B``
    (:func:`cavex.analytic.concrete_cavity.fit_AB`) are reported, the depth uses the table.
 3. **Depth**: a crater of ``k d`` with Li and Chen's (2003) ``k = 0.707 + h/d`` (``h`` the nose
@@ -35,6 +37,7 @@ covers); flagged shots stay in every table.
 
 import math
 from dataclasses import dataclass, fields, replace
+from functools import lru_cache
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
@@ -49,7 +52,8 @@ from cavex.verification.validation.concrete import DEFAULT_NU, aci_modulus, mohr
 from cavex.verification.validation.shots import shot_projectile
 
 LI_CHEN_COEFFICIENT = 72.0  # S = 72 f_c^-0.5, f_c in MPa (Li and Chen 2003)
-TABLE_POINTS = 17
+TABLE_POINTS = 33
+PHI_TOP = 16.0  # smallest table top (rho V^2/f_c)
 
 
 @dataclass(frozen=True)
@@ -98,22 +102,39 @@ def crater_calibres(crh):
     return 0.707 + 0.5 * math.sqrt(4.0 * crh - 1.0)
 
 
+def table_top(phi):
+    """Top of the table that covers ``phi``: ``PHI_TOP 2^n``, the smallest such >= ``phi``
+    (so that shots into one concrete share a few tables)."""
+    return PHI_TOP * 2.0 ** max(0, math.ceil(math.log2(max(phi, 1e-300) / PHI_TOP)))
+
+
+@lru_cache(maxsize=4096)
+def material_table(material, top):
+    """``(phi, S)`` of ``material`` at ``phi = top (i/(TABLE_POINTS - 1))^2`` (uniform in
+    ``V``), computed once per material and top and shared by every shot that uses it."""
+    phi = top * np.linspace(0.0, 1.0, TABLE_POINTS) ** 2
+    S = wall_stress(material, phi)
+    phi.setflags(write=False)
+    S.setflags(write=False)
+    return phi, S
+
+
 class TableResistance:
     """Nose force of a one-layer concrete target from the tabulated cavity wall stress.
 
     Has the integrator's interface (``force``, ``label``, ``crater_force``); the force does not
-    depend on the depth (thick target).
+    depend on the depth (thick target). ``A, B`` are :func:`fit_AB` over the table up to the
+    shot's ``phi_0 = rho V0^2/f_c`` (at least its first three points).
     """
 
-    def __init__(self, shot, constants=None, points=TABLE_POINTS):
+    def __init__(self, shot, constants=None):
         self.shot = shot
         self.material = concrete_cavity(shot.fc, shot.rho, constants)
         self.phi_max = shot.rho * shot.V0 ** 2 / shot.fc
-        phi = self.phi_max * np.linspace(0.0, 1.0, points) ** 2
-        self.S = wall_stress(self.material, phi)
-        self.A, self.B = fit_AB(phi, self.S)
-        self._stress = PchipInterpolator(shot.V0 * np.linspace(0.0, 1.0, points),
-                                         shot.fc * self.S)
+        phi, self.S = material_table(self.material, table_top(self.phi_max))
+        used = max(3, int(np.searchsorted(phi, self.phi_max, side="right")))
+        self.A, self.B = fit_AB(phi[:used], self.S[:used])
+        self._stress = PchipInterpolator(np.sqrt(phi * shot.fc / shot.rho), shot.fc * self.S)
         self._cosines, self._weights = nose_rule(shot_projectile(shot))
 
     def wall_stress(self, velocity):
