@@ -473,13 +473,28 @@ def jump(p, beta, s_ahead, U_ahead, R_ahead, strong=False):
 
 
 @njit(cache=True, error_model="numpy")
-def elastic_plastic(p, beta, steps):
-    """Wall ``(U(1) - 1, s(1), C)`` with the elastic zone directly ahead of ``beta``."""
-    C = yield_amplitude(p, beta)
-    s_a, D_a, U_a, F_a, dF_a, ev_a = elastic_state(p, C, beta)
-    s0, U0 = jump(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a))
+def wall_residual(p, beta, s_ahead, U_ahead, R_ahead, steps):
+    """``(U(1) - 1, s(1))``: the front at ``beta`` with the state ahead, then the comminuted
+    zone to the wall (:func:`jump`, :func:`integrate`)."""
+    s0, U0 = jump(p, beta, s_ahead, U_ahead, R_ahead)
     s1, U1 = integrate(p, beta, s0, U0, steps)
-    return U1 - 1.0, s1, C
+    return U1 - 1.0, s1
+
+
+@njit(cache=True, error_model="numpy")
+def _elastic_ahead(p, beta, C, steps):
+    """Wall ``(U(1) - 1, s(1), C)`` with the elastic state of amplitude ``C`` ahead of
+    ``beta``."""
+    s_a, D_a, U_a, F_a, dF_a, ev_a = elastic_state(p, C, beta)
+    residual, S = wall_residual(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a), steps)
+    return residual, S, C
+
+
+@njit(cache=True, error_model="numpy")
+def elastic_plastic(p, beta, steps):
+    """Wall ``(U(1) - 1, s(1), C)`` with the elastic zone, at yield, directly ahead of
+    ``beta``."""
+    return _elastic_ahead(p, beta, yield_amplitude(p, beta), steps)
 
 
 @njit(cache=True, error_model="numpy")
@@ -490,18 +505,13 @@ def cracking_plastic(p, beta, steps):
     C = crack_amplitude(p, beta)
     if not C <= yield_amplitude(p, beta):  # the elastic state would yield before cracking
         return np.nan, np.nan, C
-    s_a, D_a, U_a, F_a, dF_a, ev_a = elastic_state(p, C, beta)
-    s0, U0 = jump(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a))
-    s1, U1 = integrate(p, beta, s0, U0, steps)
-    return U1 - 1.0, s1, C
+    return _elastic_ahead(p, beta, C, steps)
 
 
 @njit(cache=True, error_model="numpy")
 def superseismic(p, beta, steps):
     """Wall ``(U(1) - 1, s(1))`` of a plastic front into undisturbed concrete."""
-    s0, U0 = jump(p, beta, 0.0, 0.0, 1.0)
-    s1, U1 = integrate(p, beta, s0, U0, steps)
-    return U1 - 1.0, s1
+    return wall_residual(p, beta, 0.0, 0.0, 1.0, steps)
 
 
 @njit(cache=True, error_model="numpy")
@@ -535,9 +545,8 @@ def cracked(p, gamma, steps):
     beta, s_a, U_a, ev_a, C = cracked_front(p, gamma)
     if not beta > 1.0:
         return np.nan, np.nan, beta, C
-    s0, U0 = jump(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a))
-    s1, U1 = integrate(p, beta, s0, U0, steps)
-    return U1 - 1.0, s1, beta, C
+    residual, S = wall_residual(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a), steps)
+    return residual, S, beta, C
 
 
 # ------------------------------------------------------------------------------------------
