@@ -19,9 +19,10 @@ From a shot's columns (``f_c``, ``rho``, projectile mass, diameter, CRH, ``V0``)
    of :mod:`cavex.analytic.concrete_cavity`, tabulated once per concrete (``f_c``, ``rho``) at
    33 velocities uniform in ``V`` up to ``phi = 16 2^n`` (:func:`material_table`, shared by all
    the shots into that concrete) and interpolated (PCHIP in ``V``), integrated over the tangent
-   ogive by cavex's
-   nose quadrature (:func:`cavex.analytic.penetration.nose.nose_rule`); the fitted ``A, B``
-   (:func:`cavex.analytic.concrete_cavity.fit_AB`) are reported, the depth uses the table.
+   ogive by cavex's nose quadrature (:func:`cavex.analytic.penetration.nose.nose_rule`); the
+   fitted ``A, B`` (:func:`cavex.analytic.concrete_cavity.fit_AB`) are reported, the depth uses
+   the table. Reused: the table per (concrete, top) here, the cavity solution per
+   (material, ``phi``) in :mod:`~cavex.analytic.concrete_cavity`.
 3. **Depth**: a crater of ``k d`` with Li and Chen's (2003) ``k = 0.707 + h/d`` (``h`` the nose
    length; ``k = 2.03`` at CRH 2, Forrestal's two calibres), force ``c z`` continuous with the
    tunnel force at ``z = k d`` (:func:`cavex.analytic.penetration.integrator.crater_exit`),
