@@ -156,3 +156,17 @@ def test_committed_study_is_consistent(shots, committed):
         stats = study.statistics(depths[model], shots, flags)
         cells = " | ".join(f"{stats[r][1]:.3f} / {stats[r][2]:+.3f}" for r in study.REGIMES)
         assert f"| {model} | {cells} |" in report
+
+
+def test_headline_numbers(shots, committed):
+    """The numbers docs/concrete.md quotes (mean |ln ratio| per regime), from the committed
+    depths (which test_committed_study_is_consistent ties to the code)."""
+    rows, _ = committed
+    flags = [r["flag"] for r in rows]
+    expected = {study.MODEL: (0.486, 0.403, 0.470, 0.872), study.LORO: (0.536, 0.460, 0.387, 0.937),
+                study.LI_CHEN: (0.483, 0.356, 0.251, 1.152),
+                study.CAVEX: (0.707, 0.646, 1.167, 0.822)}
+    for model, numbers in expected.items():
+        stats = study.statistics([float(r[model]) for r in rows], shots, flags)
+        got = tuple(stats[regime][1] for regime in list(study.REGIMES)[:4])
+        assert got == pytest.approx(numbers, abs=5e-4)
