@@ -3,8 +3,7 @@
 # cavex installed): penetration (derived and the paper's model), the calibrations and the
 # validation against the Forrestal et al. (1994) shots, the verification report, the oblique
 # study and the concrete study. Afterwards `git status results` shows what changed (on another
-# CPU: nothing; see
-# cavex.verification.output.number_format for the digits written).
+# CPU: nothing; see cavex.verification.output.number_format for the digits written).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cavex penetrate --out results/penetration > results/penetration/summary.txt
