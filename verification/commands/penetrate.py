@@ -24,7 +24,7 @@ def run(args, target, projectile):
     settings = resistance_settings(args)
     folder = check_output_dir(args.out, "out")
     job = penetration_job(target, projectile, crater=args.crater, **settings)
-    written = write_staged(folder, lambda stage: write_outputs(job, stage))
+    written = write_staged(folder, lambda stage: write_outputs(job, stage, draw=args.figures))
     document = summary(job, written)
     return json.dumps(document, indent=2) if args.json else text(document)
 
@@ -131,8 +131,9 @@ def phases_as_dicts(trajectory):
              "end_reason": p.end_reason} for i, p in enumerate(trajectory.phases)]
 
 
-def write_outputs(job, out_dir):
-    """Write CSV trajectories, the phase table and PNG figures; return the written paths."""
+def write_outputs(job, out_dir, draw=True):
+    """Write CSV trajectories, the phase table and (if ``draw``) PNG figures; return the
+    written paths."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = []
@@ -140,7 +141,8 @@ def write_outputs(job, out_dir):
         written.append(write_columns_csv(out / f"trajectory_{name}.csv", trajectory.as_columns()))
     written.append(write_columns_csv(out / "phases_runway.csv",
                               _columns(phases_as_dicts(job["runs"]["runway"]))))
-    written += _write_figures(job, out)
+    if draw:
+        written += _write_figures(job, out)
     return [str(p) for p in written]
 
 

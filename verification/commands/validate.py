@@ -59,7 +59,7 @@ def run(args, target, projectile):
                  scheduler=scheduler, progress=args.progress)
     seconds = time.monotonic() - began
     result["command"] = command_line(shots_path, calibration_paths, out)
-    written = write_staged(out, lambda stage: write_outputs(result, stage))
+    written = write_staged(out, lambda stage: write_outputs(result, stage, draw=args.figures))
     if args.json:
         return json.dumps(summary(result), indent=2)
     return text(result, seconds, written)
@@ -104,8 +104,9 @@ def summary(result):
 
 # --- files ------------------------------------------------------------------------------------
 
-def write_outputs(result, out):
-    """Write the JSON, CSV, report and figures into ``out``; return the paths."""
+def write_outputs(result, out, draw=True):
+    """Write the JSON, CSV, report and (if ``draw``) the figures into ``out``; return the
+    paths."""
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, content in (("validation.json", json.dumps(summary(result), indent=2) + "\n"),
@@ -113,7 +114,8 @@ def write_outputs(result, out):
                           ("report.md", report_markdown(result))):
         write_text_atomic(out / name, content)
         written.append(out / name)
-    written += write_figures(result, out)
+    if draw:
+        written += write_figures(result, out)
     return [str(p) for p in written]
 
 
