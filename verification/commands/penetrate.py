@@ -13,7 +13,7 @@ from cavex.analytic.penetration.resistance import make_resistance, model_boundar
 from cavex.config import load_config
 from cavex.verification.output.files import save_figure, write_columns_csv
 from cavex.verification.output.paths import check_output_dir, write_staged
-from cavex.verification.studies.table2 import table2_comparison
+from cavex.verification.studies.table2 import not_reproduced_line, table2_comparison
 
 
 def run(args, target, projectile):
@@ -96,6 +96,8 @@ def text(summary):
             ours["depth_m"], paper["depth_m"], ours["velocity_m_s"], paper["velocity_m_s"],
             ours["time_s"] * 1e3, paper["time_s"] * 1e3) if ours else "(phase not reached)")
         lines.append(f"{row['phase']} {row['name']:<30} {mine}")
+    if s["table2"] is not None:
+        lines.append(not_reproduced_line(s["table2"]))
     lines += ["", "wrote: " + ", ".join(s["outputs"])]
     return "\n".join(lines)
 
