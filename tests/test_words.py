@@ -43,3 +43,20 @@ def test_penetrate_says_under_table2_which_rows_and_where(capsys, tmp_path):
     # the derived model: its crater velocity (961.5 against 894.7 m/s) and its stop (3.2 m
     # against 0.79 m) are far outside the printed precision (docs/table2.md)
     assert below.startswith("rows 1, 2, 3, 4 not reproduced") and "docs/table2.md" in below
+
+
+def test_stress_prints_a_table_in_mpa_and_mm_with_the_state_spelled_out(capsys):
+    import json
+
+    code, out, err = _run(capsys, "stress", "--velocity", "300", "--depth", "0.3")
+    assert (code, err) == (0, "")
+    rows = dict(line.split("  ", 1) for line in out.splitlines())
+    rows = {k.strip(): v.strip() for k, v in rows.items()}
+    document = json.loads(_run(capsys, "stress", "--velocity", "300", "--depth", "0.3",
+                               "--json")[1])
+    assert rows["sigma_r at the wall"] == f"{document['sigma_r_Pa'] / 1e6:.4g} MPa"
+    assert rows["plastic radius b"] == f"{document['plastic_radius_m'] * 1e3:.4g} mm"
+    assert rows["response state"] == ("a: concrete + macadam + soil around the cavity; the "
+                                      "plastic zone (radius b) ends inside concrete")
+    assert document["response_state_meaning"] == rows["response state"][3:]
+    assert "3349129710" not in out and "{" not in out  # no reprs, no dicts
