@@ -60,3 +60,25 @@ def test_stress_prints_a_table_in_mpa_and_mm_with_the_state_spelled_out(capsys):
                                       "plastic zone (radius b) ends inside concrete")
     assert document["response_state_meaning"] == rows["response state"][3:]
     assert "3349129710" not in out and "{" not in out  # no reprs, no dicts
+
+
+def test_table_states_the_depth_grid_it_runs(capsys, tmp_path):
+    import json
+
+    from cavex.config import load_config
+    from cavex.verification.fedata.table import grid_depths
+
+    code, out, err = _run(capsys, "table", "-o", str(tmp_path / "t.nc"), "--velocities", "0",
+                          "600", "--depths", "0.3", "0.5", "0.7", "--workers", "1", "--json")
+    assert code == 0
+    document = json.loads(out)
+    target, projectile = load_config()
+    run = grid_depths([0.3, 0.5, 0.7], target, projectile)
+    assert document["depths_requested_m"] == [0.3, 0.5, 0.7]
+    assert sorted(document["depths_requested_m"] + document["depths_added_m"]) == list(run)
+    assert document["depths_m"] == list(run) and len(run) > 3
+    from cavex.verification.commands.table import text
+
+    line = text(document).splitlines()[1]
+    assert line.startswith(f"depths  {len(run)} depths run (3 requested + {len(run) - 3} added "
+                           "at the layer switches: ")
