@@ -82,3 +82,17 @@ def test_table_states_the_depth_grid_it_runs(capsys, tmp_path):
     line = text(document).splitlines()[1]
     assert line.startswith(f"depths  {len(run)} depths run (3 requested + {len(run) - 3} added "
                            "at the layer switches: ")
+
+
+def test_fem_warns_beyond_the_model_range(capsys):
+    import json
+
+    from cavex.verification.commands.fem import RANGE_VELOCITY, range_warnings
+
+    assert range_warnings(RANGE_VELOCITY, 1e9) == []
+    code, out, err = _run(capsys, "fem", "--velocity", "1500", "--depth", "0.3", "--json")
+    assert code == 0
+    document = json.loads(out)
+    assert len(document["warnings"]) == 1 and "1200 m/s" in document["warnings"][0]
+    assert err.splitlines() == [f"cavex fem: warning: {document['warnings'][0]}"]
+    assert "docs/fem.md 'Range'" in err
