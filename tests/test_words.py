@@ -96,3 +96,36 @@ def test_fem_warns_beyond_the_model_range(capsys):
     assert len(document["warnings"]) == 1 and "1200 m/s" in document["warnings"][0]
     assert err.splitlines() == [f"cavex fem: warning: {document['warnings'][0]}"]
     assert "docs/fem.md 'Range'" in err
+
+
+def test_verify_json_gives_its_conclusions_as_numbers(capsys, tmp_path, monkeypatch):
+    """One record per closed form and wall layer; the closest one per layer and its median are
+    those the report's first sentence for the layer states."""
+    import functools
+    import json
+
+    from cavex.verification.report import build as report
+    from cavex.verification.report.analysis import MODEL_LABEL, MODELS
+    from cavex.verification.report.text import pct
+
+    monkeypatch.setattr(report, "verify", functools.partial(
+        report.verify, velocities=[0.0, 1000.0], depths=[0.3, 0.8]))
+    code, out, err = _run(capsys, "verify", "--quick", "--out", str(tmp_path), "--workers", "1",
+                          "--json")
+    assert code == 0
+    document = json.loads(out)
+    records = document["accuracy"]
+    layers = sorted({r["wall_layer"] for r in records})
+    assert len(records) == len(layers) * len(MODELS)
+    words = {MODEL_LABEL[key]: label for key, label, _ in MODELS}
+    for layer in layers:
+        closest = [r for r in records if r["wall_layer"] == layer and r["closest"]]
+        assert len(closest) == 1
+        best = closest[0]
+        sentence = next(c for c in document["conclusions"]
+                        if c.startswith(f"**{layer} at the wall**"))
+        assert (f"the closest closed form is {words[best['model']]} (median error "
+                f"{pct(best['median_relative_difference'])})") in sentence
+        for r in records:
+            assert 0.0 <= r["within_1_percent_ratio"] <= r["within_5_percent_ratio"] <= 1.0
+            assert abs(r["worst_relative_difference"]) >= abs(r["median_relative_difference"])
