@@ -129,3 +129,30 @@ def test_verify_json_gives_its_conclusions_as_numbers(capsys, tmp_path, monkeypa
         for r in records:
             assert 0.0 <= r["within_1_percent_ratio"] <= r["within_5_percent_ratio"] <= 1.0
             assert abs(r["worst_relative_difference"]) >= abs(r["median_relative_difference"])
+
+
+def test_the_fem_fields_open_as_docs_fem_md_shows(capsys, tmp_path, monkeypatch):
+    """The snippet of docs/fem.md "Output files", run on the files ``cavex fem --fields``
+    writes: the series and the final VTU read back, and the names follow the convention."""
+    import csv
+    import json
+    import re
+    from pathlib import Path
+
+    docs = (Path(__file__).resolve().parents[1] / "docs" / "fem.md").read_text()
+    section = docs[docs.index("## Output files"):]
+    snippet = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    monkeypatch.chdir(tmp_path)
+    code, out, err = _run(capsys, "fem", "--velocity", "500", "--depth", "0.3", "--fields",
+                          "fields", "--json")
+    assert (code, err) == (0, "")
+    names = {}
+    exec(snippet, names)  # noqa: S102 - the documented snippet itself
+    assert names["wall_stress"] > 0 and names["sigma_r"].shape == (len(names["points"]) - 1,)
+    fe = json.loads(out)["fe_sigma_r_Pa"]
+    assert names["radius"][0] == pytest.approx(0.0125, rel=1e-9)  # the wall at the cavity radius
+    with open(tmp_path / "fields" / "fem_history.csv", newline="") as handle:
+        rows = list(csv.reader(handle))
+    assert rows[0] == ["time_s", "radius_m", "wall_stress_Pa", "plastic_radius_m"]
+    assert all(len(re.sub(r"e.*|[-.]", "", x).lstrip("0")) <= 6 for row in rows[1:] for x in row)
+    assert float(rows[-1][2]) == pytest.approx(fe, rel=5e-6)

@@ -64,7 +64,8 @@ def text(summary):
                  + ("not estimated" if estimate is None else f"{estimate:.3%}")
                  + f" ({s['refinements']} refinement(s) of the default resolution)")
     if "fields" in s:
-        lines.append(f"wrote   {s['fields']} (+ history CSV)")
+        lines.append(f"wrote   {s['fields']} (time series: meshio.xdmf.TimeSeriesReader), "
+                     "fem_final.vtu (meshio.read), fem_history.csv")
     return "\n".join(lines)
 
 
