@@ -156,3 +156,48 @@ def test_the_fem_fields_open_as_docs_fem_md_shows(capsys, tmp_path, monkeypatch)
     assert rows[0] == ["time_s", "radius_m", "wall_stress_Pa", "plastic_radius_m"]
     assert all(len(re.sub(r"e.*|[-.]", "", x).lstrip("0")) <= 6 for row in rows[1:] for x in row)
     assert float(rows[-1][2]) == pytest.approx(fe, rel=5e-6)
+
+
+def test_standard_errors_are_those_of_linear_least_squares():
+    """For residuals linear in the parameters the linearised estimate is exact: the ordinary
+    least-squares standard errors of a straight line (numpy.polyfit's covariance, scaled by the
+    residual variance with n - p degrees of freedom)."""
+    import numpy as np
+
+    from cavex.verification.validation.calibration import standard_errors
+
+    x = np.linspace(0.0, 1.0, 9)
+    y = 0.3 + 1.7 * x + np.array([0.01, -0.02, 0.015, 0.0, -0.01, 0.02, -0.015, 0.005, 0.0])
+    (slope, intercept), cov = np.polyfit(x, y, 1, cov=True)
+    jacobian = np.column_stack([np.ones_like(x), x])  # d r / d (lam, modulus_factor-free)
+    residuals = intercept + slope * x - y
+    se = standard_errors(jacobian, residuals, ("lam", "nu"), np.array([intercept, slope]))
+    assert se == pytest.approx([np.sqrt(cov[1, 1]), np.sqrt(cov[0, 0])], rel=1e-10)
+    # a factor fitted as its logarithm: se(f) = f se(ln f)
+    scaled = standard_errors(jacobian, residuals, ("lam", "strength_factor"),
+                             np.array([intercept, np.log(2.0)]))
+    assert scaled[1] == pytest.approx(2.0 * np.sqrt(cov[0, 0]), rel=1e-10)
+    assert standard_errors(jacobian[:2], residuals[:2], ("lam", "nu"), np.zeros(2)) == [None] * 2
+
+
+def test_calibrate_prints_standard_errors_and_warns_when_every_shot_is_fitted(capsys, tmp_path):
+    import json
+
+    shots = "examples/shots_forrestal1994.csv"
+    code, out, err = _run(capsys, "calibrate", "--shots", shots, "--out",
+                          str(tmp_path / "c.toml"), "--ids", "F94-39", "F94-40", "F94-41",
+                          "--workers", "1", "--json")
+    assert (code, err) == (0, "")
+    document = json.loads(out)
+    errors = document["standard_errors"]
+    assert set(errors) == {"lam", "strength_factor"}
+    assert all(0.0 < e < float("inf") for e in errors.values())
+    from cavex.verification.commands.calibrate import text
+
+    fitted = text(document).splitlines()[1]
+    assert f"lam = {document['fitted']['lam']:.6g} +- {errors['lam']:.2g}" in fitted
+    code, out, err = _run(capsys, "calibrate", "--shots", shots, "--out",
+                          str(tmp_path / "all.toml"), "--workers", "1")
+    assert code == 0 and err.splitlines() == [
+        "cavex calibrate: warning: every shot of the file (17) was fitted: `cavex validate` "
+        "has no held-out shot to judge this calibration on (fit a subset with --ids)"]

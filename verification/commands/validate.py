@@ -329,10 +329,15 @@ def text(result, seconds, written):
     lines = [f"{result['shots_file']['n']} shots from {result['shots_file']['path']}; "
              f"FE tables built {result['tables']['built']}, reused "
              f"{result['tables']['reused']}; {seconds:.1f} s", ""]
-    parts = [("all shots", result["summary"])]
-    if "held_out_summary" in result:
+    fitted = bool(result["calibrations"])
+    parts = [("all shots" + (" (calibrated models: in-sample on their fitted shots)" if fitted
+                             else ""), result["summary"])]
+    if result.get("held_out"):
         parts.insert(0, (f"held-out shots ({len(result['held_out'])})",
                          result["held_out_summary"]))
+    elif fitted:
+        lines += ["no held-out shot: every shot was fitted by the calibration(s), so their rows "
+                  "below are in-sample (calibrate on a subset with --ids)", ""]
     for title, summary in parts:
         lines += [f"{title}:", f"{'model':<40} {'n':>3} {'mean ratio':>10} {'std':>7} "
                   f"{'mean|ln r|':>10}"]
