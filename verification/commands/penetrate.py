@@ -163,7 +163,7 @@ def _write_figures(job, out):
     runway, single = job["runs"]["runway"], job["runs"]["first_layer_only"]
     subtitle = textwrap.fill(job["title"], 70)
     names = job.get("layer_names", [])
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
     runway_label = "runway (layered)" if job.get("table") is None else \
         "runway (layered, FE table)"
     ax.plot(runway.t * 1e3, runway.velocity, label=runway_label)
@@ -171,9 +171,9 @@ def _write_figures(job, out):
             " alone")
     ax.set(xlabel="time (ms)", ylabel="velocity (m/s)")
     ax.set_title(f"Velocity against time\n{subtitle}", fontsize=10)
-    ax.legend()
+    _legend_below(ax)
     velocity_png = _save(fig, out / "velocity_time.png", plt)
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
     ax.plot(runway.depth, runway.deceleration / 9.81 / 1e3, label=runway_label)
     ax.plot(single.depth, single.deceleration / 9.81 / 1e3, "--",
             label=f"{names[0] if names else 'first layer'} alone")
@@ -189,8 +189,14 @@ def _write_figures(job, out):
     ax.set_xlim(left, right)
     ax.set(xlabel="nose-tip depth (m)", ylabel=r"deceleration ($10^3$ g)")
     ax.set_title(f"Deceleration against depth\n{subtitle}", fontsize=10, pad=14)
-    ax.legend(loc="center right")
+    _legend_below(ax)
     return [velocity_png, _save(fig, out / "deceleration_depth.png", plt)]
+
+
+def _legend_below(ax):
+    """The legend below the axes, off the data."""
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False,
+              fontsize=9)
 
 
 def _save(fig, path, plt):

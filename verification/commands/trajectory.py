@@ -141,9 +141,12 @@ def figures(job, folder):
     return [str(path) for path in written]
 
 
-def _interfaces(ax, target, vertical=True):
+def _interfaces(ax, target, vertical=True, deepest=math.inf):
+    """The interfaces down to ``deepest`` (m) as dashed lines (an interface the shot never
+    reaches would stretch the axis away from what moves)."""
     for H in target.interface_depths:
-        (ax.axhline if vertical else ax.axvline)(H, color="0.5", lw=0.8, ls="--")
+        if H <= deepest:
+            (ax.axhline if vertical else ax.axvline)(H, color="0.5", lw=0.8, ls="--")
 
 
 #: A pitch (deg) or lateral overload (fraction of the axial peak) below this is round-off (a
@@ -290,6 +293,7 @@ def overloads(job, path):
     """Axial and lateral overload against time and nose-tip depth; a note instead of the
     lateral curves where they stay below :data:`LATERAL_ROUNDOFF` of the axial peak."""
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     fig, axes = plt.subplots(2, 2, figsize=(10, 7))
     runs = list(job["runs"].items())
@@ -306,15 +310,17 @@ def overloads(job, path):
         word = key.split("_")[0]
         if not shown:
             for a in axes[row]:
-                _note(a, f"lateral overload 0 (below {LATERAL_ROUNDOFF:g} of the axial peak: "
-                      "round-off;\na shot in its plane of symmetry has no lateral force)")
+                _note(a, f"lateral overload 0\n(below {LATERAL_ROUNDOFF:g} of the axial peak: "
+                      "round-off;\na shot in its plane of symmetry\nhas no lateral force)")
             continue
         axes[row, 0].set_ylabel(f"{word} overload (thousands of g)")
         axes[row, 0].set_xlabel("t (ms)")
         axes[row, 1].set_xlabel("nose-tip depth (m); dashed: interfaces")
-        _interfaces(axes[row, 1], job["target"], vertical=False)
+        deepest = max(float(np.max(r.history["tip_z_m"])) for _, r in runs)
+        _interfaces(axes[row, 1], job["target"], vertical=False, deepest=deepest)
         for a in axes[row]:
             a.grid(alpha=0.3)
+            a.xaxis.set_major_locator(MaxNLocator(6))  # no overprinted ticks (mm depths)
     handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.suptitle(_title(job), fontsize=10)
     if len(runs) > 1:
