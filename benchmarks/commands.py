@@ -4,7 +4,8 @@ whole process, from start to exit), beside the computation they do timed in one 
 Prints medians (and min, max) of wall time over ``--runs`` runs (default 7, after one warm-up
 that is not counted, so numba's cache is warm) of
 
-- ``cavex --help``, ``cavex penetrate --help`` and a bad input (exit code 2): the parser only;
+- ``cavex --help``, ``cavex penetrate --help`` and bad input (exit code 2): refused by the
+  parser, or by the command's checks before it loads the numerical libraries it runs on;
 - ``python -c "import numba, scipy.integrate"``: the floor of every command that computes (the
   libraries the 1-D integrator and the 3-D body need, imported and nothing else);
 - ``cavex penetrate --no-figures`` and ``cavex penetrate``; ``cavex trajectory --no-figures``
@@ -76,6 +77,10 @@ def main():
         line("cavex penetrate --help", wall([CAVEX, "penetrate", "--help"], runs))
         line("cavex stress --velocity x (bad input, exit 2)",
              wall([CAVEX, "stress", "--velocity", "x", "--depth", "0.3"], runs, expect=2))
+        line("cavex stress --velocity -1 (out of range, exit 2)",
+             wall([CAVEX, "stress", "--velocity", "-1", "--depth", "0.3"], runs, expect=2))
+        line("cavex fem --velocity 1e9 (out of range, exit 2)",
+             wall([CAVEX, "fem", "--velocity", "1e9", "--depth", "0.3"], runs, expect=2))
         floor = line("python -c 'import numba, scipy.integrate'",
                      wall([sys.executable, "-c", "import numba, scipy.integrate"], runs))
         measured = {}

@@ -33,7 +33,12 @@ def range_warnings(velocity, wall_stress):
 
 
 def job(target, projectile, depth, velocity, *, nu=None, fields=None):
-    """:func:`cavex.verification.fedata.comparison.compare_at_depth` (JSON-able)."""
+    """:func:`cavex.verification.fedata.comparison.compare_at_depth` (JSON-able). The problem
+    is checked first, before the FE solver is loaded: bad input answers at once."""
+    from cavex.analytic.geometry import spherical_problem
+    from cavex.problem import SphericalProblem
+
+    SphericalProblem(*spherical_problem(target, projectile, depth), velocity, projectile.r)
     from cavex.verification.fedata.comparison import compare_at_depth
 
     return compare_at_depth(target, projectile, depth, velocity, nu=nu, fields=fields)
