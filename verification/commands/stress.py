@@ -3,13 +3,11 @@
 import json
 import math
 
-from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.analytic.paper_model import paper_coefficients
-from cavex.analytic.penetration.resistance import check_model, model_boundary, model_label
+from cavex.analytic.penetration.labels import check_model, model_boundary, model_label
 from cavex.errors import CavexNumericalError, require
 from cavex.materials import MAX_VELOCITY
-from cavex.verification.report.analysis import state_meaning
 
 
 def run(args, target, projectile):
@@ -34,9 +32,13 @@ def stress_at_depth(target, projectile, depth, velocity, *, resistance="derived"
             f"in [0, {MAX_VELOCITY:g}] m/s", velocity)
     check_model(resistance, boundary)
     boundary = model_boundary(resistance, boundary)
+    layers, interfaces = spherical_problem(target, projectile, depth)  # checks the depth
+    # loaded once the input is checked: bad input answers before numba and scipy load
+    from cavex.analytic.cavity import cavity_solution
+    from cavex.verification.report.analysis import state_meaning
+
     if resistance == "paper":
-        return _finite(_paper(target, projectile, depth, velocity, epsilon))
-    layers, interfaces = spherical_problem(target, projectile, depth)
+        return _finite(_paper(target, projectile, depth, velocity, epsilon, state_meaning))
     state = cavity_solution(layers, interfaces, velocity, projectile.r, boundary=boundary)
     index = wall_layer(target, projectile, depth)
     return _finite({"model": model_label(resistance, boundary), "resistance": resistance,
@@ -106,7 +108,7 @@ def _finite(result):
     return result
 
 
-def _paper(target, projectile, depth, velocity, epsilon):
+def _paper(target, projectile, depth, velocity, epsilon, state_meaning):
     c = paper_coefficients(target, projectile, depth, epsilon=epsilon)
     return {"model": "paper", "resistance": "paper", "epsilon": epsilon, "depth_m": depth,
             "velocity_m_s": velocity,
