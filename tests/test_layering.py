@@ -44,6 +44,7 @@ ALLOWED = {
     V + "commands": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
                             V + "report", V + "validation", V + "studies", V + "commands"),
     V + "cli": ("cavex",),
+    "cavex.__main__": (V + "cli",),  # `python -m cavex`: the command line, nothing else
     "cavex": CORE,
 }
 

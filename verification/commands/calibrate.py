@@ -3,6 +3,7 @@ calibration file (:mod:`cavex.verification.validation.calibration`, docs/validat
 
 import json
 import shlex
+import sys
 import time
 from pathlib import Path
 
@@ -24,6 +25,9 @@ def run(args, target, projectile):
                  params=params, workers=args.workers, scheduler=args.scheduler,
                  progress=args.progress, out=out)
     command = command_line(args.shots, args.out, result["calibration"].model, params, args.ids)
+    warning = all_fitted_warning(shots, len(shot_file.shots))
+    if warning:
+        print(f"cavex calibrate: warning: {warning}", file=sys.stderr)
     document = summary(result, write_outputs(result, args.shots, shots[0], command, out))
     return json.dumps(document, indent=2) if args.json else text(document)
 
@@ -78,6 +82,7 @@ def summary(job, out):
     calibration = job["calibration"]
     return {"model": calibration.model, "params": list(calibration.params),
             "fitted": {p: getattr(calibration.mapping, p) for p in calibration.params},
+            "standard_errors": dict(calibration.standard_errors),
             "mapping": calibration.mapping.as_dict(), "shots": list(calibration.shots),
             **dict(calibration.statistics), "wall_time_s": float(job["seconds"]),
             "output": str(out)}
@@ -86,7 +91,8 @@ def summary(job, out):
 def text(summary):
     """The model and its shots, the fitted values, the fit, the file."""
     s = summary
-    values = ", ".join(f"{p} = {v:.6g}" for p, v in s["fitted"].items())
+    errors = s["standard_errors"]
+    values = ", ".join(f"{p} = {v:.6g}" + _error(errors.get(p)) for p, v in s["fitted"].items())
     return "\n".join([
         f"model   {s['model']}, {len(s['shots'])} shots: {', '.join(s['shots'])}",
         f"fitted  {values}",
@@ -95,3 +101,19 @@ def text(summary):
         f"{s['wall_time_s']:.1f} s",
         f"wrote   {s['output']}",
     ])
+
+
+def _error(se):
+    """`` +- se`` (the fit's standard error, 2 significant digits), or why there is none."""
+    if se is None:
+        return " (no standard error: as many shots as parameters)"
+    return f" +- {se:.2g}"
+
+
+def all_fitted_warning(fitted, available):
+    """The warning when the fit used every shot of the file (None otherwise): ``cavex
+    validate`` then has no held-out shot to judge the calibration on."""
+    if len(fitted) < available:
+        return None
+    return (f"every shot of the file ({available}) was fitted: `cavex validate` has no "
+            "held-out shot to judge this calibration on (fit a subset with --ids)")

@@ -58,6 +58,9 @@ class Calibration:
     shots: tuple
     source: str = ""
     statistics: tuple = ()
+    #: ``((param, standard error), ...)`` of the fit (:func:`standard_errors`; not in the
+    #: calibration file: the command prints them)
+    standard_errors: tuple = ()
 
     @property
     def column(self):
@@ -165,8 +168,35 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
                   ("mean_abs_log_ratio", round_significant(float(np.abs(r).mean()), 6)),
                   ("rms_log_ratio", round_significant(float(np.sqrt((r ** 2).mean())), 6)),
                   ("evaluations", count[0]))
+    errors = standard_errors(solution.jac, solution.fun, params, solution.x)
     return Calibration(model, mapping, params, tuple(s.id for s in shots),
-                       statistics=statistics)
+                       statistics=statistics,
+                       standard_errors=tuple(zip(params, errors, strict=True)))
+
+
+def standard_errors(jacobian, residuals, params, x):
+    r"""Standard error of each fitted parameter, from the Jacobian ``J`` of the residuals at
+    the solution ``x`` (the linearised least-squares estimate):
+
+    .. math:: \mathrm{cov}(x) = s^2 (J^T J)^{-1}, \qquad s^2 = \frac{\sum_i r_i^2}{n - p}
+
+    with ``n`` shots and ``p`` parameters. A factor fitted as ``ln f`` (:data:`LOG_PARAMETERS`)
+    gets ``f * se(ln f)`` (first order). None for every parameter when ``n <= p`` (no degree of
+    freedom left to estimate the scatter) and where ``J^T J`` is singular (a parameter the
+    depths do not determine: ``inf``)."""
+    jacobian, residuals = np.asarray(jacobian, dtype=float), np.asarray(residuals, dtype=float)
+    n, p = jacobian.shape
+    if n <= p:
+        return [None] * p
+    scatter = float(residuals @ residuals) / (n - p)
+    normal = jacobian.T @ jacobian
+    try:
+        variances = scatter * np.diag(np.linalg.inv(normal))
+    except np.linalg.LinAlgError:
+        return [math.inf] * p
+    values = _to_values(x, params)
+    return [float(math.sqrt(max(v, 0.0)) * (value if name in LOG_PARAMETERS else 1.0))
+            for name, v, value in zip(params, variances, values, strict=True)]
 
 
 class _ForwardDifferences:
