@@ -332,3 +332,27 @@ def test_debonded_work_is_the_kinetic_energy_lost(debonded):
     mismatch = -y1[13] / (result.model.energy(y0) - result.model.energy(y1)) - 1.0
     print("work-energy mismatch:", mismatch)
     assert abs(mismatch) < 5e-4
+
+
+def test_trajectory_json_peaks_and_pitch_change_per_phase(capsys, tmp_path):
+    code = main(["trajectory", "--velocity", "600", "--obliquity", "20", "--interfaces",
+                 "debonded", "--no-figures", "--json", "--out", str(tmp_path)])
+    out, _ = capsys.readouterr()
+    assert code == 0
+    document = json.loads(out)
+    run = document["runs"]["runway"]
+    assert document["settings"]["interfaces"] == ["debonded", "debonded"]
+    changes = [p["pitch_change_deg"] for p in run["phases"]]
+    assert sum(changes) == pytest.approx(run["end"]["pitch_deg"] - 20.0, abs=1e-9)
+    # the turn after the interface (the last phase, in the macadam) is nose up
+    assert run["phases"][-1]["label"] == "macadam" and changes[-1] > 0.1
+    peaks = run["overload_peaks"]
+    assert all(set(p) == {"tip_depth_m", "axial_g"} for p in peaks)
+    assert any(0.65 < p["tip_depth_m"] < 0.65 + crater_depth_default() + 0.05 for p in peaks)
+    code = main(["trajectory", "--interfaces", "debonded", "--resistance", "law", "--law-A",
+                 "1e8", "--law-B", "1000", "--out", str(tmp_path / "x")])
+    assert code == 2 and "--resistance derived" in capsys.readouterr().err
+
+
+def crater_depth_default():
+    return crater_depth(load_config()[1])

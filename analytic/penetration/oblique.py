@@ -321,12 +321,14 @@ class ObliqueModel:
             sols.append(sol)
             surfaces.append(self._surface)
             t0, y = sol.t[-1], sol.y[:, -1].copy()
+            start_pitch = phases[-1]["end_pitch_deg"] if phases else float(
+                pitch_yaw(self.axis(sol.y[:, 0]))[0])
             if which is None:
                 reason = "time limit"
-                phases.append(self._phase(label, t0, y, reason))
+                phases.append(self._phase(label, t0, y, reason, start_pitch))
                 break
             reason, crossing, interface = described[which]
-            phases.append(self._phase(label, t0, y, reason))
+            phases.append(self._phase(label, t0, y, reason, start_pitch))
             if crossing:
                 if interface is not None:  # the layer the tip has just entered
                     label = self.target.layer_name(interface + 1 if directions[which] > 0
@@ -403,11 +405,13 @@ class ObliqueModel:
     def phase_label(self, y):
         return self.target.layer_name(self.target.layer_at(max(self.tip(y)[2], 0.0)))
 
-    def _phase(self, label, t, y, reason):
+    def _phase(self, label, t, y, reason, start_pitch):
+        """One phase's summary; ``pitch_change_deg``: its end pitch minus ``start_pitch``."""
         end = self._end_state(y, t, reason)
         return {"label": label, "end_reason": reason, "end_time_s": end["time_s"],
                 "end_nose_tip_m": end["nose_tip_m"], "end_pitch_deg": end["pitch_deg"],
-                "end_speed_m_s": end["speed_m_s"]}
+                "end_speed_m_s": end["speed_m_s"],
+                "pitch_change_deg": end["pitch_deg"] - start_pitch}
 
     def _end_state(self, y, t, reason):
         pitch, yaw = pitch_yaw(self.axis(y))
@@ -471,6 +475,28 @@ def fly(target, projectile, strike=None, resistance="derived", *, body=None, bot
     model = ObliqueModel(target, projectile, law, body=body, bottom=bottom, rtol=rtol,
                          atol=atol, method=method, contact_ramp=contact_ramp)
     return model.run(strike, progress=progress)
+
+
+PEAK_RISE = 0.05  # of the peak's own value
+
+
+def overload_peaks(history, rise=PEAK_RISE):
+    """Nose-tip depths (m) and values (g) of the peaks of the axial overload: local maxima
+    ``g_i`` that rise above the dip before them by at least ``rise`` x ``g_i`` and reach
+    ``rise`` x the shot's largest overload (not the first samples' wiggles). The dip is
+    ``scipy.signal.peak_prominences``' left base: the lowest sample between the peak and the
+    nearest higher sample before it (or the start), so a peak counts by the rise it makes, not
+    by what follows (a peak entering a stronger layer is not hidden by a still larger
+    overload later)."""
+    from scipy.signal import find_peaks, peak_prominences
+
+    g, z = history["axial_g"], history["tip_z_m"]
+    index, _ = find_peaks(g)
+    if not index.size:
+        return []
+    _, left, _ = peak_prominences(g, index)
+    keep = (g[index] - g[left] >= rise * g[index]) & (g[index] >= rise * g.max())
+    return [(float(z[i]), float(g[i])) for i in index[keep]]
 
 
 def peaks(history):

@@ -15,7 +15,13 @@ from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.penetration.oblique import CONTACT_RAMP, Strike, fly, peaks
+from cavex.analytic.penetration.oblique import (
+    CONTACT_RAMP,
+    Strike,
+    fly,
+    overload_peaks,
+    peaks,
+)
 from cavex.analytic.penetration.surface_force import rotation_matrix as rotation
 from cavex.errors import is_finite_number, require
 from cavex.verification.fedata.runner import show_progress
@@ -87,9 +93,13 @@ def _steps(name, enabled):
 
 
 def run_summary(result):
-    """End state and phases of one run (JSON-ready), plus the largest pitch rate and
-    overloads."""
-    return {"end": result.end, "phases": result.phases, **peaks(result.history)}
+    """End state and phases of one run (JSON-ready; each phase with its ``pitch_change_deg``),
+    the largest pitch rate and overloads, and the axial overload's peaks
+    (:func:`~cavex.analytic.penetration.oblique.overload_peaks`) as ``overload_peaks``
+    ``[{"tip_depth_m", "axial_g"}]``."""
+    return {"end": result.end, "phases": result.phases, **peaks(result.history),
+            "overload_peaks": [{"tip_depth_m": z, "axial_g": g}
+                               for z, g in overload_peaks(result.history)]}
 
 
 def summary(job, written=None):
