@@ -2,7 +2,7 @@
 # Regenerate every committed result with the commands a user runs (from the repository root, with
 # cavex installed): penetration (derived and the paper's model), the calibrations and the
 # validation against the Forrestal et al. (1994) shots, the verification report and the oblique
-# study (bonded and debonded interfaces). Afterwards `git status results` shows what changed (on another CPU: nothing; see
+# study. Afterwards `git status results` shows what changed (on another CPU: nothing; see
 # cavex.verification.output.number_format for the digits written).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -25,6 +25,4 @@ cavex validate --shots examples/shots_forrestal1994.csv --calibration \
   --out results/validation --no-progress > /dev/null
 cavex verify --no-progress > /dev/null
 python -m cavex.verification.studies.oblique_study --no-progress > /dev/null
-python -m cavex.verification.studies.oblique_study --no-progress --interfaces debonded \
-  --out results/oblique/debonded > /dev/null
 git status --short results
