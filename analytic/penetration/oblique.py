@@ -478,25 +478,29 @@ def fly(target, projectile, strike=None, resistance="derived", *, body=None, bot
 
 
 PEAK_RISE = 0.05  # of the peak's own value
+PEAK_SPAN = 0.04  # m of nose-tip travel, about the nose length (0.0415 m for Table 1)
 
 
-def overload_peaks(history, rise=PEAK_RISE):
-    """Nose-tip depths (m) and values (g) of the peaks of the axial overload: local maxima
-    ``g_i`` that rise above the dip before them by at least ``rise`` x ``g_i`` and reach
-    ``rise`` x the shot's largest overload (not the first samples' wiggles). The dip is
-    ``scipy.signal.peak_prominences``' left base: the lowest sample between the peak and the
-    nearest higher sample before it (or the start), so a peak counts by the rise it makes, not
-    by what follows (a peak entering a stronger layer is not hidden by a still larger
-    overload later)."""
-    from scipy.signal import find_peaks, peak_prominences
-
-    g, z = history["axial_g"], history["tip_z_m"]
-    index, _ = find_peaks(g)
-    if not index.size:
-        return []
-    _, left, _ = peak_prominences(g, index)
-    keep = (g[index] - g[left] >= rise * g[index]) & (g[index] >= rise * g.max())
-    return [(float(z[i]), float(g[i])) for i in index[keep]]
+def overload_peaks(history, rise=PEAK_RISE, span=PEAK_SPAN):
+    """Nose-tip depths (m) and values (g) of the peaks of the axial overload: samples ``g_i``
+    that are the largest over the next ``span`` of nose-tip travel (``[z_i, z_i + span]``),
+    rise above the dip before them, the smallest over ``[z_i - span, z_i]``, by at least
+    ``rise`` x ``g_i``, and reach ``rise`` x the shot's largest overload. A peak counts by the
+    rise it makes, not by what follows (a peak entering a stronger layer is not hidden by a
+    larger overload later); the forward span drops the ripples of a rising overload (the nose's
+    element rings entering one by one) and keeps one peak per nose length of travel."""
+    g, z = np.asarray(history["axial_g"]), np.asarray(history["tip_z_m"])
+    found = []
+    for i in range(1, g.size - 1):
+        if not (g[i] >= g[i - 1] and g[i] > g[i + 1] and g[i] >= rise * g.max()):
+            continue
+        ahead = (z >= z[i]) & (z <= z[i] + span)
+        before = (z >= z[i] - span) & (z <= z[i])
+        ahead[:i] = False  # the path is not monotone in depth: only later samples ahead
+        before[i + 1:] = False  # and earlier ones before
+        if g[ahead].max() <= g[i] and g[i] - g[before].min() >= rise * g[i]:
+            found.append((float(z[i]), float(g[i])))
+    return found
 
 
 def peaks(history):
