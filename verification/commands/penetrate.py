@@ -182,6 +182,8 @@ def _write_figures(job, out):
     fig, ax = plt.subplots(figsize=(6.4, 4.4))
     runway_label = "runway (layered)" if job.get("table") is None else \
         "runway (layered, FE table)"
+    if job.get("debonded"):
+        runway_label = "runway (layered, debonded interfaces)"
     ax.plot(runway.t * 1e3, runway.velocity, label=runway_label)
     ax.plot(single.t * 1e3, single.velocity, "--", label=f"{names[0] if names else 'first layer'}"
             " alone")
