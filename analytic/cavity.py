@@ -289,13 +289,15 @@ def _walk(props, interfaces, velocity, radius, free_radius, dynamic, values, cod
 
 
 @njit(cache=True, error_model="numpy")
-def nose_walk(props, interfaces, velocity, cosines, weights, radius, dynamic, codes):
+def nose_walk(props, interfaces, velocity, cosines, weights, radius, dynamic, codes,
+              free_radius=np.inf):
     """The walk for the nose force at one depth (the penetration integrator's hot path).
 
     Dynamic: returns ``(sum_k w_k sigma_r(V cos(phi_k)), 0, failed)``; quasi-static:
     ``(s_0, s_2, failed)`` of ``sigma_r = s_0 + s_2 V^2`` (the force is then exact,
     ``C_A + C_B V^2``). ``codes`` gets the codes of the point at ``V`` itself (the label).
-    ``interfaces`` has one row; the medium is unbounded.
+    ``interfaces`` has one row; the medium is unbounded or (``free_radius``) cut by a
+    traction-free sphere.
     """
     failed = False
     first = 0.0
@@ -304,11 +306,11 @@ def nose_walk(props, interfaces, velocity, cosines, weights, radius, dynamic, co
     if dynamic:
         for j in range(cosines.shape[0]):
             v2 = (velocity * cosines[j]) ** 2
-            s0, s2, b, position, flags, active = _point(props, interfaces, 0, radius, np.inf,
+            s0, s2, b, position, flags, active = _point(props, interfaces, 0, radius, free_radius,
                                                         v2, True, zones, 0, False)
             failed |= (flags & FAILED) != 0
             first += weights[j] * (s0 + s2 * v2)
-    s0, s2, b, position, flags, active = _point(props, interfaces, 0, radius, np.inf,
+    s0, s2, b, position, flags, active = _point(props, interfaces, 0, radius, free_radius,
                                                 velocity * velocity, dynamic, zones, 0, False)
     failed |= (flags & FAILED) != 0
     if not dynamic:

@@ -10,7 +10,9 @@ from cavex.errors import CavexInputError, check_keys, prefixed, require
 from cavex.input_files import in_file, read_toml
 from cavex.materials import Material, Projectile, Target
 
-LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c"}
+LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c", "bottom",
+              "scab_depth"}
+BOTTOM_KEYS = ("bottom", "scab_depth")  # how a layer's bottom face holds: not on the last layer
 PROJECTILE_KEYS = {"r", "l", "R", "crh", "m", "V0", "length", "inertia", "cg", "mu"}
 TOP_KEYS = {"projectile", "layers"}
 # written by `cavex calibrate` beside the calibrated target; read by `cavex validate`
@@ -49,22 +51,30 @@ def parse_config(data):
 def parse_target(layers):
     """Build a :class:`Target` from a list of ``[[layers]]`` tables."""
     require(isinstance(layers, list) and layers, "layers", "a non-empty array of tables", layers)
-    materials, thicknesses = [], []
+    materials, thicknesses, bottoms, scabs = [], [], [], []
     for i, table in enumerate(layers):
         where = f"layers[{i}]."
         require(isinstance(table, dict), f"layers[{i}]", "a table", table)
         last = i == len(layers) - 1
         required = {"E", "nu", "rho", "lam"} | (set() if last else {"thickness"})
         check_keys(table, LAYER_KEYS, where, required=required)
-        if last and "thickness" in table:
-            raise CavexInputError("must be absent (the last layer is semi-infinite)",
-                                  f"{where}thickness")
-        numbers = {k: _number(table[k], where + k) for k in table if k != "name"}
+        for key in ("thickness", *BOTTOM_KEYS) if last else ():
+            if key in table:
+                raise CavexInputError("must be absent (the last layer is semi-infinite)",
+                                      f"{where}{key}")
+        if "bottom" in table:
+            require(isinstance(table["bottom"], str), f"{where}bottom", "a string",
+                    table["bottom"])
+        numbers = {k: _number(table[k], where + k) for k in table
+                   if k not in ("name", "bottom")}
         thickness = numbers.pop("thickness", None)
+        scab = numbers.pop("scab_depth", None)
         materials.append(prefixed(Material, where, name=table.get("name", ""), **numbers))
         if thickness is not None:
             thicknesses.append(thickness)
-    return prefixed(Target, "", materials, thicknesses)
+            bottoms.append(table.get("bottom", "bonded"))
+            scabs.append(scab)
+    return prefixed(Target, "", materials, thicknesses, bottoms, scabs)
 
 
 def parse_projectile(table):
@@ -89,6 +99,10 @@ def target_table(target):
         table = {"name": material.name} if material.name else {}
         if i < len(target.thicknesses):
             table["thickness"] = float(target.thicknesses[i])
+            if target.bottoms[i] != "bonded":  # the default is not written: bonded targets
+                table["bottom"] = target.bottoms[i]  # keep their tables and fingerprints
+            if target.scab_depths[i] is not None:
+                table["scab_depth"] = float(target.scab_depths[i])
         table.update(E=float(material.E), nu=float(material.nu), rho=float(material.rho),
                      lam=float(material.lam), tau=float(material.tau))
         tables.append(table)

@@ -100,12 +100,26 @@ class Material:
         return (1.5 * self.tau / self.E) ** (1.0 / 3.0)
 
 
+#: How a layer's bottom face holds to the layer below (``bottom`` of a layer, docs/config.md):
+#: "bonded" (the default: the layers are one continuum to the cavity expansion) or "debonded"
+#: (the interface opens: a traction-free rear face, a rear zone, a crater in the next layer;
+#: docs/analytic.md "Debonded interfaces").
+BONDINGS = ("bonded", "debonded")
+
+
 @dataclass(frozen=True)
 class Target:
-    """Plane layered target: ``layers[i]`` has ``thicknesses[i]``; the last is semi-infinite."""
+    """Plane layered target: ``layers[i]`` has ``thicknesses[i]``; the last is semi-infinite.
+
+    ``bottoms[i]`` (one of :data:`BONDINGS`, default all "bonded") is how the bottom face of
+    layer ``i`` (interface ``i + 1``) holds; ``scab_depths[i]`` (m, > 0, less than the layer's
+    thickness; None: the rule of :func:`cavex.analytic.penetration.zones.scab_depth`) is the
+    depth of the rear zone above a debonded interface."""
 
     layers: tuple
     thicknesses: tuple
+    bottoms: tuple = ()
+    scab_depths: tuple = ()
 
     def __post_init__(self):
         object.__setattr__(self, "layers", tuple(self.layers))
@@ -113,6 +127,23 @@ class Target:
         require(len(self.layers) >= 1, "layers", "at least one layer", len(self.layers))
         require(len(self.thicknesses) == len(self.layers) - 1, "thickness",
                 "given for every layer but the last (semi-infinite)", len(self.thicknesses))
+        n = len(self.thicknesses)
+        bottoms = tuple(self.bottoms) or ("bonded",) * n
+        scabs = tuple(self.scab_depths) or (None,) * n
+        require(len(bottoms) == n, "bottom", "given for every layer but the last (none: "
+                "all bonded)", len(bottoms))
+        require(len(scabs) == n, "scab_depth", "given for every layer but the last (None: "
+                "the default rule)", len(scabs))
+        for i, (bottom, scab) in enumerate(zip(bottoms, scabs, strict=True)):
+            require(bottom in BONDINGS, f"layers[{i}].bottom", "one of " + ", ".join(BONDINGS),
+                    bottom)
+            if scab is not None:
+                require(is_finite_number(scab) and 0.0 < scab < self.thicknesses[i],
+                        f"layers[{i}].scab_depth", f"in (0, {self.thicknesses[i]:g}) m (within "
+                        "the layer)", scab)
+        object.__setattr__(self, "bottoms", bottoms)
+        object.__setattr__(self, "scab_depths", tuple(None if s is None else float(s)
+                                                      for s in scabs))
         depth = 0.0
         for i, h in enumerate(self.thicknesses):
             _positive(f"layers[{i}].thickness", h)
@@ -125,6 +156,20 @@ class Target:
     def interface_depths(self):
         """Depths ``H_1 < H_2 < ...`` of the layer interfaces below the free surface (m)."""
         return tuple(accumulate(self.thicknesses))
+
+    @property
+    def debonded(self):
+        """Indices ``j`` of the debonded interfaces (``interface_depths[j]``), top down."""
+        return tuple(j for j, bottom in enumerate(self.bottoms) if bottom == "debonded")
+
+    def with_interfaces(self, bonding):
+        """This target with every interface ``bonding`` (:data:`BONDINGS`; None: unchanged):
+        what ``--interfaces`` does to the file's ``bottom`` keys."""
+        if bonding is None:
+            return self
+        require(bonding in BONDINGS, "interfaces", "one of " + ", ".join(BONDINGS), bonding)
+        return Target(self.layers, self.thicknesses, (bonding,) * len(self.thicknesses),
+                      self.scab_depths)
 
     def layer_at(self, depth):
         """Index of the layer containing ``depth`` (interfaces belong to the deeper layer)."""

@@ -79,6 +79,14 @@ def test_overload_peaks_are_the_prominent_maxima():
     g += 5.0 * np.sin(200.0 * z)  # ripple: 0.5 % of the largest peak, not a peak
     peaks = overload_peaks({"axial_g": g, "tip_z_m": z})
     assert [round(p, 2) for p, _ in peaks] == [0.3, 0.7]
+    # a peak counts by its rise above the dip before it: a smaller one before a larger one,
+    # and one on a falling shoulder that rises 10 % above its dip (not 5 % of the largest)
+    g = 400.0 * np.exp(-((z - 0.3) / 0.05) ** 2) + 1000.0 * np.exp(-((z - 0.7) / 0.05) ** 2)
+    assert [round(p, 2) for p, _ in overload_peaks({"axial_g": g, "tip_z_m": z})] == [0.3, 0.7]
+    g = np.interp(z, [0.0, 0.1, 0.5, 0.55, 1.0], [0.0, 1000.0, 300.0, 330.0, 0.0])
+    assert [round(p, 2) for p, _ in overload_peaks({"axial_g": g, "tip_z_m": z})] == [0.1, 0.55]
+    g = np.interp(z, [0.0, 0.1, 0.5, 0.55, 1.0], [0.0, 1000.0, 300.0, 310.0, 0.0])
+    assert [round(p, 2) for p, _ in overload_peaks({"axial_g": g, "tip_z_m": z})] == [0.1]
 
 
 def _shot(o, v, target, change, deep, peaks, depth, ramp=RAMPS[0]):

@@ -11,7 +11,7 @@ import sys
 from cavex import __version__
 from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
-from cavex.verification.commands.options import add_resistance_options
+from cavex.verification.commands.options import add_interface_option, add_resistance_options
 
 DEFAULT_PENETRATION_DIR = "results/penetration"
 
@@ -59,6 +59,7 @@ def build_parser():
     penetrate = commands.add_parser("penetrate", help="integrate the projectile through the target")
     _config(penetrate)
     add_resistance_options(penetrate)
+    add_interface_option(penetrate)
     penetrate.add_argument("--json", action="store_true", help="print JSON")
     penetrate.add_argument("--out", default=DEFAULT_PENETRATION_DIR, help="output folder")
     _figures(penetrate, "the CSV trajectories and phase table")
@@ -136,6 +137,7 @@ def build_parser():
                             "in the plane of obliquity toward +x)")
     trajectory.add_argument("--spin", type=float, default=0.0, help="spin about the axis (rad/s)")
     add_resistance_options(trajectory, ("derived", "paper", "table", "law"))
+    add_interface_option(trajectory)
     trajectory.add_argument("--contact-ramp", dest="contact_ramp", type=float, default=None,
                             help="contact regularisation: the stress rises linearly over "
                             "0 < V_n < this (m/s; default 0.01; docs/oblique.md)")

@@ -18,16 +18,17 @@ The resistance is any :class:`~cavex.analytic.penetration.resistance.Resistance`
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from cavex.errors import CavexNumericalError, require_choice
+from cavex.analytic.penetration.zones import CRATER_MODES, CRATER_RATIO, crater_depth, scab_depth
+from cavex.errors import CavexNumericalError
 
-CRATER_MODES = ("nose-base", "nose-tip")
-CRATER_RATIO = 4.5
+__all__ = ["CRATER_MODES", "CRATER_RATIO", "crater_depth", "penetrate", "integrate"]
+
 STOPPED = "projectile stopped"
 STATE_CHANGED = "response state changed"
 DEPTH_REACHED = "stop depth reached"
@@ -38,13 +39,16 @@ MAX_PHASE_DURATION = 10.0  # s; a phase that has not ended by then is a numerica
 @dataclass(frozen=True)
 class Phase:
     """One phase of the trajectory: its label (None where :func:`integrate` did not watch the
-    state) and where and when it ends."""
+    state), where and when it ends, and its stage (:data:`~cavex.analytic.penetration.zones.
+    STAGES`: "crater", "tunnel", or "rear face" in the rear zone above a debonded
+    interface)."""
 
     label: str
     end_depth: float
     end_velocity: float
     end_time: float
     end_reason: str
+    stage: str = "tunnel"
 
 
 @dataclass(frozen=True)
@@ -64,16 +68,10 @@ class Trajectory:
                 "deceleration_m_s2": self.deceleration, "phase": self.phase}
 
 
-def crater_depth(projectile, crater="nose-base"):
-    """Nose-tip depth at the end of the crater stage (m)."""
-    require_choice(crater, CRATER_MODES, "crater")
-    length = CRATER_RATIO * projectile.r
-    return length + projectile.l if crater == "nose-base" else length
-
-
-def crater_exit(projectile, force, depth):
-    """Exit velocity ``V_c`` and stiffness ``K`` of the crater: ``m (V0^2 - Vc^2) = L_c F(Vc)``."""
-    m, v0 = projectile.m, projectile.V0
+def crater_exit(projectile, force, depth, speed=None):
+    """Exit velocity ``V_c`` and stiffness ``K`` of the crater: ``m (V0^2 - Vc^2) = L_c F(Vc)``
+    (``speed``: the velocity ``V0`` at the crater's start; None: the striking velocity)."""
+    m, v0 = projectile.m, projectile.V0 if speed is None else speed
 
     def balance(v):
         return m * (v0 ** 2 - v ** 2) - depth * force(v)
@@ -85,19 +83,26 @@ def crater_exit(projectile, force, depth):
     return vc, m * (v0 ** 2 - vc ** 2) / depth ** 2
 
 
-def crater_stage(projectile, force, depth, samples=50):
-    """Crater trajectory samples ``(t, L, V, a)`` and the exit ``(t_c, V_c)``."""
-    vc, stiffness = crater_exit(projectile, force, depth)
+def crater_stage(projectile, force, depth, samples=50, start=None):
+    """Crater trajectory samples ``(t, L, V, a)`` and the exit ``(t_c, V_c)``, from
+    ``start = (t0, L0, V0)`` (None: the entry face, ``(0, 0, V_0)``): ``L = L0 + V0/omega
+    sin(omega (t - t0))``, ``V = V0 cos(omega (t - t0))``, ``omega = sqrt(K/m)``, for a nose-tip
+    travel ``depth`` (:func:`cavex.analytic.penetration.zones.crater_depth`)."""
+    t0, depth0, v0 = (0.0, 0.0, projectile.V0) if start is None else start
+    vc, stiffness = crater_exit(projectile, force, depth, v0)
     omega = math.sqrt(stiffness / projectile.m)
     if not omega > 0.0:  # V_c = V0 to round-off: a mass that the target cannot slow
         raise CavexNumericalError(f"the crater does not slow the projectile (m = "
-                                  f"{projectile.m:g} kg, V0 = {projectile.V0:g} m/s)")
-    tc = math.acos(vc / projectile.V0) / omega
+                                  f"{projectile.m:g} kg, V0 = {v0:g} m/s)")
+    tc = math.acos(vc / v0) / omega
     t = np.linspace(0.0, tc, samples)
-    depths = projectile.V0 / omega * np.sin(omega * t)
-    velocity = projectile.V0 * np.cos(omega * t)
+    depths = v0 / omega * np.sin(omega * t)
+    velocity = v0 * np.cos(omega * t)
     depths[-1], velocity[-1] = depth, vc  # the exit state exactly, not re-rounded
-    return (t, depths, velocity, stiffness * depths / projectile.m), tc, vc
+    deceleration = stiffness * depths / projectile.m
+    if start is not None:
+        t, depths = t + t0, depths + depth0
+    return (t, depths, velocity, deceleration), t0 + tc, vc
 
 
 def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, atol=ATOL):
@@ -106,9 +111,14 @@ def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, 
     Parameters
     ----------
     target, projectile : Target, Projectile
+        At a debonded interface (``target.debonded``; docs/analytic.md "Debonded
+        interfaces") the phase ends where the nose tip enters the rear zone (then stage "rear
+        face") and where it reaches the interface; a crater stage in the next layer follows.
     resistance : Resistance
+        With a debonded interface, one that has ``layer_force(index, V)`` (the crater medium
+        below it): :class:`~cavex.analytic.penetration.resistance.ClosedFormResistance`.
     crater : {"nose-base", "nose-tip"}
-        Where the crater depth ``4.5 r`` is measured from; ``None`` skips the crater stage.
+        Where the crater depth ``4.5 r`` is measured from; ``None`` skips the crater stages.
 
     Returns
     -------
@@ -121,30 +131,72 @@ def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, 
         depth0 = crater_depth(projectile, crater)
         samples, t0, v0 = crater_stage(projectile, resistance.crater_force, depth0)
         _append(columns, *samples, 0)
-        phases.append(Phase("crater", depth0, v0, t0, "crater depth reached"))
+        phases.append(Phase("crater", depth0, v0, t0, "crater depth reached", "crater"))
     return _tunnel(target, projectile, resistance, (t0, depth0, v0), columns, phases,
-                   rtol=rtol, atol=atol)
+                   crater=crater, rtol=rtol, atol=atol)
 
 
-def _tunnel(target, projectile, resistance, start, columns, phases, rtol, atol):
-    """Phases from ``start = (t0, L0, V0)`` to rest, each ended by :func:`integrate`."""
+def phase_stops(target, projectile):
+    """``[(depth, reason, next stage)]``: where a tunnel phase ends by the nose tip's depth.
+    A bonded interface ``H`` ends it (stage "tunnel" goes on); a debonded one twice: at the
+    rear zone's top ``H - s`` ("rear face") and at ``H`` ("crater": the next layer's crater
+    stage follows)."""
+    stops = []
+    for j, H in enumerate(target.interface_depths):
+        reached = f"nose tip reached interface {j + 1}"
+        if target.bottoms[j] == "debonded":
+            stops.append((H - scab_depth(target, projectile, j),
+                          f"nose tip reached the rear zone of interface {j + 1}", "rear face"))
+            stops.append((H, reached + " (debonded)", "crater"))
+        else:
+            stops.append((H, reached, "tunnel"))
+    return stops
+
+
+def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol, atol):
+    """Phases from ``start = (t0, L0, V0)`` to rest, each ended by :func:`integrate` (and a
+    crater stage below each debonded interface, :func:`phase_stops`)."""
     label = resistance.label(start[1], start[2])
-    ahead = [H for H in target.interface_depths if H > start[1]]
+    stops = phase_stops(target, projectile)
+    ahead = [stop for stop in stops if stop[0] > start[1]]
+    stage = "rear face" if any(s[2] == "rear face" and s[0] <= start[1] < d[0]
+                               for s, d in zip(stops, stops[1:], strict=False)) else "tunnel"
     while start[2] > 0.0:
-        stop_depth, stop_reason = None, None
-        if ahead:
-            number = len(target.interface_depths) - len(ahead) + 1
-            stop_depth, stop_reason = ahead[0], f"nose tip reached interface {number}"
+        stop_depth, stop_reason = (ahead[0][0], ahead[0][1]) if ahead else (None, None)
         phase, sol = integrate(resistance, projectile.m, start, stop_depth=stop_depth,
                                stop_reason=stop_reason, label=label, rtol=rtol, atol=atol)
-        if phase.end_reason == stop_reason:
-            ahead.pop(0)
         _append_solution(columns, sol, phase.end_time, resistance, projectile.m, len(phases))
-        phases.append(phase)
+        phases.append(replace(phase, stage=stage))
         start = (phase.end_time, phase.end_depth, phase.end_velocity)
+        if phase.end_reason == stop_reason:
+            stage = ahead.pop(0)[2]
+            if stage == "crater":
+                start = _interface_crater(target, projectile, resistance, start, columns,
+                                          phases, crater)
+                stage = "tunnel"
+                ahead = [stop for stop in ahead if stop[0] > start[1]]
+                if start[2] > 0.0:
+                    label = resistance.label(start[1], start[2])
+                continue
         if start[2] > 0.0:
             label = _next_label(resistance, sol, phase.end_time, label)
     return _trajectory(columns, phases)
+
+
+def _interface_crater(target, projectile, resistance, start, columns, phases, crater):
+    """The crater stage of the layer below a debonded interface, from ``start = (t, H, V)``
+    at the interface: the entry crater's closed form (:func:`crater_stage`) with that layer's
+    single-medium force; returns the state at its end (``crater`` None: no crater, ``start``)."""
+    if crater is None or start[2] <= 0.0:
+        return start
+    index = target.layer_at(start[1])
+    length = crater_depth(projectile, crater)
+    samples, t_end, v_end = crater_stage(
+        projectile, lambda v: resistance.layer_force(index, v), length, start=start)
+    _append(columns, *samples, len(phases))
+    phases.append(Phase("crater", samples[1][-1], v_end, t_end,
+                        f"crater depth reached ({target.layer_name(index)})", "crater"))
+    return t_end, float(samples[1][-1]), v_end
 
 
 def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REACHED,

@@ -39,6 +39,7 @@ from cavex.analytic.penetration.surface_force import (
     rotation_matrix,
     surface_loads,
 )
+from cavex.analytic.penetration.zones import open_zones
 from cavex.errors import CavexNumericalError, is_finite_number, require
 from cavex.materials import MAX_VELOCITY
 
@@ -188,7 +189,7 @@ class ObliqueModel:
     """
 
     def __init__(self, target, projectile, law, *, body=None, bottom=None, rtol=RTOL,
-                 atol=ATOL, method=METHOD, contact_ramp=None):
+                 atol=ATOL, method=METHOD, contact_ramp=None, crater="nose-base"):
         self.target, self.projectile, self.law = target, projectile, law
         self.body = body or build_body(projectile)
         self.bottom = bottom
@@ -201,17 +202,32 @@ class ObliqueModel:
         b = self.body
         self._p = b.points
         self._inertia = b.inertia
-        self._surface = (b.points, b.normals, b.areas, b.sizes, b.partners, b.length, self.mu,
-                         self.contact_ramp, np.inf if bottom is None else float(bottom), *law.data)
+        # the zones of the debonded interfaces (zones.open_zones), each opened by the event of
+        # the nose tip crossing its top; none for a bonded target
+        self.zones = open_zones(target, projectile, crater) if target.debonded else []
+        tops = [top for top, _ in self.zones]
+        self._zone_tops = sorted({t for t in tops if t not in target.interface_depths})
+        self._open_zones(0.0)
         self._tip = b.tip
         self.evaluations = 0
         self._step = None  # the compiled integrator's next step, kept across phases
 
+    def _open_zones(self, depth):
+        """Open every zone whose top is at or above the nose-tip depth ``depth`` (a zone once
+        open stays open) and rebuild the compiled surface arguments."""
+        b = self.body
+        self.opened = np.array([z for z in self.zones if z[0] < depth or (
+            z[0] == depth and depth > 0.0)], dtype=float).reshape(-1, 2)
+        self._surface = (b.points, b.normals, b.areas, b.sizes, b.partners, b.length, self.mu,
+                         self.contact_ramp, np.inf if self.bottom is None else float(self.bottom),
+                         b.nose, self.opened, *self.law.data)
+
     # -- forces ---------------------------------------------------------------------------
-    def loads(self, y):
+    def loads(self, y, surface=None):
         """``(F, M_body, power, rotation)``: total surface force (target frame), moment about
-        the centre of mass (body frame), power of the surface forces, rotation matrix."""
-        force, moment, power, status, vn, _ = surface_loads(y, *self._surface)
+        the centre of mass (body frame), power of the surface forces, rotation matrix
+        (``surface``: the compiled surface arguments of a phase; None: the current ones)."""
+        force, moment, power, status, vn, _ = surface_loads(y, *(surface or self._surface))
         if status != OK:
             raise_for(status, vn)
         return force, moment, power, rotation_matrix(y[3:7])
@@ -266,6 +282,9 @@ class ObliqueModel:
         depths = np.asarray(self.target.interface_depths, dtype=float)
         described = [(f"nose tip crossed interface {j + 1} (z = {H:g} m)", True, j)
                      for j, H in enumerate(depths)]
+        described += [(f"nose tip reached a rear zone (z = {top:g} m)", True, None)
+                      for top in self._zone_tops]
+        depths = np.concatenate([depths, self._zone_tops])
         described += [(RICOCHET, False, None), (PERFORATION, False, None),
                       ("axis parallel to the surface", True, None), (STOPPED, False, None)]
         directions = np.zeros(len(described))
@@ -278,13 +297,15 @@ class ObliqueModel:
 
     def event_values(self, y, args):
         return event_values(y, self.body.mass, self._inertia, args,
-                            np.empty(len(self.target.interface_depths) + 4))
+                            np.empty(args[2].size + 4))
 
     def run(self, strike, max_phases=50, progress=None):
         """Integrate ``strike`` to a final event; returns a :class:`Result`. ``progress``:
         optional ``callable(t, y)`` called after every integrator step."""
         y = self.initial_state(strike)
         self._step = None  # every run starts afresh: the same shot, the same bits
+        self._open_zones(0.0)
+        surfaces = []  # the surface arguments (open zones) of each phase
         self._min_step = MIN_STEP * self.body.length / strike.speed
         directions, described, args = self._events(y)
         g = self.event_values(y, args)
@@ -298,23 +319,28 @@ class ObliqueModel:
         for _ in range(max_phases):
             sol, which = phase(t0, y, directions, args, progress)
             sols.append(sol)
+            surfaces.append(self._surface)
             t0, y = sol.t[-1], sol.y[:, -1].copy()
+            start_pitch = phases[-1]["end_pitch_deg"] if phases else float(
+                pitch_yaw(self.axis(sol.y[:, 0]))[0])
             if which is None:
                 reason = "time limit"
-                phases.append(self._phase(label, t0, y, reason))
+                phases.append(self._phase(label, t0, y, reason, start_pitch))
                 break
             reason, crossing, interface = described[which]
-            phases.append(self._phase(label, t0, y, reason))
+            phases.append(self._phase(label, t0, y, reason, start_pitch))
             if crossing:
                 if interface is not None:  # the layer the tip has just entered
                     label = self.target.layer_name(interface + 1 if directions[which] > 0
                                                    else interface)
+                if directions[which] > 0 and self.zones:  # deeper: zones open at this top
+                    self._open_zones(float(args[2][which]))
                 directions[which] = -directions[which]
             else:
                 break
         else:
             raise CavexNumericalError(f"more than {max_phases} phases")
-        history = self._history(sols)
+        history = self._history(sols, surfaces)
         return Result(history=history, phases=phases, end=self._end_state(y, t0, reason),
                       solutions=sols, model=self)
 
@@ -379,11 +405,13 @@ class ObliqueModel:
     def phase_label(self, y):
         return self.target.layer_name(self.target.layer_at(max(self.tip(y)[2], 0.0)))
 
-    def _phase(self, label, t, y, reason):
+    def _phase(self, label, t, y, reason, start_pitch):
+        """One phase's summary; ``pitch_change_deg``: its end pitch minus ``start_pitch``."""
         end = self._end_state(y, t, reason)
         return {"label": label, "end_reason": reason, "end_time_s": end["time_s"],
                 "end_nose_tip_m": end["nose_tip_m"], "end_pitch_deg": end["pitch_deg"],
-                "end_speed_m_s": end["speed_m_s"]}
+                "end_speed_m_s": end["speed_m_s"],
+                "pitch_change_deg": end["pitch_deg"] - start_pitch}
 
     def _end_state(self, y, t, reason):
         pitch, yaw = pitch_yaw(self.axis(y))
@@ -395,16 +423,17 @@ class ObliqueModel:
                 "speed_m_s": float(np.linalg.norm(y[7:10])),
                 "work_J": float(y[13])}
 
-    def _history(self, sols):
+    def _history(self, sols, surfaces):
         t = np.concatenate([s.t if i == 0 else s.t[1:] for i, s in enumerate(sols)])
         Y = np.concatenate([s.y if i == 0 else s.y[:, 1:] for i, s in enumerate(sols)], axis=1)
+        phase_of = np.concatenate([np.full(s.t.size - (i > 0), i) for i, s in enumerate(sols)])
         n = t.size
         out = {k: np.empty(n) for k in (
             "pitch_deg", "yaw_deg", "axial_g", "lateral_g")}
         tips, forces, moments, omegas = (np.empty((n, 3)) for _ in range(4))
         for i in range(n):
             y = Y[:, i]
-            force, moment, _, rot = self.loads(y)
+            force, moment, _, rot = self.loads(y, surfaces[phase_of[i]])
             axis = rot[:, 0]
             tips[i] = y[0:3] + rot @ self._tip
             forces[i], moments[i] = force, rot @ moment
@@ -439,10 +468,39 @@ def fly(target, projectile, strike=None, resistance="derived", *, body=None, bot
     """One trajectory: :class:`Result` of ``strike`` (default: normal incidence at ``V0``);
     ``progress(t, y)`` is called after every integrator step."""
     strike = strike or Strike(projectile.V0)
+    require(resistance == "derived" or not target.debonded, "interfaces",
+            "'bonded' unless the resistance is 'derived' (a debonded interface needs its "
+            "traction-free sphere)", "debonded")
     law = make_law(target, projectile, resistance, bottom=bottom, **law_options)
     model = ObliqueModel(target, projectile, law, body=body, bottom=bottom, rtol=rtol,
                          atol=atol, method=method, contact_ramp=contact_ramp)
     return model.run(strike, progress=progress)
+
+
+PEAK_RISE = 0.05  # of the peak's own value
+PEAK_SPAN = 0.04  # m of nose-tip travel, about the nose length (0.0415 m for Table 1)
+
+
+def overload_peaks(history, rise=PEAK_RISE, span=PEAK_SPAN):
+    """Nose-tip depths (m) and values (g) of the peaks of the axial overload: samples ``g_i``
+    that are the largest over the next ``span`` of nose-tip travel (``[z_i, z_i + span]``),
+    rise above the dip before them, the smallest over ``[z_i - span, z_i]``, by at least
+    ``rise`` x ``g_i``, and reach ``rise`` x the shot's largest overload. A peak counts by the
+    rise it makes, not by what follows (a peak entering a stronger layer is not hidden by a
+    larger overload later); the forward span drops the ripples of a rising overload (the nose's
+    element rings entering one by one) and keeps one peak per nose length of travel."""
+    g, z = np.asarray(history["axial_g"]), np.asarray(history["tip_z_m"])
+    found = []
+    for i in range(1, g.size - 1):
+        if not (g[i] >= g[i - 1] and g[i] > g[i + 1] and g[i] >= rise * g.max()):
+            continue
+        ahead = (z >= z[i]) & (z <= z[i] + span)
+        before = (z >= z[i] - span) & (z <= z[i])
+        ahead[:i] = False  # the path is not monotone in depth: only later samples ahead
+        before[i + 1:] = False  # and earlier ones before
+        if g[ahead].max() <= g[i] and g[i] - g[before].min() >= rise * g[i]:
+            found.append((float(z[i]), float(g[i])))
+    return found
 
 
 def peaks(history):

@@ -110,6 +110,9 @@ class ClosedFormResistance(Resistance):
     def __init__(self, target, projectile, model="derived", boundary=None,
                  switch=None, epsilon="quasi-static"):
         check_model(model, boundary)
+        require(model == "derived" or not target.debonded, "interfaces",
+                "'bonded' for the paper model (a debonded interface needs the derived closed "
+                "form's traction-free sphere)", "debonded")
         boundary = model_boundary(model, boundary)
         self.target, self.projectile = target, projectile
         self.model, self.boundary, self.epsilon = model, boundary, epsilon
@@ -119,7 +122,12 @@ class ClosedFormResistance(Resistance):
             target.single(0), projectile, model, boundary, switch, epsilon)
         self._paper = PaperModel(target, projectile, epsilon) if model == "paper" else None
         n = len(target.layers)
-        self._tables = [material_table(tuple(target.layers[i:])) for i in range(n)]
+        # the layers the cavity in layer i sees: down to the first debonded interface below
+        # (its radius is then a traction-free sphere), else all (docs/analytic.md)
+        self._ends = [next((j for j in target.debonded if j >= i), None) for i in range(n)]
+        self._tables = [material_table(tuple(target.layers[i:(n if end is None else end + 1)]))
+                        for i, end in enumerate(self._ends)]
+        self._layer_forces = {}
         self._names = target.layer_names()
         self._cosines, self._weights = nose_rule(projectile)
         self._dynamic = boundary == "dynamic"
@@ -144,6 +152,17 @@ class ClosedFormResistance(Resistance):
     def crater_force(self, velocity):
         """Force of the single-medium model of the first layer (used by the crater stage)."""
         return (self._single or self).force(0.0, velocity)
+
+    def layer_force(self, index, velocity):
+        """Force of the single-medium model of layer ``index`` (the crater stage below a
+        debonded interface; layer 0: :meth:`crater_force`)."""
+        if index == 0:
+            return self.crater_force(velocity)
+        if index not in self._layer_forces:
+            self._layer_forces[index] = ClosedFormResistance(
+                self.target.single(index), self.projectile, self.model, self.boundary,
+                self.switch, self.epsilon)
+        return self._layer_forces[index].force(0.0, velocity)
 
     def evaluate(self, depth, velocity):
         """``(force, label parts)`` at ``(depth, velocity)``: the derived model's label as the
@@ -175,9 +194,14 @@ class ClosedFormResistance(Resistance):
         first, interfaces = surrounding(self.target.interface_depths, self.projectile, depth,
                                         self.switch)
         codes = self._codes
+        end, free_radius = self._ends[first], np.inf
+        if end is not None:  # a debonded interface below: a traction-free sphere there
+            free_radius = interfaces[end - first]
+            interfaces = interfaces[:end - first]
         first_part, second_part, failed = nose_walk(
             self._tables[first], np.array([interfaces]).reshape(1, len(interfaces)),
-            float(velocity), self._cosines, self._weights, self._r, self._dynamic, codes)
+            float(velocity), self._cosines, self._weights, self._r, self._dynamic, codes,
+            free_radius)
         if failed:
             raise CavexNumericalError("dynamic elastic-plastic boundary did not converge "
                                       f"(V <= {velocity} m/s, depth {depth} m)")

@@ -72,24 +72,25 @@ def _lerp(x, x0, dx, column, values):
 
 
 @njit(cache=True, error_model="numpy")
-def _derived(scalars, tables, counts, depths, z, nz, vn, radii, zones):
+def _derived(scalars, faces, tables, counts, depths, z, nz, vn, radii, zones):
     """Layered cavity-expansion wall stress of an element (see the module docstring)."""
-    a, free_surface, bottom, dynamic = scalars[0], scalars[1], scalars[2], scalars[3] > 0.0
+    a, bottom, dynamic = scalars[0], scalars[2], scalars[3] > 0.0
     n = depths.shape[0] + 1
     k = np.searchsorted(depths, z, side="right")  # the element's own layer
     c = np.inf
-    if nz > HORIZONTAL:  # down: layers k, k + 1, ..., then the bottom
+    if nz > HORIZONTAL:  # down: layers k, k + 1, ..., then the bottom or a debonded face
         group = k
-        for j in range(n - 1 - k):
+        for j in range(counts[group] - 1):
             radii[0, j] = a + min(max((depths[k + j] - z) / nz, 1e-12), FAR)
-        if bottom < np.inf:
-            c = a + (bottom - z) / nz
-    elif nz < -HORIZONTAL:  # up: layers k, k - 1, ..., then the free surface
+        face = min(bottom, faces[0, k])
+        if face < np.inf:
+            c = a + (face - z) / nz
+    elif nz < -HORIZONTAL:  # up: layers k, k - 1, ..., then the free surface or an open face
         group = n + k
-        for j in range(k):
+        for j in range(counts[group] - 1):
             radii[0, j] = a + min(max((z - depths[k - 1 - j]) / (-nz), 1e-12), FAR)
-        if free_surface > 0.0:
-            c = a + z / (-nz)
+        if faces[1, k] > -np.inf:
+            c = a + (z - faces[1, k]) / (-nz)
     else:
         group = 2 * n + k
     props = tables[group, :counts[group]]
@@ -107,10 +108,12 @@ def element_stress(kind, scalars, values, tables, counts, depths, z, nz, vn, rad
     ``scalars`` per kind: ``DEPTH_QUADRATIC`` ``(offset, L_0, dL)`` with ``values[:, 0:2] =
     (s_0, s_2)``; ``TABLE`` ``(offset, L_0, dL, dV2)`` with ``values[i, j]`` at
     ``(L_0 + i dL, j dV2)``; ``DERIVED`` ``(a, free surface, bottom, dynamic)`` with the
-    material tables of every (own layer, direction) group. ``radii`` ``(1, >= n - 1)`` and
+    material tables of every (own layer, direction) group and ``values`` the traction-free
+    faces ``(2, n)`` below and above each layer (``inf`` / ``-inf``: none). ``radii``
+    ``(1, >= n - 1)`` and
     ``zones`` ``(0, 1, 2)`` are scratch."""
     if kind == DERIVED:
-        return _derived(scalars, tables, counts, depths, z, nz, vn, radii, zones)
+        return _derived(scalars, values, tables, counts, depths, z, nz, vn, radii, zones)
     depth = z + scalars[0]
     if kind == DEPTH_QUADRATIC:
         return (_lerp(depth, scalars[1], scalars[2], 0, values)
@@ -181,8 +184,13 @@ class DerivedLaw(_Law):
         self.free_surface, self.bottom = free_surface, bottom
         layers = target.layers
         n = len(layers)
-        # groups: 0..n-1 down from layer k, n..2n-1 up from layer k, 2n..3n-1 horizontal
-        sequences = ([layers[k:] for k in range(n)] + [layers[k::-1] for k in range(n)]
+        faces = traction_free_faces(target, free_surface)
+        # groups: 0..n-1 down from layer k, n..2n-1 up from layer k, 2n..3n-1 horizontal; a
+        # group ends at a debonded interface (its face is traction-free)
+        below = [next((j for j in target.debonded if j >= k), n - 1) for k in range(n)]
+        above = [max((j + 1 for j in target.debonded if j < k), default=0) for k in range(n)]
+        sequences = ([layers[k:below[k] + 1] for k in range(n)]
+                     + [layers[k:above[k] - 1 if above[k] else None:-1] for k in range(n)]
                      + [(layers[k],) for k in range(n)])
         tables = np.zeros((3 * n, n, 6))
         counts = np.array([len(s) for s in sequences], dtype=np.int64)
@@ -191,8 +199,22 @@ class DerivedLaw(_Law):
         scalars = np.array([self.radius, 1.0 if free_surface else 0.0,
                             np.inf if bottom is None else float(bottom),
                             1.0 if boundary == "dynamic" else 0.0])
-        self.data = (DERIVED, scalars, _EMPTY2, tables, counts,
+        self.data = (DERIVED, scalars, faces, tables, counts,
                      np.asarray(target.interface_depths, dtype=float))
+
+
+def traction_free_faces(target, free_surface=True):
+    """``(2, n)``: for each layer the depth of the traction-free face its downward normals
+    meet, the first debonded interface below (``inf``: none), and that its upward normals
+    meet, the last debonded interface above, else the free surface ``0`` (``-inf`` without
+    ``free_surface``)."""
+    depths, n = target.interface_depths, len(target.layers)
+    faces = np.empty((2, n))
+    for k in range(n):
+        faces[0, k] = next((depths[j] for j in target.debonded if j >= k), np.inf)
+        faces[1, k] = max((depths[j] for j in target.debonded if j < k),
+                          default=0.0 if free_surface else -np.inf)
+    return faces
 
 
 class PaperLaw(_Law):

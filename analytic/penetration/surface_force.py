@@ -11,7 +11,10 @@ surface forces. For surface element ``i`` (body-frame centroid ``p_i``, outward 
     V_n = \mathbf u \cdot \mathbf n, \quad z = x_3 + p_3,
 
 embedded fraction ``w = clip(1/2 + z/h_i, 0, 1)`` (and ``clip(1/2 + (z_b - z)/h_i, 0, 1)`` at
-a finite bottom ``z_b``). A wetted element (``w > 0`` and ``V_n > 10^-9 (|v| + L |omega|)``,
+a finite bottom ``z_b``; for a shank element and each open zone ``[z_t, z_b]``
+(:func:`cavex.analytic.penetration.zones.open_zones`, opened by the integrator's events) at
+most ``1 - |[z - h_i/2, z + h_i/2] ∩ [z_t, z_b]| / h_i``: no tunnel wall in a crater or a
+scabbed rear zone). A wetted element (``w > 0`` and ``V_n > 10^-9 (|v| + L |omega|)``,
 the round-off guard) carries the load ``P = A_i w sigma_n(z, n_3, V_n) min(V_n / V_r, 1)``
 (contact regularisation over ``0 < V_n < V_r``, ``V_r`` = ``contact_ramp``; 0: none), force
 
@@ -111,7 +114,8 @@ def mirror_state(y):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, contact_ramp, bottom,
-                  kind, scalars, values, tables, counts, depths, radii, zones, out, damping):
+                  nose, open_zones, kind, scalars, values, tables, counts, depths, radii, zones,
+                  out, damping):
     """Force, moment about the centre of mass (target frame) and power of element ``i``
     into ``out[0:7]``, its contact damping ``kappa b a^T`` (module docstring, target frame)
     into ``damping``; returns ``(status, V_n)``."""
@@ -124,6 +128,12 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
     frac = min(max(0.5 + z / sizes[i], 0.0), 1.0)
     if bottom < np.inf:
         frac = min(frac, min(max(0.5 + (bottom - z) / sizes[i], 0.0), 1.0))
+    if not nose[i]:  # the shank carries no load in an open zone (crater, scabbed rear zone)
+        for k in range(open_zones.shape[0]):
+            half = 0.5 * sizes[i]
+            inside = min(z + half, open_zones[k, 1]) - max(z - half, open_zones[k, 0])
+            if inside > 0.0:
+                frac = min(frac, max(1.0 - inside / sizes[i], 0.0))
     if frac <= 0.0:
         return OK, 0.0
     n0 = rot[0, 0] * normals[i, 0] + rot[0, 1] * normals[i, 1] + rot[0, 2] * normals[i, 2]
@@ -168,7 +178,7 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
 
 @njit(cache=True, error_model="numpy")
 def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
-                  kind, scalars, values, tables, counts, depths):
+                  nose, open_zones, kind, scalars, values, tables, counts, depths):
     """``(F (3, target frame), M (3, body frame), power, status, V_n of a failed element,
     C)`` of the surface forces in state ``y`` (module docstring; the law arrays are
     ``law.data``; ``C = diag(1, R^T) (sum kappa b a^T) diag(1, R)``, the contact damping
@@ -197,8 +207,9 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contac
             continue
         for second in range(2 if j != i else 1):
             status, vn = _element_load(j if second else i, y, rot, omega, scale, points,
-                                       normals, areas, sizes, mu, contact_ramp, bottom, kind,
-                                       scalars, values, tables, counts, depths, radii, zones,
+                                       normals, areas, sizes, mu, contact_ramp, bottom, nose,
+                                       open_zones, kind, scalars, values, tables, counts,
+                                       depths, radii, zones,
                                        other if second else one,
                                        other_damping if second else one_damping)
             if status == BEYOND_TABLE:
@@ -230,12 +241,12 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contac
 
 @njit(cache=True, error_model="numpy")
 def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length, mu, contact_ramp,
-               bottom, kind, scalars, values, tables, counts, depths):
+               bottom, nose, open_zones, kind, scalars, values, tables, counts, depths):
     """``(dy/dt, D, status, V_n of a failed element)`` (module docstring; ``D`` the 6 x 6
     contact damping block of the Jacobian)."""
     force, moment, power, status, vn, damping = surface_loads(
         y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
-        kind, scalars, values, tables, counts, depths)
+        nose, open_zones, kind, scalars, values, tables, counts, depths)
     dy = np.empty(14)
     q0, q1, q2, q3 = y[3], y[4], y[5], y[6]
     w0, w1, w2 = y[10], y[11], y[12]

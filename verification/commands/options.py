@@ -25,6 +25,7 @@ from cavex.analytic.penetration.labels import (
     model_boundary,
 )
 from cavex.errors import CavexInputError
+from cavex.materials import BONDINGS
 from cavex.problem import BOUNDARIES
 
 CLOSED_FORMS = MODELS  # the resistances that are closed forms
@@ -93,3 +94,23 @@ def resistance_settings(args, offered=RESISTANCES):
             "boundary": model_boundary(resistance if resistance in CLOSED_FORMS else "derived",
                                        args.boundary),
             "epsilon": getattr(args, "epsilon", "quasi-static"), "table": table}
+
+
+def add_interface_option(command):
+    """``--interfaces bonded|debonded``: every interface of the target so, overriding the
+    config file's ``bottom`` keys (default: as the file says; docs/config.md)."""
+    command.add_argument("--interfaces", choices=BONDINGS, default=None,
+                         help="every interface bonded or debonded (a traction-free rear face, "
+                         "a rear zone and a crater in the next layer; docs/analytic.md); "
+                         "default: each layer's 'bottom' key in the config (bonded)")
+
+
+def interface_target(args, target, resistance):
+    """``target`` with ``--interfaces`` applied, checked: a debonded interface needs the
+    derived closed form (the traction-free sphere of its rear face)."""
+    target = target.with_interfaces(getattr(args, "interfaces", None))
+    if target.debonded and resistance != "derived":
+        raise CavexInputError(f"option --interfaces debonded (or a layer's bottom = "
+                              f"\"debonded\") goes with --resistance derived (got "
+                              f"--resistance {resistance})")
+    return target

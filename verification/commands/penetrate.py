@@ -10,6 +10,7 @@ from pathlib import Path
 
 from cavex.analytic.penetration.integrator import crater_depth, penetrate
 from cavex.analytic.penetration.resistance import make_resistance, model_boundary, model_label
+from cavex.analytic.penetration.zones import scab_depth
 from cavex.config import load_config
 from cavex.verification.output.files import save_figure, write_columns_csv
 from cavex.verification.output.paths import check_output_dir, write_staged
@@ -19,9 +20,10 @@ from cavex.verification.studies.table2 import not_reproduced_line, table2_compar
 def run(args, target, projectile):
     """``cavex penetrate``: fly, write every file or none (also on Ctrl-C or kill), return the
     text or JSON to print."""
-    from cavex.verification.commands.options import resistance_settings
+    from cavex.verification.commands.options import interface_target, resistance_settings
 
     settings = resistance_settings(args)
+    target = interface_target(args, target, settings["resistance"])
     folder = check_output_dir(args.out, "out")
     job = penetration_job(target, projectile, crater=args.crater, **settings)
     written = write_staged(folder, lambda stage: write_outputs(job, stage, draw=args.figures))
@@ -50,20 +52,30 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
                 target, projectile, resistance, boundary, epsilon, table), crater=crater),
             "first_layer_only": penetrate(single, projectile, make_resistance(
                 single, projectile, closed, boundary, epsilon), crater=crater)}
-    paper = (target, projectile) == load_config()
-    return {"model": model, "first_layer_model": first, "resistance": resistance,
+    paper = (target.with_interfaces("bonded"), projectile) == load_config()
+    return {"model": model, "interfaces": interface_summary(target, projectile),
+            "first_layer_model": first, "resistance": resistance,
             "boundary": boundary, "epsilon": epsilon,
             "table": None if table is None else str(table), "crater": crater,
             "runs": runs, "table2": table2_comparison(runs["runway"]) if paper else None,
             "target_label": "runway (the paper's Table 1)" if paper else "layered target",
             "notes": crater_notes(target, projectile, crater),
+            "debonded": bool(target.debonded),
             "interface_depths": target.interface_depths,
             "title": resistance_title(resistance, boundary, epsilon, table),
             "layer_names": target.layer_names()}
 
 
 SETTINGS = ("model", "first_layer_model", "resistance", "boundary", "epsilon", "table",
-            "crater", "target_label", "notes")
+            "crater", "interfaces", "target_label", "notes")
+
+
+def interface_summary(target, projectile):
+    """Each interface's bonding and, where debonded, its rear-zone depth (m)."""
+    return [{"depth_m": H, "bottom": bottom} | (
+        {"rear_zone_m": scab_depth(target, projectile, j)} if bottom == "debonded" else {})
+        for j, (H, bottom) in enumerate(zip(target.interface_depths, target.bottoms,
+                                            strict=True))]
 
 
 def summary(job, written=()):
@@ -79,11 +91,17 @@ def text(summary):
     s = summary
     settings = {"paper": f", epsilon {s['epsilon']}",
                 "table": f" ({s['table']}; first layer alone: {s['first_layer_model']})"}
+    debonded = [i for i in s["interfaces"] if i["bottom"] == "debonded"]
     lines = [f"model {s['model']}{settings.get(s['resistance'], '')}, crater from {s['crater']}"]
+    if debonded:
+        lines.append("debonded interfaces at " + ", ".join(
+            f"{i['depth_m']:g} m (rear zone {i['rear_zone_m']:.4g} m)" for i in debonded))
     lines += [f"note: {note}" for note in s["notes"]]
+    stage = (lambda p: f" {p['stage']:<9}") if debonded else (lambda p: "")
     lines += ["", f"phases ({s['target_label']}):",
-              f"{'#':>2} {'label':<24} {'L (m)':>8} {'V (m/s)':>9} {'t (ms)':>8}  ends because"]
-    lines += [f"{p['phase']:>2} {p['label']:<24} {p['end_depth_m']:8.4f} "
+              f"{'#':>2}{' stage    ' if debonded else ''} {'label':<24} {'L (m)':>8} "
+              f"{'V (m/s)':>9} {'t (ms)':>8}  ends because"]
+    lines += [f"{p['phase']:>2}{stage(p)} {p['label']:<24} {p['end_depth_m']:8.4f} "
               f"{p['end_velocity_m_s']:9.2f} {p['end_time_s'] * 1e3:8.3f}  {p['end_reason']}"
               for p in s["phases"]]
     if s["table2"] is not None:
@@ -128,7 +146,7 @@ def resistance_title(resistance, boundary, epsilon, table=None):
 
 def phases_as_dicts(trajectory):
     """The phase table as JSON-able rows."""
-    return [{"phase": i + 1, "label": p.label, "end_depth_m": p.end_depth,
+    return [{"phase": i + 1, "stage": p.stage, "label": p.label, "end_depth_m": p.end_depth,
              "end_velocity_m_s": p.end_velocity, "end_time_s": p.end_time,
              "end_reason": p.end_reason} for i, p in enumerate(trajectory.phases)]
 
@@ -141,8 +159,10 @@ def write_outputs(job, out_dir, draw=True):
     written = []
     for name, trajectory in job["runs"].items():
         written.append(write_columns_csv(out / f"trajectory_{name}.csv", trajectory.as_columns()))
-    written.append(write_columns_csv(out / "phases_runway.csv",
-                              _columns(phases_as_dicts(job["runs"]["runway"]))))
+    rows = phases_as_dicts(job["runs"]["runway"])
+    if not job["debonded"]:  # the stage column only where there is more than one tunnel
+        rows = [{k: v for k, v in row.items() if k != "stage"} for row in rows]
+    written.append(write_columns_csv(out / "phases_runway.csv", _columns(rows)))
     if draw:
         written += _write_figures(job, out)
     return [str(p) for p in written]
@@ -166,6 +186,8 @@ def _write_figures(job, out):
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     runway_label = "runway (layered)" if job.get("table") is None else \
         "runway (layered, FE table)"
+    if job.get("debonded"):
+        runway_label = "runway (layered, debonded interfaces)"
     ax.plot(runway.t * 1e3, runway.velocity, label=runway_label)
     ax.plot(single.t * 1e3, single.velocity, "--", label=f"{names[0] if names else 'first layer'}"
             " alone")

@@ -15,7 +15,13 @@ from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.penetration.oblique import CONTACT_RAMP, Strike, fly, peaks
+from cavex.analytic.penetration.oblique import (
+    CONTACT_RAMP,
+    Strike,
+    fly,
+    overload_peaks,
+    peaks,
+)
 from cavex.analytic.penetration.surface_force import rotation_matrix as rotation
 from cavex.errors import is_finite_number, require
 from cavex.verification.fedata.runner import show_progress
@@ -60,6 +66,8 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
                 "spin_rad_s": strike.spin, "resistance": resistance, "boundary": boundary,
                 "epsilon": epsilon, "free_surface": free_surface,
                 "contact_ramp_m_s": contact_ramp}
+    if target.debonded:  # a bonded target's settings (and committed results) are unchanged
+        settings["interfaces"] = list(target.bottoms)
     return {"runs": runs, "settings": settings, "target": target}
 
 
@@ -85,9 +93,13 @@ def _steps(name, enabled):
 
 
 def run_summary(result):
-    """End state and phases of one run (JSON-ready), plus the largest pitch rate and
-    overloads."""
-    return {"end": result.end, "phases": result.phases, **peaks(result.history)}
+    """End state and phases of one run (JSON-ready; each phase with its ``pitch_change_deg``),
+    the largest pitch rate and overloads, and the axial overload's peaks
+    (:func:`~cavex.analytic.penetration.oblique.overload_peaks`) as ``overload_peaks``
+    ``[{"tip_depth_m", "axial_g"}]``."""
+    return {"end": result.end, "phases": result.phases, **peaks(result.history),
+            "overload_peaks": [{"tip_depth_m": z, "axial_g": g}
+                               for z, g in overload_peaks(result.history)]}
 
 
 def summary(job, written=None):
@@ -405,9 +417,10 @@ def run(args, target, projectile):
     from cavex.analytic.penetration.resistance import RESISTANCES
     from cavex.errors import CavexInputError, CavexNumericalError
     from cavex.materials import MAX_VELOCITY
-    from cavex.verification.commands.options import resistance_settings
+    from cavex.verification.commands.options import interface_target, resistance_settings
 
     settings = resistance_settings(args, (*RESISTANCES, "law"))
+    target = interface_target(args, target, settings["resistance"])
     law = [args.law_A is not None, args.law_B is not None]
     if not all(law) if args.resistance == "law" else any(law):
         raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
