@@ -60,7 +60,7 @@ FIT = "concrete (fitted)"
 LORO = "concrete (LORO)"
 LI_CHEN = "Li & Chen 2003"
 FORRESTAL = "Forrestal 1994"
-CAVEX = "cavex derived dynamic"
+CAVEX = "cavex derived-dynamic"
 MODELS = (MODEL, FIT, LORO, LI_CHEN, FORRESTAL, CAVEX)
 REGIMES = {
     "all": lambda s, flag: True,
@@ -137,7 +137,7 @@ def baseline_depths(shots):
         out[LI_CHEN].append(round_significant(li_chen_depth(s), DIGITS))
         out[FORRESTAL].append(round_significant(empirical.shot_depth(s), DIGITS))
         try:
-            value = round_significant(predict(s, "derived dynamic"), DIGITS)
+            value = round_significant(predict(s, "derived-dynamic"), DIGITS)
         except (CavexInputError, CavexNumericalError):
             value = None
         out[CAVEX].append(value)
@@ -150,7 +150,8 @@ def statistics(depths, shots, flags):
     for name, member in REGIMES.items():
         logs = [math.log(d / s.depth) for d, s, f in zip(depths, shots, flags, strict=True)
                 if d is not None and member(s, f)]
-        out[name] = (len(logs), float(np.mean(np.abs(logs))), float(np.mean(logs)))
+        out[name] = ((len(logs), float(np.mean(np.abs(logs))), float(np.mean(logs))) if logs
+                     else (0, None, None))
     return out
 
 
@@ -207,9 +208,10 @@ def report_md(result, shots_file):
                                                                           strict=True)) + " |")
     lines.append("|---|" + "---:|" * len(regimes))
     for m in MODELS:
-        cells = [f"{stats[m][r][1]:.3f} / {stats[m][r][2]:+.3f}" for r in regimes]
-        missing = [stats[m][r][0] for r in regimes] != counts
-        lines.append(f"| {m}{' (some shots failed)' if missing else ''} | "
+        cells = [f"{stats[m][r][1]:.3f} / {stats[m][r][2]:+.3f}" if stats[m][r][0] else "n/a"
+                 for r in regimes]
+        failed = counts[0] - stats[m][regimes[0]][0]
+        lines.append(f"| {m}{f' ({failed} shots failed)' if failed else ''} | "
                      + " | ".join(cells) + " |")
     c, p = result["fitted"]
     left_out = [f"S_max = {c:g}, p_l = {p / 1e9:g} GPa" for c, p in GRID
