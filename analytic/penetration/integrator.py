@@ -153,6 +153,9 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
     of: rest (``V = 0``), the nose tip at ``stop_depth``, the response state leaving ``label``.
 
     ``scipy.integrate.solve_ivp`` (DOP853, dense output) with a terminal event for each end.
+    The force is evaluated at ``(max(L, L0), max(V, 0))``: the true motion has ``V >= 0``, but a
+    trial stage of a step that overshoots rest (``V < 0``) can carry ``L`` back above the start,
+    even to the free surface.
 
     Parameters
     ----------
@@ -180,8 +183,8 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
     """
     t0, depth0, v0 = start
 
-    def rhs(t, y):
-        return (y[1], -resistance.force(y[0], max(y[1], 0.0)) / mass)
+    def rhs(t, y):  # depth never falls below the start: a trial stage past rest is clamped
+        return (y[1], -resistance.force(max(y[0], depth0), max(y[1], 0.0)) / mass)
 
     events = _phase_events(resistance, stop_depth, stop_reason, label)
     sol = solve_ivp(rhs, (t0, t0 + MAX_PHASE_DURATION), (depth0, v0),

@@ -23,8 +23,10 @@ def run(args, target, projectile):
     result = job(shots, resistance=settings["resistance"], boundary=settings["boundary"],
                  params=params, workers=args.workers, scheduler=args.scheduler,
                  progress=args.progress, out=out)
-    command = command_line(args.shots, args.out, result["calibration"].model, params, args.ids)
-    document = summary(result, write_outputs(result, args.shots, shots[0], command, out))
+    calibration = result["calibration"]
+    command = command_line(args.shots, args.out, calibration.model, params, args.ids)
+    reference = next(s for s in shots if s.id in calibration.shots)  # the first one fitted
+    document = summary(result, write_outputs(result, args.shots, reference, command, out))
     return json.dumps(document, indent=2) if args.json else text(document)
 
 
@@ -79,12 +81,15 @@ def summary(job, out):
     return {"model": calibration.model, "params": list(calibration.params),
             "fitted": {p: getattr(calibration.mapping, p) for p in calibration.params},
             "mapping": calibration.mapping.as_dict(), "shots": list(calibration.shots),
-            **dict(calibration.statistics), "wall_time_s": float(job["seconds"]),
+            **dict(calibration.statistics),
+            "skipped": {shot: reason for shot, reason in calibration.skipped},
+            "wall_time_s": float(job["seconds"]),
             "output": str(out)}
 
 
 def text(summary):
-    """The model and its shots, the fitted values, the fit, the file."""
+    """The model and its shots, the fitted values, the fit, the shots the model could not
+    predict (left out of the fit), the file."""
     s = summary
     values = ", ".join(f"{p} = {v:.6g}" for p, v in s["fitted"].items())
     return "\n".join([
@@ -93,5 +98,6 @@ def text(summary):
         f"fit     mean |ln(predicted/measured)| {s['mean_abs_log_ratio']:.4f}, rms "
         f"{s['rms_log_ratio']:.4f}, {s['evaluations']} evaluations, "
         f"{s['wall_time_s']:.1f} s",
+        *(f"skipped {shot}: {reason}" for shot, reason in s["skipped"].items()),
         f"wrote   {s['output']}",
     ])

@@ -42,7 +42,7 @@ DIFF_STEP = {"closed form": 1e-6, FE_MODEL: 2e-2}
 TOLERANCE = {"closed form": 1e-12, FE_MODEL: 1e-3}  # FE: its depths carry ~1e-3 noise
 CALIBRATION_KEYS = {"model", "params", "lam", "strength_factor", "modulus_factor", "nu",
                     "shots", "shots_file", "reference_shot", "n", "mean_abs_log_ratio",
-                    "rms_log_ratio", "evaluations"}
+                    "rms_log_ratio", "evaluations", "skipped"}
 CALIBRATION_REQUIRED = {"model", "params", "lam", "strength_factor", "modulus_factor", "nu",
                         "shots"}
 
@@ -58,6 +58,7 @@ class Calibration:
     shots: tuple
     source: str = ""
     statistics: tuple = ()
+    skipped: tuple = ()  # (shot id, reason) of the shots the model could not predict
 
     @property
     def column(self):
@@ -66,7 +67,8 @@ class Calibration:
     def describe(self):
         return {"column": self.column, "model": self.model, "file": self.source,
                 "params": list(self.params), "mapping": self.mapping.as_dict(),
-                "shots": list(self.shots), **dict(self.statistics)}
+                "shots": list(self.shots), **dict(self.statistics),
+                "skipped": {shot: reason for shot, reason in self.skipped}}
 
 
 def check_parameters(params):
@@ -94,9 +96,28 @@ def _bounds(params):
     return lower, upper
 
 
+class ShotFailure(Exception):
+    """``model`` could not predict one shot (its id and the reason)."""
+
+    def __init__(self, shot_id, reason):
+        super().__init__(f"shot '{shot_id}': {reason}")
+        self.shot_id, self.reason = shot_id, reason
+
+
 def log_ratios(shots, model, mapping, tables=None):
-    """``ln(predicted / measured)`` per shot for ``model`` (a model label)."""
-    return np.array([math.log(predict(s, model, mapping, tables) / s.depth) for s in shots])
+    """``ln(predicted / measured)`` per shot for ``model`` (a model label); a shot the model
+    cannot predict (a numerical or range error, a depth not finite and > 0) raises
+    :class:`ShotFailure`."""
+    ratios = []
+    for shot in shots:
+        try:
+            depth = predict(shot, model, mapping, tables)
+        except (CavexInputError, CavexNumericalError) as exc:
+            raise ShotFailure(shot.id, str(exc).splitlines()[0]) from None
+        if not (math.isfinite(depth) and depth > 0.0):
+            raise ShotFailure(shot.id, f"predicted depth {depth!r} m")
+        ratios.append(math.log(depth / shot.depth))
+    return np.array(ratios)
 
 
 def fit(shots, resistance="derived", params=None, start=None, tables=None, progress=False, *,
@@ -119,6 +140,10 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
     progress : bool
         One line per evaluation on stderr.
 
+    A shot the model cannot predict at a parameter the fit visits (:class:`ShotFailure`) is
+    left out, named in ``skipped`` (and on stderr with ``progress``), and the fit starts again
+    without it; too few shots left is a numerical failure.
+
     Returns
     -------
     Calibration
@@ -130,9 +155,37 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
     require(len(shots) >= len(params), "shots",
             f"at least as many shots as free parameters ({len(params)})", len(shots))
     start = start or Mapping()
-    kind = FE_MODEL if model == FE_MODEL else "closed form"
     tables = tables or TableCache(progress=False)
     tables.velocities_for(shots)
+    active, skipped = list(shots), []
+    while True:
+        try:
+            mapping, evaluations = _least_squares(active, model, params, start, tables,
+                                                  progress)
+            r = log_ratios(active, model, mapping, tables)
+            break
+        except ShotFailure as failure:
+            skipped.append((failure.shot_id, failure.reason))
+            active = [s for s in active if s.id != failure.shot_id]
+            if progress:
+                print(f"cavex: calibrate {model}: {failure}; fitting again without it",
+                      file=sys.stderr, flush=True)
+            if len(active) < len(params):
+                raise CavexNumericalError(
+                    f"calibration of {model}: {len(skipped)} shot(s) the model cannot "
+                    f"predict, too few left (last {failure})") from None
+    statistics = (("n", len(active)),
+                  ("mean_abs_log_ratio", round_significant(float(np.abs(r).mean()), 6)),
+                  ("rms_log_ratio", round_significant(float(np.sqrt((r ** 2).mean())), 6)),
+                  ("evaluations", evaluations))
+    return Calibration(model, mapping, params, tuple(s.id for s in active),
+                       statistics=statistics, skipped=tuple(skipped))
+
+
+def _least_squares(shots, model, params, start, tables, progress):
+    """The fitted mapping (parameters rounded to :data:`PARAMETER_DIGITS`) and the number of
+    residual evaluations; :class:`ShotFailure` passes through."""
+    kind = FE_MODEL if model == FE_MODEL else "closed form"
     count = [0]
     began = time.monotonic()
 
@@ -159,14 +212,7 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
         raise CavexNumericalError(f"calibration of {model} left the models' range: {exc}") \
             from None
     values = [round_significant(v, PARAMETER_DIGITS) for v in _to_values(solution.x, params)]
-    mapping = start.with_values(params, values)
-    r = log_ratios(shots, model, mapping, tables)
-    statistics = (("n", len(shots)),
-                  ("mean_abs_log_ratio", round_significant(float(np.abs(r).mean()), 6)),
-                  ("rms_log_ratio", round_significant(float(np.sqrt((r ** 2).mean())), 6)),
-                  ("evaluations", count[0]))
-    return Calibration(model, mapping, params, tuple(s.id for s in shots),
-                       statistics=statistics)
+    return start.with_values(params, values), count[0]
 
 
 class _ForwardDifferences:
@@ -202,34 +248,32 @@ class _ForwardDifferences:
 # --- files ------------------------------------------------------------------------------------
 
 def calibration_text(calibration, shots_file, reference, command=None):
-    """The TOML text of a calibration file (see the module docstring)."""
-    from cavex.config import config_text
+    """The TOML text of a calibration file (see the module docstring); every string and comment
+    escaped (:func:`cavex.config.toml_string`), so any shot id or path reads back."""
+    from cavex.config import config_text, toml_comment, toml_string
 
     stats = dict(calibration.statistics)
     m = calibration.mapping
     lines = ["# cavex calibration, written by `cavex calibrate`.",
-             *([f"# command: {command}"] if command else []),
-             f"# [projectile] and [[layers]]: the calibrated target of shot '{reference.id}', so",
+             *([toml_comment(f"command: {command}")] if command else []),
+             toml_comment(f"[projectile] and [[layers]]: the calibrated target of shot "
+                          f"'{reference.id}', so"),
              "# `cavex penetrate --config THIS_FILE` runs it (derived-quasi-static: add",
              "# --boundary quasi-static; paper: --resistance paper). `cavex validate --calibration",
              "# THIS_FILE` reads [calibration] and applies its mapping to every shot.",
              "", "[calibration]",
-             f"model = {_toml_string(calibration.model)}",
-             f"params = [{', '.join(_toml_string(p) for p in calibration.params)}]",
+             f"model = {toml_string(calibration.model)}",
+             f"params = [{', '.join(toml_string(p) for p in calibration.params)}]",
              *(f"{name} = {getattr(m, name)!r}" for name in ("lam", "strength_factor",
                                                               "modulus_factor", "nu")),
-             f"shots_file = {_toml_string(str(shots_file))}",
-             f"shots = [{', '.join(_toml_string(i) for i in calibration.shots)}]",
-             f"reference_shot = {_toml_string(reference.id)}",
+             f"shots_file = {toml_string(str(shots_file))}",
+             f"shots = [{', '.join(toml_string(i) for i in calibration.shots)}]",
+             *([f"skipped = [{', '.join(toml_string(i) for i, _ in calibration.skipped)}]"]
+               if calibration.skipped else []),
+             f"reference_shot = {toml_string(reference.id)}",
              *(f"{k} = {v!r}" for k, v in stats.items()), "", ""]
     target, projectile = shot_target(reference, m), shot_projectile(reference)
     return "\n".join(lines) + config_text(target, projectile)
-
-
-def _toml_string(text):
-    import json
-
-    return json.dumps(str(text))
 
 
 def read_calibration(path):
@@ -258,7 +302,11 @@ def parse_calibration(data, source=""):
     shots = table["shots"]
     require(isinstance(shots, list) and shots and all(isinstance(s, str) for s in shots),
             "calibration.shots", "a non-empty array of shot ids", shots)
+    skipped = table.get("skipped", [])
+    require(isinstance(skipped, list) and all(isinstance(s, str) for s in skipped),
+            "calibration.skipped", "an array of shot ids", skipped)
     statistics = tuple((k, table[k]) for k in ("n", "mean_abs_log_ratio", "rms_log_ratio",
                                                "evaluations") if k in table)
     return Calibration(table["model"], mapping, params, tuple(shots), source=source,
-                       statistics=statistics)
+                       statistics=statistics,
+                       skipped=tuple((s, "not predicted in the fit") for s in skipped))
