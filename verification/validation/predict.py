@@ -206,8 +206,10 @@ def predictions(shots, models, tables=None, progress=None):
 
 def ratio_statistics(ratios):
     """``n``, mean and sample standard deviation of ``ratios`` and their mean ``|ln ratio|``
-    (None where undefined), rounded to :data:`DEPTH_DIGITS` significant digits."""
-    r = np.array([x for x in ratios if x is not None], dtype=float)
+    (None where undefined; a missing, non-finite or non-positive ratio is not counted), rounded
+    to :data:`DEPTH_DIGITS` significant digits."""
+    r = np.array([x for x in ratios if x is not None and math.isfinite(x) and x > 0.0],
+                 dtype=float)
     n = int(r.size)
 
     def rounded(value):
