@@ -6,6 +6,7 @@ Tolerances: depths in the result files carry 6 significant digits (half a unit: 
 
 import json
 import math
+import re
 import tomllib
 
 import pytest
@@ -82,6 +83,9 @@ def test_calibration_file_reads_back_for_any_id_and_path(tmp_path, capsys):
     code, _, err = run(capsys, "validate", "--shots", shots, "--calibration", out, "--out",
                        tmp_path / "v", "--no-progress")
     assert code == 0, err
+    # the size and time first (a derived-dynamic calibration: its column and the table's)
+    assert re.match(r"cavex: validate 2 shots x 7 models = 14 predictions; FE tables: 2 to "
+                    r"build \(\d+ FE cases\), 0 on disk; under a minute on \d+ worker", err), err
     code, _, err = run(capsys, "penetrate", "--config", out, "--out", tmp_path / "p")
     assert code == 0, err
 
@@ -210,3 +214,39 @@ def test_a_run_past_the_step_budget_stops_with_a_message(tmp_path, capsys, monke
     code, out, err = run(capsys, "trajectory", "--no-figures", "--out", tmp_path / "t")
     assert code == 1 and err.count("\n") == 1 and "more than 50 integrator steps" in err
     assert not (tmp_path / "t").exists()
+
+
+# --- kill -9 during a write: the next run removes the stage it left ---------------------------
+
+def test_a_stage_left_by_kill_9_is_removed_by_the_next_run(tmp_path, capsys):
+    import os
+    import socket
+    import subprocess
+    import sys
+    import time
+
+    from cavex.verification.output.paths import STAGE_PREFIX, STALE_SECONDS
+
+    out = tmp_path / "v"
+    killed = subprocess.run([sys.executable, "-c", (
+        "import os, signal\n"
+        "from cavex.verification.output.paths import staged_output\n"
+        f"with staged_output({str(out)!r}) as stage:\n"
+        "    (stage / 'validation.json').write_text('{')\n"
+        "    os.kill(os.getpid(), signal.SIGKILL)\n")])
+    assert killed.returncode == -9
+    (left,) = out.glob(STAGE_PREFIX + "*")
+    host = socket.gethostname()
+    alive = out / f"{STAGE_PREFIX}{host}-{os.getpid()}-abc"  # a run still writing: kept
+    foreign_new = out / f"{STAGE_PREFIX}otherhost-1-abc"  # another host's, recent: kept
+    foreign_old = out / f"{STAGE_PREFIX}otherhost-2-abc"  # another host's, a day old: removed
+    legacy_old = out / f"{STAGE_PREFIX}k2j4_x"  # an older cavex's, a day old: removed
+    for stage in (alive, foreign_new, foreign_old, legacy_old):
+        stage.mkdir()
+    day_ago = time.time() - STALE_SECONDS - 60.0
+    for stage in (foreign_old, legacy_old):
+        os.utime(stage, (day_ago, day_ago))
+    code, _, err = run(capsys, "penetrate", "--out", out)
+    assert code == 0, err
+    assert sorted(out.glob(STAGE_PREFIX + "*")) == sorted([alive, foreign_new])
+    assert not left.exists()

@@ -13,7 +13,9 @@ the same files.
 import csv
 import io
 import json
+import os
 import shlex
+import sys
 import time
 
 import numpy as np
@@ -54,6 +56,8 @@ def run(args, target, projectile):
                               "give one per model")
     out = check_output_dir(DEFAULT_OUT if args.out is None else args.out, "out")
     check_execution(workers, scheduler)
+    print(f"cavex: validate {estimate(shot_file.shots, calibrations, out / 'tables', workers)}",
+          file=sys.stderr, flush=True)
     began = time.monotonic()
     result = job(shot_file, calibrations, tables_dir=out / "tables", workers=workers,
                  scheduler=scheduler, progress=args.progress)
@@ -63,6 +67,26 @@ def run(args, target, projectile):
     if args.json:
         return json.dumps(summary(result), indent=2)
     return text(result, seconds, written)
+
+
+def columns_of(calibrations):
+    """Every column :func:`job` fills: the models, the calibrated ones and, with a
+    derived-dynamic calibration, :data:`COMPRESSIBILITY_COLUMN`."""
+    from cavex.verification.validation.predict import validation_columns
+
+    columns = validation_columns(calibrations)
+    dynamic = [c for c in calibrations if c.model == "derived-dynamic"]
+    if dynamic:
+        columns[COMPRESSIBILITY_COLUMN] = (FE_MODEL, dynamic[0].mapping)
+    return columns
+
+
+def estimate(shots, calibrations, tables_dir, workers):
+    """The run's size and time (:func:`cavex.verification.validation.predict.run_estimate`)."""
+    from cavex.verification.validation.predict import run_estimate
+
+    workers = workers or os.cpu_count() or 1
+    return run_estimate(shots, columns_of(calibrations), TableCache(tables_dir), workers)
 
 
 def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=None,
@@ -75,9 +99,8 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
                         progress=show_progress(progress))
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
                       progress=progress)
-    dynamic = [c for c in calibrations if c.model == "derived-dynamic"]
-    if dynamic:
-        columns = {COMPRESSIBILITY_COLUMN: (FE_MODEL, dynamic[0].mapping)}
+    if any(c.model == "derived-dynamic" for c in calibrations):
+        columns = {COMPRESSIBILITY_COLUMN: columns_of(calibrations)[COMPRESSIBILITY_COLUMN]}
         depths, failures = predictions(shot_file.shots, columns, tables, progress)
         for row, depth in zip(result["shots"], depths[COMPRESSIBILITY_COLUMN], strict=True):
             row["predicted_m"][COMPRESSIBILITY_COLUMN] = depth

@@ -50,6 +50,10 @@ MODELS = (*CAVEX_MODELS, EMPIRICAL)
 DEPTH_DIGITS = FE_DIGITS  # predicted depths and statistics in the result files
 TABLE_VELOCITY_STEP = 50.0  # m/s between FE table velocities (interpolated by PCHIP in V^2)
 TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on depth
+# for run estimates only, measured on the development shots (one worker, x86_64): 95 FE tables
+# of 25 velocities and 2 depths in ~100 s; a closed-form prediction 1.4-2.6 ms
+TABLE_CASES_PER_SECOND_PER_WORKER = 45.0
+PREDICTION_SECONDS = 2.5e-3
 
 
 # --- one prediction ---------------------------------------------------------------------------
@@ -133,6 +137,16 @@ class TableCache:
         """Set the velocity grid to cover ``shots`` (call before :meth:`table`)."""
         self._velocities = table_velocities(shots)
 
+    def plan(self, shots, mappings):
+        """``(to build, on disk)``: the distinct FE tables ``shots`` need under ``mappings``
+        (call :meth:`velocities_for` first)."""
+        keys = {self.key(shot_target(shot, m), shot_projectile(shot), self._velocities)
+                for m in mappings for shot in shots}
+        keys -= set(self._tables)
+        on_disk = {k for k in keys if self.directory is not None
+                   and (self.directory / f"table_{k}.nc").exists()}
+        return len(keys - on_disk), len(on_disk)
+
     def key(self, target, projectile, velocities):
         from cavex.config import fingerprint
         from cavex.verification.fedata.table import settings_json
@@ -180,6 +194,25 @@ class TableCache:
 
 # --- many shots -------------------------------------------------------------------------------
 
+def run_estimate(shots, models, tables, workers):
+    """One line: the size of a run of ``models`` (column -> ``(model, mapping)``) over
+    ``shots`` and its time, from :data:`TABLE_CASES_PER_SECOND_PER_WORKER` and
+    :data:`PREDICTION_SECONDS` (the empirical model costs nothing)."""
+    tables.velocities_for(shots)
+    table_mappings = [mapping or Mapping() for model, mapping in models.values()
+                      if model == FE_MODEL]
+    build, reused = tables.plan(shots, table_mappings) if table_mappings else (0, 0)
+    cases = build * len(tables._velocities) * len(TABLE_DEPTHS)
+    cavex_models = sum(model != EMPIRICAL for model, _ in models.values())
+    seconds = (cases / (TABLE_CASES_PER_SECOND_PER_WORKER * max(1, workers))
+               + len(shots) * cavex_models * PREDICTION_SECONDS)
+    when = ("under a minute" if seconds < 60.0 else f"about {seconds / 60.0:.0f} min"
+            if seconds < 3600.0 else f"about {seconds / 3600.0:.1f} h")
+    return (f"{len(shots)} shots x {len(models)} models = {len(shots) * len(models)} "
+            f"predictions; FE tables: {build} to build ({cases} FE cases), {reused} on disk; "
+            f"{when} on {workers} worker(s)")
+
+
 def predictions(shots, models, tables=None, progress=None):
     """``{model: [depth or None]}`` and ``{model: {shot id: reason}}`` for the failures.
 
@@ -222,6 +255,16 @@ def ratio_statistics(ratios):
             "mean_abs_log_ratio": rounded(np.abs(np.log(r)).mean()) if n else None}
 
 
+def validation_columns(calibrations=(), mapping=None):
+    """Column name -> ``(model, mapping)``: every model of :data:`MODELS` under ``mapping``
+    (default :class:`Mapping`), then ``"<model> calibrated"`` per calibration."""
+    mapping = mapping or Mapping()
+    columns = {name: (name, mapping) for name in MODELS}
+    for calibration in calibrations:
+        columns[calibration.column] = (calibration.model, calibration.mapping)
+    return columns
+
+
 def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None):
     """Per-shot predictions of every model and their statistics.
 
@@ -243,9 +286,7 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         calibrations), ``failures``, ``models``, ``calibrations``.
     """
     mapping = mapping or Mapping()
-    columns = {name: (name, mapping) for name in MODELS}
-    for calibration in calibrations:
-        columns[calibration.column] = (calibration.model, calibration.mapping)
+    columns = validation_columns(calibrations, mapping)
     tables = tables or TableCache()
     tables.velocities_for(shots)
     depths, failures = predictions(shots, columns, tables, progress)
