@@ -250,3 +250,46 @@ def test_a_stage_left_by_kill_9_is_removed_by_the_next_run(tmp_path, capsys):
     assert code == 0, err
     assert sorted(out.glob(STAGE_PREFIX + "*")) == sorted([alive, foreign_new])
     assert not left.exists()
+
+
+# --- outliers: flagged in the report, statistics with and without -----------------------------
+
+OUT_OF_TREND = "OUT" + GOOD[0][2:].replace(",0.173", ",0.00865")  # measured 20x too shallow
+
+
+def test_is_outlier_needs_every_model_off_by_more_than_the_factor():
+    from cavex.verification.validation.predict import OUTLIER_FACTOR, is_outlier
+
+    assert OUTLIER_FACTOR == 3.0
+    assert is_outlier([3.01, 20.0, None]) and is_outlier([1 / 3.01, 0.1])
+    assert not is_outlier([3.01, 2.99]) and not is_outlier([None, None]) and not is_outlier([])
+    assert is_outlier([0.2, 5.0])  # off either way
+
+
+def test_validate_flags_a_shot_every_model_misses(tmp_path, capsys):
+    shots = tmp_path / "shots.csv"
+    shots.write_text("\n".join([COLUMNS, *GOOD, OUT_OF_TREND]) + "\n")
+    code, out, err = run(capsys, "validate", "--shots", shots, "--out", tmp_path / "v",
+                         "--no-progress")
+    assert code == 0, err
+    result = json.loads((tmp_path / "v" / "validation.json").read_text())
+    assert result["outliers"] == {"factor": 3.0, "shots": ["OUT"]}
+    for model, stats in result["summary"].items():  # kept in the statistics, and without
+        assert stats["n"] == 3 and result["summary_without_outliers"][model]["n"] == 2
+    report = (tmp_path / "v" / "report.md").read_text()
+    assert "## Outliers: shots every model misses by more than a factor 3" in report
+    assert "| OUT | 277 | 8.65 |" in report
+    assert "without the 1 outlier(s), every model off by more than a factor 3 (OUT" in out
+
+
+def test_calibrate_flags_its_outliers_and_gives_the_fit_without_them(tmp_path, capsys):
+    shots = tmp_path / "shots.csv"  # Forrestal's 17 shots and one 20x out of trend
+    shots.write_text(open("examples/shots_forrestal1994.csv").read() + OUT_OF_TREND + "\n")
+    code, out, err = run(capsys, "calibrate", "--shots", shots, "--out", tmp_path / "c.toml",
+                         "--params", "strength_factor", "--json", "--no-progress")
+    assert code == 0, err
+    document = json.loads(out)
+    assert document["outliers"] == ["OUT"] and document["n"] == 18
+    assert document["without_outliers"]["n"] == 17
+    assert document["without_outliers"]["mean_abs_log_ratio"] < document["mean_abs_log_ratio"]
+    assert read_calibration(tmp_path / "c.toml").outliers == ("OUT",)

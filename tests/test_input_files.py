@@ -83,7 +83,7 @@ def calibration_faults(text):
                    "(Expected ']' at the end of a table declaration)"),
         "unknown key": (text.replace("reference_shot = ", "reference = "),
                         "calibration.reference is not a known key (accepted: evaluations, lam, "
-                        "mean_abs_log_ratio, model, modulus_factor, n, nu, params, "
+                        "mean_abs_log_ratio, model, modulus_factor, n, nu, outliers, params, "
                         "reference_shot, rms_log_ratio, shots, shots_file, skipped, "
                         "strength_factor)"),
         "missing key": (text.replace("\nshots = ", "\n# shots = "),

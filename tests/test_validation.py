@@ -369,7 +369,7 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     out_dir = tmp_path / "val"
     code, out, err = run(capsys, "validate", "--shots", str(small), "--calibration", str(cal),
                          "--json", "--out", str(out_dir))
-    assert (code, err) == (0, "")
+    assert code == 0 and err.startswith("cavex: validate 2 shots x ") and err.count("\n") == 1
     result = json.loads(out)
     rows = {row["id"]: row for row in result["shots"]}
     assert data["calibration"]["model"] == "derived-quasi-static"

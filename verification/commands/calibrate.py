@@ -73,16 +73,33 @@ def write_outputs(job, shots_path, reference, command, out):
     return out
 
 
+def _outlier_lines(s):
+    """The fitted shots the model misses by more than the factor, and the fit without them."""
+    if not s["outliers"]:
+        return []
+    w = s["without_outliers"]
+    fit = ("no shot left" if w["n"] == 0 else
+           f"mean |ln(predicted/measured)| {w['mean_abs_log_ratio']:.4f}, rms "
+           f"{w['rms_log_ratio']:.4f} over {w['n']} shots")
+    return [f"outliers {len(s['outliers'])} shot(s) off by more than a factor "
+            f"{s['outlier_factor']:g} at the fit (flagged, still fitted): "
+            f"{', '.join(s['outliers'])}", f"without  {fit}"]
+
+
 def summary(job, out):
     """What ``cavex calibrate --json`` prints: the model, the fitted parameters (all
-    dimensionless), the mapping, the shots fitted, the fit statistics, the wall time and the
-    file written."""
+    dimensionless), the mapping, the shots fitted, the fit statistics, the shots skipped, the
+    outliers and the statistics without them, the wall time and the file written."""
+    from cavex.verification.validation.predict import OUTLIER_FACTOR
+
     calibration = job["calibration"]
     return {"model": calibration.model, "params": list(calibration.params),
             "fitted": {p: getattr(calibration.mapping, p) for p in calibration.params},
             "mapping": calibration.mapping.as_dict(), "shots": list(calibration.shots),
             **dict(calibration.statistics),
             "skipped": {shot: reason for shot, reason in calibration.skipped},
+            "outlier_factor": OUTLIER_FACTOR, "outliers": list(calibration.outliers),
+            "without_outliers": dict(calibration.without_outliers),
             "wall_time_s": float(job["seconds"]),
             "output": str(out)}
 
@@ -99,5 +116,6 @@ def text(summary):
         f"{s['rms_log_ratio']:.4f}, {s['evaluations']} evaluations, "
         f"{s['wall_time_s']:.1f} s",
         *(f"skipped {shot}: {reason}" for shot, reason in s["skipped"].items()),
+        *_outlier_lines(s),
         f"wrote   {s['output']}",
     ])

@@ -29,6 +29,7 @@ from cavex.verification.validation.predict import (
     FE_MODEL,
     MODELS,
     TableCache,
+    flag_outliers,
     predictions,
     summaries,
     validate,
@@ -113,6 +114,7 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
         held = [r for r in result["shots"] if r["id"] in result["held_out"]]
         result["held_out_summary"] = summaries(held, list(result["summary"]))
         result["models"].append(COMPRESSIBILITY_COLUMN)
+        flag_outliers(result)
     result["shots_file"] = {"path": shot_file.path, "comments": list(shot_file.comments),
                             "n": len(shot_file.shots)}
     result["tables"] = {"built": tables.built, "reused": tables.reused}
@@ -257,6 +259,7 @@ def report_markdown(result):
     lines += _summary_table(result["summary"]) + [""]
     lines += ["Ratio = predicted / measured depth; std is the sample standard deviation; "
               "mean abs ln ratio is the mean of |ln(predicted/measured)|.", ""]
+    lines += _outlier_section(result)
     lines += ["## Compressibility: the FE table against the incompressible closed forms", ""]
     for column, what in ((FE_MODEL, "uncalibrated mapping"),
                          (result.get("compressibility_column"),
@@ -284,6 +287,27 @@ def report_markdown(result):
             lines += [f"- {model}, shot {i}: {reason}" for i, reason in items.items()]
         lines.append("")
     return "\n".join(lines)
+
+
+def _outlier_section(result):
+    """Report lines: the flagged shots (every model off by more than the factor), each with
+    its measured depth and the range of the models' ratios, and the statistics without them."""
+    flagged, factor = result["outliers"]["shots"], result["outliers"]["factor"]
+    lines = ["## Outliers: shots every model misses by more than a factor "
+             f"{factor:g}", ""]
+    if not flagged:
+        return lines + ["None.", ""]
+    rows = {row["id"]: row for row in result["shots"]}
+    lines += [f"{len(flagged)} shot(s), kept in every statistic above (flagged, not dropped):",
+              "", "| shot | V0 (m/s) | measured (mm) | predicted / measured, every model |",
+              "|---|---:|---:|---|"]
+    for shot in flagged:
+        ratios = [r for r in rows[shot]["ratio"].values() if r is not None]
+        lines.append(f"| {shot} | {rows[shot]['V0_m_s']:g} | "
+                     f"{rows[shot]['measured_m'] * 1e3:g} | {min(ratios):.3g} to "
+                     f"{max(ratios):.3g} |")
+    lines += ["", "Without them:", ""] + _summary_table(result["summary_without_outliers"])
+    return lines + [""]
 
 
 def write_figures(result, out):
@@ -351,6 +375,12 @@ def text(result, seconds, written):
              f"FE tables built {result['tables']['built']}, reused "
              f"{result['tables']['reused']}; {seconds:.1f} s", ""]
     parts = [("all shots", result["summary"])]
+    flagged = result["outliers"]["shots"]
+    if flagged:
+        shown = ", ".join(flagged[:10]) + (", ..." if len(flagged) > 10 else "")
+        parts.append((f"without the {len(flagged)} outlier(s), every model off by more than a "
+                      f"factor {result['outliers']['factor']:g} ({shown}; see report.md)",
+                      result["summary_without_outliers"]))
     if "held_out_summary" in result:
         parts.insert(0, (f"held-out shots ({len(result['held_out'])})",
                          result["held_out_summary"]))

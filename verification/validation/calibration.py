@@ -32,7 +32,7 @@ from cavex.errors import CavexInputError, CavexNumericalError, check_keys, prefi
 from cavex.input_files import in_file, read_toml
 from cavex.verification.output.number_format import round_significant
 from cavex.verification.validation.concrete import BOUNDS, FREE_PARAMETERS, Mapping, shot_target
-from cavex.verification.validation.predict import FE_MODEL, TableCache, predict
+from cavex.verification.validation.predict import FE_MODEL, OUTLIER_FACTOR, TableCache, predict
 from cavex.verification.validation.shots import shot_projectile
 
 PARAMETER_DIGITS = 6
@@ -42,7 +42,7 @@ DIFF_STEP = {"closed form": 1e-6, FE_MODEL: 2e-2}
 TOLERANCE = {"closed form": 1e-12, FE_MODEL: 1e-3}  # FE: its depths carry ~1e-3 noise
 CALIBRATION_KEYS = {"model", "params", "lam", "strength_factor", "modulus_factor", "nu",
                     "shots", "shots_file", "reference_shot", "n", "mean_abs_log_ratio",
-                    "rms_log_ratio", "evaluations", "skipped"}
+                    "rms_log_ratio", "evaluations", "skipped", "outliers"}
 CALIBRATION_REQUIRED = {"model", "params", "lam", "strength_factor", "modulus_factor", "nu",
                         "shots"}
 
@@ -59,6 +59,8 @@ class Calibration:
     source: str = ""
     statistics: tuple = ()
     skipped: tuple = ()  # (shot id, reason) of the shots the model could not predict
+    outliers: tuple = ()  # fitted shot ids off by more than OUTLIER_FACTOR at the fit
+    without_outliers: tuple = ()  # the statistics over the other fitted shots
 
     @property
     def column(self):
@@ -68,7 +70,8 @@ class Calibration:
         return {"column": self.column, "model": self.model, "file": self.source,
                 "params": list(self.params), "mapping": self.mapping.as_dict(),
                 "shots": list(self.shots), **dict(self.statistics),
-                "skipped": {shot: reason for shot, reason in self.skipped}}
+                "skipped": {shot: reason for shot, reason in self.skipped},
+                "outliers": list(self.outliers), "without_outliers": dict(self.without_outliers)}
 
 
 def check_parameters(params):
@@ -149,7 +152,9 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
     Calibration
         Fitted parameters rounded to :data:`PARAMETER_DIGITS` significant digits; statistics
         (``n``, ``mean_abs_log_ratio``, ``rms_log_ratio``, ``evaluations``) at the rounded
-        parameters.
+        parameters; the fitted shots off by more than
+        :data:`~cavex.verification.validation.predict.OUTLIER_FACTOR` there (``outliers``:
+        flagged, still fitted) and the statistics without them (``without_outliers``).
     """
     model, params = model_label(resistance, boundary), check_parameters(params)
     require(len(shots) >= len(params), "shots",
@@ -174,12 +179,22 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
                 raise CavexNumericalError(
                     f"calibration of {model}: {len(skipped)} shot(s) the model cannot "
                     f"predict, too few left (last {failure})") from None
-    statistics = (("n", len(active)),
-                  ("mean_abs_log_ratio", round_significant(float(np.abs(r).mean()), 6)),
-                  ("rms_log_ratio", round_significant(float(np.sqrt((r ** 2).mean())), 6)),
-                  ("evaluations", evaluations))
+    flagged = np.abs(r) > math.log(OUTLIER_FACTOR)
     return Calibration(model, mapping, params, tuple(s.id for s in active),
-                       statistics=statistics, skipped=tuple(skipped))
+                       statistics=(*fit_statistics(r), ("evaluations", evaluations)),
+                       skipped=tuple(skipped),
+                       outliers=tuple(s.id for s, f in zip(active, flagged, strict=True) if f),
+                       without_outliers=fit_statistics(r[~flagged]))
+
+
+def fit_statistics(r):
+    """``n``, mean ``|ln ratio|`` and rms ``ln ratio`` of the log ratios ``r`` (6 significant
+    digits; the means None without shots)."""
+    def rounded(value):
+        return round_significant(float(value), 6) if r.size else None
+
+    return (("n", int(r.size)), ("mean_abs_log_ratio", rounded(np.abs(r).mean())),
+            ("rms_log_ratio", rounded(np.sqrt((r ** 2).mean()))))
 
 
 def _least_squares(shots, model, params, start, tables, progress):
@@ -270,6 +285,8 @@ def calibration_text(calibration, shots_file, reference, command=None):
              f"shots = [{', '.join(toml_string(i) for i in calibration.shots)}]",
              *([f"skipped = [{', '.join(toml_string(i) for i, _ in calibration.skipped)}]"]
                if calibration.skipped else []),
+             *([f"outliers = [{', '.join(toml_string(i) for i in calibration.outliers)}]"]
+               if calibration.outliers else []),
              f"reference_shot = {toml_string(reference.id)}",
              *(f"{k} = {v!r}" for k, v in stats.items()), "", ""]
     target, projectile = shot_target(reference, m), shot_projectile(reference)
@@ -302,11 +319,13 @@ def parse_calibration(data, source=""):
     shots = table["shots"]
     require(isinstance(shots, list) and shots and all(isinstance(s, str) for s in shots),
             "calibration.shots", "a non-empty array of shot ids", shots)
-    skipped = table.get("skipped", [])
-    require(isinstance(skipped, list) and all(isinstance(s, str) for s in skipped),
-            "calibration.skipped", "an array of shot ids", skipped)
+    skipped, outliers = table.get("skipped", []), table.get("outliers", [])
+    for name, ids in (("skipped", skipped), ("outliers", outliers)):
+        require(isinstance(ids, list) and all(isinstance(s, str) for s in ids),
+                f"calibration.{name}", "an array of shot ids", ids)
     statistics = tuple((k, table[k]) for k in ("n", "mean_abs_log_ratio", "rms_log_ratio",
                                                "evaluations") if k in table)
     return Calibration(table["model"], mapping, params, tuple(shots), source=source,
                        statistics=statistics,
-                       skipped=tuple((s, "not predicted in the fit") for s in skipped))
+                       skipped=tuple((s, "not predicted in the fit") for s in skipped),
+                       outliers=tuple(outliers))
