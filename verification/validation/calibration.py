@@ -71,7 +71,7 @@ class Calibration:
                 "params": list(self.params), "mapping": self.mapping.as_dict(),
                 "shots": list(self.shots), **dict(self.statistics),
                 "skipped": {shot: reason for shot, reason in self.skipped},
-                "outliers": list(self.outliers), "without_outliers": dict(self.without_outliers)}
+                "outliers": list(self.outliers)}
 
 
 def check_parameters(params):
