@@ -50,10 +50,11 @@ MODELS = (*CAVEX_MODELS, EMPIRICAL)
 DEPTH_DIGITS = FE_DIGITS  # predicted depths and statistics in the result files
 TABLE_VELOCITY_STEP = 50.0  # m/s between FE table velocities (interpolated by PCHIP in V^2)
 TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on depth
-# for run estimates only, measured on the development shots (one worker, x86_64): 95 FE tables
-# of 25 velocities and 2 depths in ~100 s; a closed-form prediction 1.4-2.6 ms
+# for run estimates only, measured on the development shots (one worker, x86_64, unloaded):
+# 95 FE tables of 25 velocities and 2 depths in ~90 s; a prediction 1.4-2.6 ms with a closed
+# form, 29 ms with an FE table (5000 shots: 12 min on a machine loaded ~2x)
 TABLE_CASES_PER_SECOND_PER_WORKER = 45.0
-PREDICTION_SECONDS = 2.5e-3
+PREDICTION_SECONDS = {"closed form": 2.5e-3, FE_MODEL: 3e-2}
 # a shot every model misses by more than this factor (either way) is flagged as an outlier:
 # 21 of the 286 development shots (C133: 1.2 mm measured at 86 m/s, every model ~25 mm), none
 # of Forrestal's 17
@@ -207,14 +208,15 @@ def run_estimate(shots, models, tables, workers):
                       if model == FE_MODEL]
     build, reused = tables.plan(shots, table_mappings) if table_mappings else (0, 0)
     cases = build * len(tables._velocities) * len(TABLE_DEPTHS)
-    cavex_models = sum(model != EMPIRICAL for model, _ in models.values())
+    per_shot = sum(PREDICTION_SECONDS[FE_MODEL if model == FE_MODEL else "closed form"]
+                   for model, _ in models.values() if model != EMPIRICAL)
     seconds = (cases / (TABLE_CASES_PER_SECOND_PER_WORKER * max(1, workers))
-               + len(shots) * cavex_models * PREDICTION_SECONDS)
+               + len(shots) * per_shot)
     when = ("under a minute" if seconds < 60.0 else f"about {seconds / 60.0:.0f} min"
             if seconds < 3600.0 else f"about {seconds / 3600.0:.1f} h")
     return (f"{len(shots)} shots x {len(models)} models = {len(shots) * len(models)} "
             f"predictions; FE tables: {build} to build ({cases} FE cases), {reused} on disk; "
-            f"{when} on {workers} worker(s)")
+            f"{when} on {workers} worker(s) of an unloaded machine")
 
 
 def predictions(shots, models, tables=None, progress=None):
