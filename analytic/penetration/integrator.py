@@ -86,18 +86,29 @@ def crater_exit(projectile, force, depth):
 
 
 def crater_stage(projectile, force, depth, samples=50):
-    """Crater trajectory samples ``(t, L, V, a)`` and the exit ``(t_c, V_c)``."""
-    vc, stiffness = crater_exit(projectile, force, depth)
-    omega = math.sqrt(stiffness / projectile.m)
-    if not omega > 0.0:  # V_c = V0 to round-off: a mass that the target cannot slow
-        raise CavexNumericalError(f"the crater does not slow the projectile (m = "
-                                  f"{projectile.m:g} kg, V0 = {projectile.V0:g} m/s)")
-    tc = math.acos(vc / projectile.V0) / omega
+    """Crater trajectory samples ``(t, L, V, a)`` and the exit ``(t_c, V_c)``.
+
+    A projectile the crater stops (``m V0^2 <= L_c F(0)``) rests at
+    ``L_s = V0 sqrt(m / K) = sqrt(m V0^2 L_c / F(0))``, ``K L_c = F(0)`` (the crater's force
+    continuous with the tunnel's at rest), at ``t_s = (pi / 2) sqrt(m / K)``, ``V_c = 0``; at
+    the threshold ``L_s = L_c``, continuous with the tunnel branch."""
+    m, v0 = projectile.m, projectile.V0
+    if m * v0 ** 2 <= depth * force(0.0):
+        stiffness = force(0.0) / depth
+        omega = math.sqrt(stiffness / m)
+        tc, vc, end = 0.5 * math.pi / omega, 0.0, v0 / omega
+    else:
+        vc, stiffness = crater_exit(projectile, force, depth)
+        omega = math.sqrt(stiffness / m)
+        if not omega > 0.0:  # V_c = V0 to round-off: a mass that the target cannot slow
+            raise CavexNumericalError(f"the crater does not slow the projectile (m = "
+                                      f"{m:g} kg, V0 = {v0:g} m/s)")
+        tc, end = math.acos(vc / v0) / omega, depth
     t = np.linspace(0.0, tc, samples)
-    depths = projectile.V0 / omega * np.sin(omega * t)
-    velocity = projectile.V0 * np.cos(omega * t)
-    depths[-1], velocity[-1] = depth, vc  # the exit state exactly, not re-rounded
-    return (t, depths, velocity, stiffness * depths / projectile.m), tc, vc
+    depths = v0 / omega * np.sin(omega * t)
+    velocity = v0 * np.cos(omega * t)
+    depths[-1], velocity[-1] = end, vc  # the exit state exactly, not re-rounded
+    return (t, depths, velocity, stiffness * depths / m), tc, vc
 
 
 def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, atol=ATOL):
@@ -121,7 +132,9 @@ def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, 
         depth0 = crater_depth(projectile, crater)
         samples, t0, v0 = crater_stage(projectile, resistance.crater_force, depth0)
         _append(columns, *samples, 0)
-        phases.append(Phase("crater", depth0, v0, t0, "crater depth reached"))
+        depth0 = samples[1][-1]  # short of the crater depth where the crater stops it
+        phases.append(Phase("crater", depth0, v0, t0,
+                            "crater depth reached" if v0 > 0.0 else STOPPED))
     return _tunnel(target, projectile, resistance, (t0, depth0, v0), columns, phases,
                    rtol=rtol, atol=atol)
 
@@ -190,6 +203,11 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
     sol = solve_ivp(rhs, (t0, t0 + MAX_PHASE_DURATION), (depth0, v0),
                     method="DOP853", events=[e for e, _ in events], dense_output=True,
                     rtol=rtol, atol=atol)
+    if sol.status == 0:  # reached t0 + MAX_PHASE_DURATION: no event
+        raise CavexNumericalError(
+            f"the projectile was still moving {MAX_PHASE_DURATION:g} s into a phase (depth "
+            f"{sol.y[0, -1]:.4g} m, {sol.y[1, -1]:.4g} m/s): a body this heavy or slender for "
+            "the target is beyond the model")
     if sol.status != 1:
         raise CavexNumericalError(f"penetration integration failed at t={sol.t[-1]} s, "
                                   f"depth {sol.y[0, -1]} m: {sol.message}")

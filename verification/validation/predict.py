@@ -17,9 +17,8 @@ projectile the shot's (:func:`~cavex.verification.validation.shots.shot_projecti
 cavex's models run the penetration integrator
 (:func:`cavex.analytic.penetration.integrator.penetrate`,
 crater of ``4.5 r`` from the nose base, as ``cavex penetrate``); the predicted depth is the nose
-tip's final depth. A projectile that the crater stage would stop (``m V0^2 <= L_c F(0)``, which
-the integrator refuses) reaches ``sqrt(m V0^2 L_c / F(0))``: the crater's ``K L`` force with
-``K L_c = F(0)``, continuous with the integrator's depth at the threshold.
+tip's final depth; a projectile that the crater stage stops (``m V0^2 <= L_c F(0)``) reaches
+``sqrt(m V0^2 L_c / F(0))`` (:func:`cavex.analytic.penetration.integrator.crater_stage`).
 
 A calibrated model (:mod:`cavex.verification.validation.calibration`) is one of cavex's models with
 the fitted mapping parameters, named ``"<model> calibrated"``.
@@ -33,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.penetration.integrator import crater_depth, penetrate
+from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.nose import nose_rule
 from cavex.analytic.penetration.resistance import MODEL_LABELS, make_resistance, parse_model_label
 from cavex.analytic.penetration.resistance import MODELS as CLOSED_FORMS
@@ -64,12 +63,7 @@ OUTLIER_FACTOR = 3.0
 # --- one prediction ---------------------------------------------------------------------------
 
 def penetration_depth(target, projectile, resistance):
-    """Final nose-tip depth (m) of the integrator, or the crater-stage stop (module docstring)."""
-    crater = crater_depth(projectile)
-    energy = projectile.m * projectile.V0 ** 2
-    static = resistance.crater_force(0.0)
-    if energy <= crater * static:
-        return math.sqrt(energy * crater / static)
+    """Final nose-tip depth (m) of the integrator (also where the crater stops it)."""
     return float(penetrate(target, projectile, resistance).depth[-1])
 
 
