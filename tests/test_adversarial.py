@@ -55,6 +55,12 @@ case("stress-table-refused", ["stress", "--resistance", "table", "--velocity", "
                               "--depth", "0.1"], 2)
 case("paper-with-dynamic", ["penetrate", "--resistance", "paper", "--boundary", "dynamic",
                             "--out", "{tmp}/o"], 2)
+for command, argv in (("penetrate", ["--out", "{tmp}/o"]),
+                      ("stress", ["--velocity", "500", "--depth", "0.1"]),
+                      ("trajectory", ["--out", "{tmp}/o"])):
+    case(f"epsilon-without-paper-{command}", [command, "--epsilon", "cylindrical", *argv], 2)
+case("calibrate-repeated-id", ["calibrate", "--shots", "{tmp}/s.csv", "--ids", "A1", "A1",
+                               "--params", "lam", "--out", "{tmp}/c.toml"], 2, {"s.csv": SHOTS})
 case("table-without-file", ["penetrate", "--resistance", "table", "--out", "{tmp}/o"], 2)
 case("file-without-table", ["penetrate", "--table", "{tmp}/t.nc", "--out", "{tmp}/o"], 2,
      {"t.nc": b"CDF\x01"})

@@ -102,7 +102,12 @@ class ShotFile:
     columns: tuple
 
     def by_id(self, ids):
-        """The shots with ``ids``, in the order given; an unknown id is an input error."""
+        """The shots with ``ids``, in the order given; an unknown or repeated id is an input
+        error (a repeat would weigh a shot twice in a fit)."""
+        repeated = sorted({i for i in ids if list(ids).count(i) > 1})
+        if repeated:
+            raise CavexInputError(f"shot id(s) {', '.join(map(repr, repeated))} given more than "
+                                  "once", "ids")
         known = {s.id: s for s in self.shots}
         missing = [i for i in ids if i not in known]
         if missing:
