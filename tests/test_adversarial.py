@@ -297,6 +297,15 @@ case("trajectory-ramp-at-bounds", ["trajectory", "--contact-ramp", "0.001", "--o
                                    "45", "--no-figures", "--out", "{tmp}/o"], 0)
 case("trajectory-tail-first", ["trajectory", "--attack", "89.99", "--no-figures", "--out",
                                "{tmp}/o"], 1)
+case("trajectory-too-heavy-to-stop", ["trajectory", "--config", "{tmp}/c.toml", "--no-figures",
+                                      "--out", "{tmp}/o"], 1,
+     {"c.toml": _config("m = 0.505", "m = 1e6\nlength = 2.0")})
+case("trajectory-lightest", ["trajectory", "--config", "{tmp}/c.toml", "--no-figures", "--out",
+                             "{tmp}/o"], 0,
+     {"c.toml": _config("m = 0.505", "m = 1e-6\nlength = 0.2")})
+case("trajectory-friction-10", ["trajectory", "--config", "{tmp}/c.toml", "--obliquity", "80",
+                                "--no-figures", "--out", "{tmp}/o"], 0,
+     {"c.toml": _config("m = 0.505", "m = 0.505\nmu = 10")})
 case("calibrate-bom-crlf", ["calibrate", "--shots", "{tmp}/s.csv", "--params", "lam",
                             "--out", "{tmp}/c.toml"], 0,
      {"s.csv": ("\ufeff" + SHOTS.replace("\n", "\r\n")).encode("utf-8")})

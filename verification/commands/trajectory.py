@@ -75,23 +75,26 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
 
 
 def check_answered(name, result):
-    """A run that reached the 1 s time limit still moving is no answer (numerical failure): the
-    body has turned tail-first and slides through the target, which resists only surfaces
-    moving into it and has no tail face to plough (a large attack, or one against the
-    obliquity, gets there)."""
+    """A run that reached the 1 s time limit still moving is no answer (numerical failure):
+    either the body has turned tail-first and slides through the target, which resists only
+    surfaces moving into it and has no tail face to plough (a large attack, or one against the
+    obliquity, gets there), or it is too heavy for the target to stop within the time limit."""
     from cavex.errors import CavexNumericalError
 
     end = result.end
     if end["state"] != "time limit":
         return
     y = result.solutions[-1].y[:, -1]
-    heading = float(np.dot(result.model.axis(y), y[7:10]))
-    how = ("turned tail-first and slid" if heading < 0.0 else "still moved")
-    raise CavexNumericalError(
-        f"the {name} trajectory did not end: the body {how} to the {end['time_s']:g} s time "
-        f"limit ({end['speed_m_s']:.3g} m/s, nose tip {end['nose_tip_m'][2]:.3g} m deep); the "
-        "model loads only surfaces moving into the target (no tail face): use a smaller "
-        "--attack or one toward the obliquity")
+    where = (f"to the {end['time_s']:g} s time limit ({end['speed_m_s']:.3g} m/s, nose tip "
+             f"{end['nose_tip_m'][2]:.3g} m deep)")
+    if float(np.dot(result.model.axis(y), y[7:10])) < 0.0:
+        why = ("the body turned tail-first and slid " + where + "; the model loads only "
+               "surfaces moving into the target (no tail face): use a smaller --attack or one "
+               "toward the obliquity")
+    else:
+        why = (f"the body was still moving nose-first {where}: a body this heavy for the target "
+               "is beyond the model's time")
+    raise CavexNumericalError(f"the {name} trajectory did not end: {why}")
 
 
 @contextmanager
