@@ -1,29 +1,37 @@
-"""Closed-form layered cavity expansion, nose resistance and the rigid-projectile integrator."""
+"""Closed-form layered cavity expansion, nose resistance and the rigid-projectile integrator.
 
-from cavex.analytic.cavity import (
-    CavityState,
-    cavity_solution,
-    cavity_stress,
-    plastic_radius,
-    quasi_static_coefficients,
-    response_state,
-)
-from cavex.analytic.geometry import spherical_problem
-from cavex.analytic.paper_model import (
-    PaperCoefficients,
-    PaperModel,
-    paper_coefficients,
-    paper_phase_depths,
-    paper_stress,
-)
-from cavex.analytic.penetration.integrator import Trajectory, penetrate
-from cavex.analytic.penetration.nose import nose_force, ogive_coefficients
-from cavex.analytic.penetration.oblique import Strike, fly
-from cavex.analytic.penetration.resistance import ClosedFormResistance, make_resistance
+The names below are imported on first use (PEP 562), so that importing one submodule (e.g. the
+resistance vocabulary the command line's parser needs) does not compile or load the others
+(numba, scipy)."""
 
-__all__ = ["CavityState", "ClosedFormResistance", "PaperCoefficients", "PaperModel", "Strike",
-           "Trajectory", "cavity_solution", "cavity_stress", "fly", "make_resistance",
-           "nose_force",
-           "ogive_coefficients",
-           "paper_coefficients", "paper_phase_depths", "paper_stress", "penetrate",
-           "plastic_radius", "quasi_static_coefficients", "response_state", "spherical_problem"]
+import importlib
+
+#: public name -> the submodule that defines it
+_WHERE = {
+    "CavityState": "cavity", "cavity_solution": "cavity", "cavity_stress": "cavity",
+    "plastic_radius": "cavity", "quasi_static_coefficients": "cavity",
+    "response_state": "cavity",
+    "spherical_problem": "geometry",
+    "PaperCoefficients": "paper_model", "PaperModel": "paper_model",
+    "paper_coefficients": "paper_model", "paper_phase_depths": "paper_model",
+    "paper_stress": "paper_model",
+    "Trajectory": "penetration.integrator", "penetrate": "penetration.integrator",
+    "nose_force": "penetration.nose", "ogive_coefficients": "penetration.nose",
+    "Strike": "penetration.oblique", "fly": "penetration.oblique",
+    "ClosedFormResistance": "penetration.resistance",
+    "make_resistance": "penetration.resistance",
+}
+
+__all__ = sorted(_WHERE)
+
+
+def __getattr__(name):
+    if name not in _WHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted([*globals(), *_WHERE])

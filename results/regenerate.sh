@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Regenerate every committed result with the commands a user runs (from the repository root, with
 # cavex installed): penetration (derived and the paper's model), the calibrations and the
-# validation against the Forrestal et al. (1994) shots, the verification report and the oblique
-# study. Afterwards `git status results` shows what changed (on another CPU: nothing; see
-# cavex.verification.output.number_format for the digits written).
+# validation against the Forrestal et al. (1994) shots, the verification report, the oblique
+# study and the concrete study. Afterwards `git status results` shows what changed (on another
+# CPU: nothing; see cavex.verification.output.number_format for the digits written).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cavex penetrate --out results/penetration > results/penetration/summary.txt
@@ -25,4 +25,5 @@ cavex validate --shots examples/shots_forrestal1994.csv --calibration \
   --out results/validation --no-progress > /dev/null
 cavex verify --no-progress > /dev/null
 python -m cavex.verification.studies.oblique_study --no-progress > /dev/null
+python -m cavex.verification.studies.concrete_validation --workers 2 > /dev/null
 git status --short results

@@ -117,14 +117,19 @@ def test_write_result_is_an_xdmf_time_series_meshio_reads_back(tmp_path):
     t, point_data, cell_data = steps[-1]
     assert t == pytest.approx(layered.history["time"][-1], rel=1e-12)
     # the reference points plus u are the current configuration: the wall at the final radius
-    assert points[0, 0] + point_data["u [m]"][0, 0] == pytest.approx(0.0125, rel=1e-9)
-    assert set(cell_data) == {"sigma_r [Pa]", "sigma_theta [Pa]", "plastic_strain [1]",
-                              "layer [index]"}
-    assert np.all(cell_data["sigma_r [Pa]"][0][:5] > 0)
-    assert set(np.unique(cell_data["layer [index]"][0])) == {0, 1}
+    assert points[0, 0] + point_data["u_m"][0, 0] == pytest.approx(0.0125, rel=1e-9)
+    assert set(cell_data) == {"sigma_r_Pa", "sigma_theta_Pa", "plastic_strain", "layer"}
+    assert np.all(cell_data["sigma_r_Pa"][0][:5] > 0)
+    assert set(np.unique(cell_data["layer"][0])) == {0, 1}
     history = np.loadtxt(tmp_path / "run_history.csv", delimiter=",", skiprows=1)
-    assert (tmp_path / "run_history.csv").read_text().startswith("time [s],radius [m]")
-    assert history[-1, 2] == pytest.approx(layered.cavity_stress)
+    assert (tmp_path / "run_history.csv").read_text().startswith(
+        "time_s,radius_m,wall_stress_Pa,plastic_radius_m\n")
+    assert history[-1, 2] == layered.history["wall_stress"][-1]  # 17 digits: exact
+    final = meshio.read(tmp_path / "run_final.vtu")  # the last snapshot, one mesh
+    assert np.array_equal(final.points, points)
+    for name, values in cell_data.items():
+        assert np.array_equal(final.cell_data[name][0], values[0])
+    assert np.array_equal(final.point_data["u_m"], point_data["u_m"])
 
 
 def test_compare_at_depth_is_json_and_side_by_side():

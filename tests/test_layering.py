@@ -9,8 +9,9 @@ Floors, bottom to top (README "Where things are"):
   closed forms (``cavity``, ``paper_model``, ``geometry``) sit below the penetration feature
   (``analytic/penetration/``);
 - ``verification/``: ``output/`` (file formats) at the bottom, then ``fedata/`` (FE data
-  production), then ``report/``, ``validation/`` and ``studies/`` (which use ``fedata/`` but
-  not each other), then ``commands/`` (one module per command), then ``cli``.
+  production), then ``report/`` and ``validation/`` (which use ``fedata/`` but not each
+  other), then ``studies/`` (which may use ``validation/``: a study of the validation data),
+  then ``commands/`` (one module per command), then ``cli``.
 """
 
 import ast
@@ -39,10 +40,11 @@ ALLOWED = {
     V + "validation": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
                               V + "validation"),
     V + "studies": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
-                           V + "studies"),
+                           V + "validation", V + "studies"),
     V + "commands": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
                             V + "report", V + "validation", V + "studies", V + "commands"),
     V + "cli": ("cavex",),
+    "cavex.__main__": (V + "cli",),  # `python -m cavex`: the command line, nothing else
     "cavex": CORE,
 }
 

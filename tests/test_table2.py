@@ -9,10 +9,9 @@ import pytest
 from cavex.analytic.paper_model import layer_epsilon
 from cavex.analytic.penetration.integrator import crater_depth
 from cavex.config import load_config
-from cavex.verification.studies.table2 import PAPER_TABLE2, table2_rows
+from cavex.verification.studies.table2 import PAPER_TABLE2, PRINT_HALF_UNIT, table2_rows
 from cavex.verification.studies.table2_study import (
     ADMISSIBLE,
-    PRINT_HALF_UNIT,
     Reading,
     ReadingResistance,
     factorial_readings,

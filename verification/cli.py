@@ -17,13 +17,18 @@ DEFAULT_PENETRATION_DIR = "results/penetration"
 
 
 class _Help(argparse.ArgumentDefaultsHelpFormatter):
-    """Every option's help shows its default, unless the help already says it."""
+    """Every option's help shows its default (or that it is required), unless the help already
+    says it; a flag (off unless given) shows none."""
 
     def _get_help_string(self, action):
         text = action.help or ""
-        if "default" in text or action.default in (None, False, argparse.SUPPRESS):
+        if "default" in text or "required" in text:
             return text
-        return super()._get_help_string(action)
+        if action.required or not action.option_strings:
+            return text + " (required)"
+        if action.default is None or action.default is False or action.nargs == 0:
+            return text
+        return text + " (default: %(default)s)"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -56,6 +61,7 @@ def build_parser():
     add_resistance_options(penetrate)
     penetrate.add_argument("--json", action="store_true", help="print JSON")
     penetrate.add_argument("--out", default=DEFAULT_PENETRATION_DIR, help="output folder")
+    _figures(penetrate, "the CSV trajectories and phase table")
     penetrate.add_argument("--crater", choices=("nose-base", "nose-tip"), default="nose-base",
                            help="where the crater depth 4.5 r is measured from")
     stress = commands.add_parser("stress", help="cavity-wall stress at a nose depth")
@@ -71,14 +77,17 @@ def build_parser():
     fem.add_argument("--nu", type=float, help="Poisson's ratio for every layer (default: file's)")
     fem.add_argument("--json", action="store_true", help="print JSON")
     fem.add_argument("--fields", help="folder for the FE fields (XDMF time series for ParaView "
-                     "and meshio, history CSV)")
+                     "and meshio, history CSV; default: none written)")
     table = commands.add_parser("table", help="FE-tabulated sigma_r(V, L) for the target")
     _config(table)
     table.add_argument("--velocities", nargs="+", type=float,
                        help="m/s (default 0, 100, ..., 1200)")
-    table.add_argument("--depths", nargs="+", type=float, help="nose depths, m")
+    table.add_argument("--depths", nargs="+", type=float, help="nose depths, m (default: the "
+                       "target's default grid; the layer switch and refinement depths are "
+                       "added, and the run states the grid)")
     table.add_argument("-o", "--out", default="results/table.nc", help="NetCDF file to write")
-    table.add_argument("--nu", type=float, help="Poisson's ratio for every layer")
+    table.add_argument("--nu", type=float, help="Poisson's ratio for every layer (default: "
+                       "file's)")
     table.add_argument("--json", action="store_true", help="print JSON")
     _parallel(table)
     verify = commands.add_parser("verify", help="analytic against FE report for the target")
@@ -108,9 +117,11 @@ def build_parser():
                                    "depths (docs/validation.md)")
     validate.add_argument("--shots", required=True, help="shot file (CSV)")
     validate.add_argument("--calibration", nargs="+", action="extend",
-                          help="calibration TOML file(s) from `cavex calibrate`")
+                          help="calibration TOML file(s) from `cavex calibrate` (default: "
+                          "none, the uncalibrated models only)")
     validate.add_argument("--json", action="store_true", help="print JSON")
     validate.add_argument("--out", help="output folder (default results/validation)")
+    _figures(validate, "validation.json, predictions.csv and report.md")
     _parallel(validate)
     trajectory = commands.add_parser("trajectory", help="oblique shot with attitude: the rigid "
                                      "projectile in 3-D through the layers (docs/oblique.md)")
@@ -129,21 +140,25 @@ def build_parser():
                             help="contact regularisation: the stress rises linearly over "
                             "0 < V_n < this (m/s; default 0.01; docs/oblique.md)")
     trajectory.add_argument("--law-A", dest="law_A", type=float, help="A of sigma_n = A + B "
-                            "V_n^2 (Pa)")
-    trajectory.add_argument("--law-B", dest="law_B", type=float, help="B (kg/m^3)")
+                            "V_n^2 (Pa; required with --resistance law, default: none)")
+    trajectory.add_argument("--law-B", dest="law_B", type=float, help="B (kg/m^3; required "
+                            "with --resistance law, default: none)")
     trajectory.add_argument("--no-free-surface", action="store_true",
                             help="no free-surface reduction of the derived law")
     trajectory.add_argument("--compare-homogeneous", action="store_true",
                             help="also the same shot into the first layer alone")
     trajectory.add_argument("--json", action="store_true", help="print JSON")
-    trajectory.add_argument("--figures", action=argparse.BooleanOptionalAction, default=True,
-                            help="draw the figures (default; --no-figures: the CSV histories "
-                            "and summary.json only, for scripted runs)")
+    _figures(trajectory, "the CSV histories and summary.json")
     trajectory.add_argument("--progress", action=argparse.BooleanOptionalAction,
                             help="progress bar of integrator steps on stderr (default: when "
                             "stderr is a terminal)")
     trajectory.add_argument("--out", default="results/trajectory",
                             help="output folder (default results/trajectory)")
+    config = commands.add_parser("config", help="print the configuration as TOML: the embedded "
+                                 "default (Table 1) to copy and edit, or a checked --config FILE")
+    _config(config)
+    config.add_argument("--default", action="store_true", help="the embedded default (also "
+                        "without --config)")
     _describe(commands)
     return parser
 
@@ -157,14 +172,59 @@ def _describe(commands):
 
 
 def _parallel(command):
-    command.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://127.0.0.1:8786")
+    command.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://127.0.0.1:8786 "
+                         "(default: local processes, --workers)")
     command.add_argument("--workers", type=int, help="local worker processes (default: CPUs)")
     command.add_argument("--progress", action=argparse.BooleanOptionalAction,
                          help="progress bar on stderr (default: when stderr is a terminal)")
 
 
+def _figures(command, files):
+    """``--figures/--no-figures``: draw the PNG figures (default), or write only ``files`` (for
+    scripted runs: no matplotlib)."""
+    command.add_argument("--figures", action=argparse.BooleanOptionalAction, default=True,
+                         help=f"draw the figures (default; --no-figures: {files} only, for "
+                         "scripted runs)")
+
+
 def _config(command):
     command.add_argument("--config", help="target TOML file (default: the paper's Table 1)")
+
+
+COMPILING = ("cavex: compiling the numerical kernels (first run after installing or updating; "
+             "cached for later runs)")
+
+
+def announce_compiling(stream):
+    """Write :data:`COMPILING` to ``stream`` once, when numba starts compiling a kernel (its
+    ``numba:compile`` event fires on a cache miss only: a kernel loaded from numba's cache says
+    nothing). Returns the listener (registered for the rest of the process)."""
+    from numba.core import event
+
+    class Notice(event.Listener):
+        said = False
+
+        def on_start(self, _event):
+            if not Notice.said:
+                Notice.said = True
+                print(COMPILING, file=stream, flush=True)
+
+        def on_end(self, _event):
+            pass
+
+    listener = Notice()
+    event.register("numba:compile", listener)
+    return listener
+
+
+_ANNOUNCED = []  # the listener of this process, once registered
+
+
+def _announce_on_terminal(command):
+    """The compile notice on stderr when it is a terminal (as the progress bars), once per
+    process; ``cavex config`` compiles nothing."""
+    if command != "config" and not _ANNOUNCED and sys.stderr.isatty():
+        _ANNOUNCED.append(announce_compiling(sys.stderr))
 
 
 def main(argv=None):
@@ -175,7 +235,10 @@ def main(argv=None):
         if args.command is None:  # bare `cavex`: what it can do
             parser.print_help()
             return 0
+        if args.command == "config" and args.default and args.config is not None:
+            raise CavexInputError("options --default and --config FILE exclude each other")
         target, projectile = load_config(args.config) if "config" in args else (None, None)
+        _announce_on_terminal(args.command)
         command = importlib.import_module(f"cavex.verification.commands.{args.command}")
         text = command.run(args, target, projectile)
     except CavexInputError as exc:

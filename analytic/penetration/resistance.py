@@ -21,76 +21,23 @@ import numpy as np
 from cavex.analytic.cavity import material_table, nose_walk, state_label
 from cavex.analytic.geometry import spherical_problem, surrounding
 from cavex.analytic.paper_model import PaperModel
+from cavex.analytic.penetration.labels import (  # noqa: F401 (the vocabulary, re-exported)
+    DEFAULT_BOUNDARY,
+    MODEL_LABELS,
+    MODELS,
+    OLD_LABELS,
+    PAPER_BOUNDARY,
+    RESISTANCES,
+    check_model,
+    label_options,
+    model_boundary,
+    model_label,
+    parse_model_label,
+)
 from cavex.analytic.penetration.nose import nose_rule, ogive_coefficients
-from cavex.errors import CavexInputError, CavexNumericalError, require, require_choice
-from cavex.problem import BOUNDARIES
+from cavex.errors import CavexNumericalError, require, require_choice
 
-MODELS = ("derived", "paper")  # the closed forms (ClosedFormResistance)
-#: Every 1-D resistance a caller can choose (``resistance=``, ``--resistance``): the two closed
-#: forms and the FE table (:class:`cavex.analytic.penetration.tabulated.TabulatedResistance`).
-RESISTANCES = (*MODELS, "table")
-#: The model labels (keys and labels in JSON, CSV, reports, calibration files): the resistance
-#: and, for the derived model, its boundary convention (:func:`model_label`).
-MODEL_LABELS = ("derived-quasi-static", "derived-dynamic", "paper", "table")
-#: Earlier spellings of a model label (validation's columns, ``calibrate --model``), each with
-#: the label that replaced it; refused with a line that names the new one.
-OLD_LABELS = {"derived quasi-static": "derived-quasi-static",
-              "derived dynamic": "derived-dynamic", "FE table": "table", "fe-table": "table"}
-#: The derived model's default boundary convention: the closed form closest to the FE in every
-#: layer of the default target (results/verification/report.md; README "Commands").
-DEFAULT_BOUNDARY = "dynamic"
-PAPER_BOUNDARY = "quasi-static"  # the paper's printed model has its own convention
 RECENT = 32  # (depth, velocity) answers kept
-
-
-def model_boundary(model, boundary=None):
-    """The boundary convention ``model`` runs with: ``boundary``, or when None the model's
-    default (:data:`DEFAULT_BOUNDARY` for "derived", the paper's quasi-static for "paper")."""
-    if boundary is None:
-        return PAPER_BOUNDARY if model == "paper" else DEFAULT_BOUNDARY
-    return boundary
-
-
-def check_model(model, boundary=None):
-    """The model is known, and the paper model is only offered with its quasi-static boundary
-    (None: the model's default, :func:`model_boundary`)."""
-    require_choice(model, MODELS, "model")
-    if boundary is not None:
-        require_choice(boundary, BOUNDARIES, "boundary")
-    boundary = model_boundary(model, boundary)
-    require(model != "paper" or boundary == PAPER_BOUNDARY, "boundary",
-            "'quasi-static' for the paper model", boundary)
-
-
-def model_label(resistance, boundary=None):
-    """The label of ``resistance`` with ``boundary``: ``derived-<boundary>`` (None: the default
-    boundary, :func:`model_boundary`), ``paper`` (its own quasi-static boundary only), ``table``
-    (the FE has no boundary convention)."""
-    require_choice(resistance, RESISTANCES, "resistance")
-    if resistance == "table":
-        return "table"
-    check_model(resistance, boundary)
-    return "paper" if resistance == "paper" else f"derived-{model_boundary(resistance, boundary)}"
-
-
-def parse_model_label(label, parameter="model"):
-    """``(resistance, boundary)`` of a label of :data:`MODEL_LABELS` (``boundary`` None for
-    ``paper`` and ``table``: they have no choice of it), so that
-    ``model_label(*parse_model_label(label)) == label``. An old spelling
-    (:data:`OLD_LABELS`) is refused with the label that replaced it."""
-    if isinstance(label, str) and label in OLD_LABELS:
-        raise CavexInputError(f"must be '{OLD_LABELS[label]}' (the label '{label}' was "
-                              "replaced)", parameter)
-    require_choice(label, MODEL_LABELS, parameter)
-    resistance, _, boundary = label.partition("-")
-    return resistance, boundary or None
-
-
-def label_options(label):
-    """The command-line options that choose ``label``, e.g. ``--resistance derived --boundary
-    quasi-static``."""
-    resistance, boundary = parse_model_label(label)
-    return f"--resistance {resistance}" + (f" --boundary {boundary}" if boundary else "")
 
 
 def make_resistance(target, projectile, resistance="derived", boundary=None,

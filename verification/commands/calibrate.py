@@ -3,6 +3,7 @@ calibration file (:mod:`cavex.verification.validation.calibration`, docs/validat
 
 import json
 import shlex
+import sys
 import time
 from pathlib import Path
 
@@ -25,6 +26,9 @@ def run(args, target, projectile):
                  progress=args.progress, out=out)
     calibration = result["calibration"]
     command = command_line(args.shots, args.out, calibration.model, params, args.ids)
+    warning = all_fitted_warning(shots, len(shot_file.shots))
+    if warning:
+        print(f"cavex calibrate: warning: {warning}", file=sys.stderr)
     reference = next(s for s in shots if s.id in calibration.shots)  # the first one fitted
     document = summary(result, write_outputs(result, args.shots, reference, command, out))
     return json.dumps(document, indent=2) if args.json else text(document)
@@ -95,6 +99,7 @@ def summary(job, out):
     calibration = job["calibration"]
     return {"model": calibration.model, "params": list(calibration.params),
             "fitted": {p: getattr(calibration.mapping, p) for p in calibration.params},
+            "standard_errors": dict(calibration.standard_errors),
             "mapping": calibration.mapping.as_dict(), "shots": list(calibration.shots),
             **dict(calibration.statistics),
             "skipped": {shot: reason for shot, reason in calibration.skipped},
@@ -108,7 +113,8 @@ def text(summary):
     """The model and its shots, the fitted values, the fit, the shots the model could not
     predict (left out of the fit), the file."""
     s = summary
-    values = ", ".join(f"{p} = {v:.6g}" for p, v in s["fitted"].items())
+    errors = s["standard_errors"]
+    values = ", ".join(f"{p} = {v:.6g}" + _error(errors.get(p)) for p, v in s["fitted"].items())
     return "\n".join([
         f"model   {s['model']}, {len(s['shots'])} shots: {', '.join(s['shots'])}",
         f"fitted  {values}",
@@ -119,3 +125,19 @@ def text(summary):
         *_outlier_lines(s),
         f"wrote   {s['output']}",
     ])
+
+
+def _error(se):
+    """`` +- se`` (the fit's standard error, 2 significant digits), or why there is none."""
+    if se is None:
+        return " (no standard error: as many shots as parameters)"
+    return f" +- {se:.2g}"
+
+
+def all_fitted_warning(fitted, available):
+    """The warning when the fit used every shot of the file (None otherwise): ``cavex
+    validate`` then has no held-out shot to judge the calibration on."""
+    if len(fitted) < available:
+        return None
+    return (f"every shot of the file ({available}) was fitted: `cavex validate` has no "
+            "held-out shot to judge this calibration on (fit a subset with --ids)")

@@ -1,35 +1,63 @@
 """``cavex fem``: the FE wall stress against both closed-form conventions at one nose depth."""
 
 import json
+import sys
+
+#: m/s: the upper end of the model's range (docs/fem.md "Range"): the velocities the FE is
+#: verified over (cavex.verification.fedata.table.DEFAULT_VELOCITIES, 0-1200 m/s), a little
+#: above the speeds the rigid-projectile model is used at (the paper's V0 = 1000 m/s, the
+#: validation shots to 800 m/s); beyond it the wall stress leaves the constitutive law (no
+#: equation of state) and a real projectile deforms.
+RANGE_VELOCITY = 1200.0
 
 
 def run(args, target, projectile):
-    """The comparison as text or JSON; ``--fields`` also writes the FE fields."""
+    """The comparison as text or JSON; ``--fields`` also writes the FE fields. A velocity
+    beyond :data:`RANGE_VELOCITY` is computed, with one warning line on stderr."""
     document = summary(job(target, projectile, args.depth, args.velocity, nu=args.nu,
                            fields=args.fields))
+    for warning in document["warnings"]:
+        print(f"cavex fem: warning: {warning}", file=sys.stderr)
     return json.dumps(document, indent=2) if args.json else text(document)
 
 
+def range_warnings(velocity, wall_stress):
+    """What to say about ``velocity`` (m/s) with the FE ``wall_stress`` (Pa): a sentence if it
+    is beyond :data:`RANGE_VELOCITY`, else nothing."""
+    if velocity <= RANGE_VELOCITY:
+        return []
+    return [f"V = {velocity:g} m/s is beyond {RANGE_VELOCITY:g} m/s, the model's range (the "
+            f"incompressible rigid-projectile regime, docs/fem.md 'Range'): a real projectile "
+            f"deforms, and the wall stress ({wall_stress / 1e9:.3g} GPa) is beyond the "
+            "constitutive law"]
+
+
 def job(target, projectile, depth, velocity, *, nu=None, fields=None):
-    """:func:`cavex.verification.fedata.comparison.compare_at_depth` (JSON-able)."""
+    """:func:`cavex.verification.fedata.comparison.compare_at_depth` (JSON-able). The problem
+    is checked first, before the FE solver is loaded: bad input answers at once."""
+    from cavex.analytic.geometry import spherical_problem
+    from cavex.problem import SphericalProblem
+
+    SphericalProblem(*spherical_problem(target, projectile, depth), velocity, projectile.r)
     from cavex.verification.fedata.comparison import compare_at_depth
 
     return compare_at_depth(target, projectile, depth, velocity, nu=nu, fields=fields)
 
 
 def summary(job):
-    """What ``cavex fem --json`` prints: the comparison as it is."""
-    return job
+    """What ``cavex fem --json`` prints: the comparison as it is, with ``warnings`` (the
+    velocity beyond the model's range, :func:`range_warnings`)."""
+    return {**job, "warnings": range_warnings(job["velocity_m_s"], job["fe_sigma_r_Pa"])}
 
 
 def text(summary):
     """The problem, the FE and analytic wall stresses with their differences, the estimate."""
     s = summary
     fe, analytic = s["fe_sigma_r_Pa"], s["analytic_sigma_r_Pa"]
-    lines = [f"nose depth {s['depth_m']} m, V = {s['velocity_m_s']} m/s, cavity "
-             f"radius {s['cavity_radius_m']} m, layers {', '.join(s['layers'])}",
-             f"interfaces (m): requested {s['interface_radii_m']}, FE final "
-             f"{s['interface_radii_final_m']}",
+    lines = [f"nose depth {s['depth_m']:.6g} m, V = {s['velocity_m_s']:.6g} m/s, cavity "
+             f"radius {s['cavity_radius_m']:.6g} m, layers {', '.join(s['layers'])}",
+             f"interfaces (m): requested {_radii(s['interface_radii_m'])}, FE final "
+             f"{_radii(s['interface_radii_final_m'])}",
              f"{'':<26} {'sigma_r (MPa)':>14} {'FE/analytic - 1':>16} {'b (m)':>10}",
              f"{'FE':<26} {fe / 1e6:14.3f} {'':>16} {s['fe_plastic_radius_m']:10.5f}"]
     for boundary, stress in analytic.items():
@@ -41,5 +69,11 @@ def text(summary):
                  + ("not estimated" if estimate is None else f"{estimate:.3%}")
                  + f" ({s['refinements']} refinement(s) of the default resolution)")
     if "fields" in s:
-        lines.append(f"wrote   {s['fields']} (+ history CSV)")
+        lines.append(f"wrote   {s['fields']} (time series: meshio.xdmf.TimeSeriesReader), "
+                     "fem_final.vtu (meshio.read), fem_history.csv")
     return "\n".join(lines)
+
+
+def _radii(radii):
+    """Interface radii (m) to 6 significant digits, or "none"."""
+    return ", ".join(f"{r:.6g}" for r in radii) or "none"

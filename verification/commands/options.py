@@ -15,7 +15,7 @@ names the new options (exit code 2).
 import argparse
 
 from cavex.analytic.paper_model import EPSILON_READINGS
-from cavex.analytic.penetration.resistance import (
+from cavex.analytic.penetration.labels import (
     MODEL_LABELS,
     MODELS,
     OLD_LABELS,
@@ -48,7 +48,7 @@ def add_resistance_options(command, offered=RESISTANCES, table=True, epsilon=Tru
                          "dynamic; the paper model has its own, quasi-static)")
     if table:
         command.add_argument("--table", help="NetCDF table from `cavex table` (--resistance "
-                             "table; the first layer alone: the derived model)")
+                             "table; the first layer alone: the derived model; default: none)")
     if epsilon:
         command.add_argument("--epsilon", choices=EPSILON_READINGS,
                              help="the paper model's reading of epsilon (docs/table2.md) "

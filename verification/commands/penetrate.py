@@ -13,7 +13,7 @@ from cavex.analytic.penetration.resistance import make_resistance, model_boundar
 from cavex.config import load_config
 from cavex.verification.output.files import save_figure, write_columns_csv
 from cavex.verification.output.paths import check_output_dir, write_staged
-from cavex.verification.studies.table2 import table2_comparison
+from cavex.verification.studies.table2 import not_reproduced_line, table2_comparison
 
 
 def run(args, target, projectile):
@@ -24,7 +24,7 @@ def run(args, target, projectile):
     settings = resistance_settings(args)
     folder = check_output_dir(args.out, "out")
     job = penetration_job(target, projectile, crater=args.crater, **settings)
-    written = write_staged(folder, lambda stage: write_outputs(job, stage))
+    written = write_staged(folder, lambda stage: write_outputs(job, stage, draw=args.figures))
     document = summary(job, written)
     return json.dumps(document, indent=2) if args.json else text(document)
 
@@ -96,6 +96,8 @@ def text(summary):
             ours["depth_m"], paper["depth_m"], ours["velocity_m_s"], paper["velocity_m_s"],
             ours["time_s"] * 1e3, paper["time_s"] * 1e3) if ours else "(phase not reached)")
         lines.append(f"{row['phase']} {row['name']:<30} {mine}")
+    if s["table2"] is not None:
+        lines.append(not_reproduced_line(s["table2"]))
     lines += ["", "wrote: " + ", ".join(s["outputs"])]
     return "\n".join(lines)
 
@@ -131,8 +133,9 @@ def phases_as_dicts(trajectory):
              "end_reason": p.end_reason} for i, p in enumerate(trajectory.phases)]
 
 
-def write_outputs(job, out_dir):
-    """Write CSV trajectories, the phase table and PNG figures; return the written paths."""
+def write_outputs(job, out_dir, draw=True):
+    """Write CSV trajectories, the phase table and (if ``draw``) PNG figures; return the
+    written paths."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     written = []
@@ -140,7 +143,8 @@ def write_outputs(job, out_dir):
         written.append(write_columns_csv(out / f"trajectory_{name}.csv", trajectory.as_columns()))
     written.append(write_columns_csv(out / "phases_runway.csv",
                               _columns(phases_as_dicts(job["runs"]["runway"]))))
-    written += _write_figures(job, out)
+    if draw:
+        written += _write_figures(job, out)
     return [str(p) for p in written]
 
 
@@ -159,7 +163,7 @@ def _write_figures(job, out):
     runway, single = job["runs"]["runway"], job["runs"]["first_layer_only"]
     subtitle = textwrap.fill(job["title"], 70)
     names = job.get("layer_names", [])
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
     runway_label = "runway (layered)" if job.get("table") is None else \
         "runway (layered, FE table)"
     ax.plot(runway.t * 1e3, runway.velocity, label=runway_label)
@@ -167,9 +171,9 @@ def _write_figures(job, out):
             " alone")
     ax.set(xlabel="time (ms)", ylabel="velocity (m/s)")
     ax.set_title(f"Velocity against time\n{subtitle}", fontsize=10)
-    ax.legend()
+    _legend_below(ax)
     velocity_png = _save(fig, out / "velocity_time.png", plt)
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
     ax.plot(runway.depth, runway.deceleration / 9.81 / 1e3, label=runway_label)
     ax.plot(single.depth, single.deceleration / 9.81 / 1e3, "--",
             label=f"{names[0] if names else 'first layer'} alone")
@@ -185,8 +189,14 @@ def _write_figures(job, out):
     ax.set_xlim(left, right)
     ax.set(xlabel="nose-tip depth (m)", ylabel=r"deceleration ($10^3$ g)")
     ax.set_title(f"Deceleration against depth\n{subtitle}", fontsize=10, pad=14)
-    ax.legend(loc="center right")
+    _legend_below(ax)
     return [velocity_png, _save(fig, out / "deceleration_depth.png", plt)]
+
+
+def _legend_below(ax):
+    """The legend below the axes, off the data."""
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False,
+              fontsize=9)
 
 
 def _save(fig, path, plt):

@@ -3,10 +3,9 @@
 import json
 import math
 
-from cavex.analytic.cavity import cavity_solution
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.analytic.paper_model import paper_coefficients
-from cavex.analytic.penetration.resistance import check_model, model_boundary, model_label
+from cavex.analytic.penetration.labels import check_model, model_boundary, model_label
 from cavex.errors import CavexNumericalError, require
 from cavex.materials import MAX_VELOCITY
 
@@ -33,16 +32,22 @@ def stress_at_depth(target, projectile, depth, velocity, *, resistance="derived"
             f"in [0, {MAX_VELOCITY:g}] m/s", velocity)
     check_model(resistance, boundary)
     boundary = model_boundary(resistance, boundary)
+    layers, interfaces = spherical_problem(target, projectile, depth)  # checks the depth
+    # loaded once the input is checked: bad input answers before numba and scipy load
+    from cavex.analytic.cavity import cavity_solution
+    from cavex.verification.report.analysis import state_meaning
+
     if resistance == "paper":
-        return _finite(_paper(target, projectile, depth, velocity, epsilon))
-    layers, interfaces = spherical_problem(target, projectile, depth)
+        return _finite(_paper(target, projectile, depth, velocity, epsilon, state_meaning))
     state = cavity_solution(layers, interfaces, velocity, projectile.r, boundary=boundary)
     index = wall_layer(target, projectile, depth)
     return _finite({"model": model_label(resistance, boundary), "resistance": resistance,
             "boundary": boundary, "depth_m": depth,
             "velocity_m_s": velocity, "sigma_r_Pa": state.stress, "S": state.S,
-            "S_normalised_by": f"tau of {target.layer_name(index)} ({layers[0].tau} Pa)",
-            "response_state": state.state, "plastic_radius_m": state.plastic_radius,
+            "S_normalised_by": f"tau of {target.layer_name(index)}", "tau_Pa": layers[0].tau,
+            "response_state": state.state,
+            "response_state_meaning": state_meaning(state.state, target.layer_names()),
+            "plastic_radius_m": state.plastic_radius,
             "wall_layer": target.layer_name(index), "interface_radii_m": list(interfaces),
             "plastic_zones": [{"layer": target.layer_name(index + i), "r_inner_m": r0,
                                "r_outer_m": r1} for i, r0, r1 in state.plastic_zones]})
@@ -53,9 +58,43 @@ def summary(job):
     return job
 
 
+DIGITS = 4  # significant digits of the text table (the JSON keeps every digit)
+
+
 def text(summary):
-    """One ``key value`` line per item."""
-    return "\n".join(f"{key:<22} {value}" for key, value in summary.items())
+    """A table of quantity, value (:data:`DIGITS` significant digits) and unit: stresses in
+    MPa, lengths in mm, the response state spelled out (:func:`state_meaning`)."""
+    s = summary
+    g = _digits
+    model = s["model"] + (f", epsilon {s['epsilon']}" if s["resistance"] == "paper"
+                          else f" ({s['boundary']} boundary)")
+    rows = [("model", model, ""), ("nose-tip depth L", g(s["depth_m"]), "m"),
+            ("expansion velocity V", g(s["velocity_m_s"]), "m/s")]
+    if "wall_layer" in s:
+        rows.append(("layer at the wall", s["wall_layer"], ""))
+    rows += [("sigma_r at the wall", g(s["sigma_r_Pa"] / 1e6), "MPa"),
+             ("S = sigma_r / tau", g(s["S"]), f"(tau = {g(s['tau_Pa'] / 1e6)} MPa, "
+              f"{s['S_normalised_by']})")]
+    if s["resistance"] == "paper":
+        rows += [("A, B (S = A + B rho V^2/tau)", f"{g(s['A'])}, {g(s['B'])}",
+                  f"(Eq. {s['equation']})")]
+    rows.append(("response state", f"{s['response_state']}:", s["response_state_meaning"]))
+    if "plastic_radius_m" in s:
+        rows.append(("plastic radius b", g(s["plastic_radius_m"] * 1e3), "mm"))
+        radii = ", ".join(g(r * 1e3) for r in s["interface_radii_m"])
+        rows.append(("interface radii", f"{radii} mm from the cavity centre" if radii
+                     else "none (one layer around the cavity)", ""))
+        zones = "; ".join(f"{z['layer']} {g(z['r_inner_m'] * 1e3)}-{g(z['r_outer_m'] * 1e3)}"
+                          for z in s["plastic_zones"]) or "none"
+        rows.append(("plastic zones", zones, "mm"))
+    width = max(len(name) for name, _, _ in rows)
+    return "\n".join(f"{name:<{width}}  {value}" + (f" {unit}" if unit else "")
+                     for name, value, unit in rows)
+
+
+def _digits(x):
+    """``x`` with :data:`DIGITS` significant digits."""
+    return format(x, f".{DIGITS}g")
 
 
 def _finite(result):
@@ -69,10 +108,11 @@ def _finite(result):
     return result
 
 
-def _paper(target, projectile, depth, velocity, epsilon):
+def _paper(target, projectile, depth, velocity, epsilon, state_meaning):
     c = paper_coefficients(target, projectile, depth, epsilon=epsilon)
     return {"model": "paper", "resistance": "paper", "epsilon": epsilon, "depth_m": depth,
             "velocity_m_s": velocity,
             "sigma_r_Pa": c.stress(velocity), "S": c.S(velocity),
-            "S_normalised_by": f"tau = {c.tau} Pa (as the paper's Eq. {c.equation})",
-            "A": c.A, "B": c.B, "equation": c.equation, "response_state": c.state}
+            "S_normalised_by": f"tau as the paper's Eq. {c.equation}", "tau_Pa": c.tau,
+            "A": c.A, "B": c.B, "equation": c.equation, "response_state": c.state,
+            "response_state_meaning": state_meaning(c.state, target.layer_names())}

@@ -8,6 +8,7 @@ the two wall-layer switch depths): concrete, macadam and into the soil
 import json
 import math
 import shutil
+import sys
 import time
 
 import numpy as np
@@ -38,6 +39,7 @@ def job(target, projectile, velocities=None, depths=None, out_path="results/tabl
         DEFAULT_VELOCITIES,
         build_table,
         check_grid,
+        grid_depths,
     )
     from cavex.verification.output.paths import check_output_file
 
@@ -47,11 +49,33 @@ def job(target, projectile, velocities=None, depths=None, out_path="results/tabl
     out_path = check_output_file(out_path, "out")
     check_execution(workers, scheduler)
     store = out_path.with_name(out_path.name + STORE_SUFFIX)
+    grid = depth_grid(depths, grid_depths(depths, target, projectile))
+    if sys.stderr.isatty():  # said before the run, as the progress bar (the text says it too)
+        print(f"cavex table: {grid_line(grid)}", file=sys.stderr, flush=True)
     start = time.perf_counter()
     ds = build_table(target, projectile, velocities, depths, nu=nu, numerics=numerics,
                      scheduler=scheduler, workers=workers, progress=progress, store=store)
     return {"dataset": ds, "seconds": time.perf_counter() - start, "output": out_path,
-            "store": store}
+            "store": store, "grid": grid}
+
+
+def depth_grid(requested, run):
+    """``{"requested": [...], "added": [...]}`` (m): the depths asked for and those the table
+    adds at the wall-layer switches (:func:`cavex.verification.fedata.table.grid_depths`:
+    each switch depth's node and the refinement depths above it)."""
+    asked = sorted({float(d) for d in requested})
+    added = [float(d) for d in run if not any(abs(d - a) < 1e-6 for a in asked)]
+    return {"requested": asked, "added": added}
+
+
+def grid_line(grid):
+    """One sentence: how many depths run, of which how many were added, and where."""
+    asked, added = grid["requested"], grid["added"]
+    line = f"{len(asked) + len(added)} depths run ({len(asked)} requested"
+    if not added:
+        return line + ", none added)"
+    return (line + f" + {len(added)} added at the layer switches: "
+            + ", ".join(f"{d:.4g}" for d in added) + " m)")
 
 
 def write_outputs(job):
@@ -74,6 +98,8 @@ def summary(job, path):
     return {"cases": ds.sizes["velocity"] * (ds.sizes["depth"] + 1),
             "velocities_m_s": [float(x) for x in ds["velocity"].values],
             "depths_m": [float(x) for x in ds["depth"].values],
+            "depths_requested_m": job["grid"]["requested"],
+            "depths_added_m": job["grid"]["added"],
             "failed": int(ds["failed"].sum()) + int(ds["failed_first_layer"].sum()),
             "max_error_estimate": estimate, "wall_time_s": float(job["seconds"]),
             "output": str(path)}
@@ -87,6 +113,8 @@ def text(summary):
     return "\n".join([
         f"cases   {s['cases']} ({len(v)} velocities {v[0]:g}..{v[-1]:g} m/s x "
         f"{len(d)} depths {d[0]:g}..{d[-1]:g} m, + first layer alone)",
+        "depths  " + grid_line({"requested": s["depths_requested_m"],
+                                "added": s["depths_added_m"]}),
         f"failed  {s['failed']}",
         f"largest FE error estimate {estimate:.3%}",
         f"time    {s['wall_time_s']:.1f} s",

@@ -8,6 +8,7 @@ interfaces marked, a 3-D view of the path in the layered block (pyvista, off-scr
 """
 
 import json
+import math
 import sys
 from contextlib import contextmanager
 from pathlib import Path
@@ -189,20 +190,31 @@ def figures(job, folder):
     return [str(path) for path in written]
 
 
-def _interfaces(ax, target, vertical=True):
+def _interfaces(ax, target, vertical=True, deepest=math.inf):
+    """The interfaces down to ``deepest`` (m) as dashed lines (an interface the shot never
+    reaches would stretch the axis away from what moves)."""
     for H in target.interface_depths:
-        (ax.axhline if vertical else ax.axvline)(H, color="0.5", lw=0.8, ls="--")
+        if H <= deepest:
+            (ax.axhline if vertical else ax.axvline)(H, color="0.5", lw=0.8, ls="--")
+
+
+#: A pitch (deg) or lateral overload (fraction of the axial peak) below this is round-off (a
+#: shot in the plane of symmetry: normal incidence without attack): noted, not plotted.
+PITCH_ROUNDOFF_DEG = 1e-6
+LATERAL_ROUNDOFF = 1e-9
+SIDE_WIDTH_IN = 7.5  # side view: width (in); its height follows the picture's aspect
 
 
 def _layer_names(ax, target):
-    """Each layer's name at the right edge of a side view, at the middle of its depth range
-    (the last one just below the last interface)."""
-    tops = [0.0, *target.interface_depths]
-    bottom = ax.get_ylim()[0]  # the axis is inverted: ylim = (deepest, shallowest)
+    """Each layer's name at the right edge of a side view, in the middle of the part of its
+    depth range that is in view (only the layers in view)."""
+    tops = [0.0, *target.interface_depths, math.inf]
+    deep, shallow = ax.get_ylim()  # the axis is inverted: ylim = (deepest, shallowest)
     for k, name in enumerate(target.layer_names()):
-        low = tops[k + 1] if k + 1 < len(tops) else max(bottom, tops[k] + 0.1)
-        ax.text(1.01, 0.5 * (tops[k] + low), name,
-                transform=ax.get_yaxis_transform(), va="center", fontsize=8, color="0.3")
+        low, high = max(tops[k], shallow, 0.0), min(tops[k + 1], deep)
+        if high > low:
+            ax.text(1.01, 0.5 * (low + high), name, transform=ax.get_yaxis_transform(),
+                    va="center", fontsize=8, color="0.3")
 
 
 def outline_points(result, y):
@@ -219,28 +231,62 @@ def outline_points(result, y):
     return world[:, 0], world[:, 2]
 
 
+def side_limits(xs, zs, target, min_ratio=0.3):
+    """``(x limits, z limits)`` of a side view drawn to scale around what moves: the extent of
+    ``xs``, ``zs`` (outlines and path) and the surface, with a margin; the narrower extent is
+    widened to at least ``min_ratio`` of the wider (a straight shot is not a hairline), and
+    the interfaces the picture reaches are in it."""
+    x0, x1 = float(np.min(xs)), float(np.max(xs))
+    z0, z1 = min(float(np.min(zs)), 0.0), max(float(np.max(zs)), 0.0)
+    span = max(x1 - x0, z1 - z0)
+    margin = 0.08 * span
+    x0, x1, z0, z1 = x0 - margin, x1 + margin, z0 - margin, z1 + margin
+    width, depth = x1 - x0, z1 - z0
+    if width < min_ratio * depth:
+        middle, half = 0.5 * (x0 + x1), 0.5 * min_ratio * depth
+        x0, x1 = middle - half, middle + half
+    elif depth < min_ratio * width:
+        grow = min_ratio * width - depth
+        z0, z1 = z0 - 0.25 * grow, z1 + 0.75 * grow  # mostly below: the target
+    return (x0, x1), (z0, z1)
+
+
 def side_view(job, path):
+    """The path in the plane of obliquity to scale (equal axes) around what moves
+    (:func:`side_limits`): the centre of mass and the outline at 9 equal time intervals, the
+    surface, the interfaces in view and the layers named; the legend below the axes."""
     import matplotlib.pyplot as plt
 
     target = job["target"]
-    fig, ax = plt.subplots(figsize=(7, 6))
+    curves, xs, zs = [], [], []
     for k, (name, result) in enumerate(job["runs"].items()):
         h = result.history
-        color = f"C{k}"
+        outlines = [outline_points(result, result.state(t))
+                    for t in np.linspace(0.0, h["t_s"][-1], 9)]
+        curves.append((name, f"C{k}", h, outlines))
+        xs += [h["cg_x_m"], *(o[0] for o in outlines)]
+        zs += [h["cg_z_m"], *(o[1] for o in outlines)]
+    (x0, x1), (z0, z1) = side_limits(np.concatenate(xs), np.concatenate(zs), target)
+    height = min(max(SIDE_WIDTH_IN * (z1 - z0) / (x1 - x0), 2.2), 8.0)
+    fig, ax = plt.subplots(figsize=(SIDE_WIDTH_IN, height + 1.0))
+    for name, color, h, outlines in curves:
         ax.plot(h["cg_x_m"], h["cg_z_m"], color=color, lw=1, label=f"{name}: centre of mass")
-        t_end = h["t_s"][-1]
-        for t in np.linspace(0.0, t_end, 9):
-            xs, zs = outline_points(result, result.state(t))
-            ax.plot(xs, zs, color=color, lw=0.8)
-    _interfaces(ax, target)
+        for k, (ox, oz) in enumerate(outlines):
+            ax.plot(ox, oz, color=color, lw=0.8,
+                    label=f"{name}: outline at 9 equal time intervals" if k == 0 else None)
+    for depth in target.interface_depths:
+        if z0 < depth < z1:
+            ax.axhline(depth, color="0.5", lw=0.8, ls="--")
     ax.axhline(0.0, color="k", lw=1)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(z1, z0)  # depth downward
     ax.set_aspect("equal")
-    ax.invert_yaxis()
     _layer_names(ax, target)
     ax.set_xlabel("x (m, horizontal, plane of obliquity)")
     ax.set_ylabel("z (m, depth)")
-    ax.set_title(_title(job) + "\nprojectile outline at 9 equal time intervals")
-    ax.legend(fontsize=8, loc="upper right")
+    ax.set_title(_title(job), fontsize=9, pad=24)
+    ax.legend(fontsize=8, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2,
+              frameon=False)  # between the title and the axes: off the data
     return save_figure(fig, path, dpi=120, bbox_inches="tight")
 
 
@@ -252,48 +298,94 @@ def _title(job):
             f"{s['contact_ramp_m_s']:g} m/s")
 
 
+def _note(ax, text):
+    """``text`` in the middle of an empty axes (instead of a curve of round-off)."""
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", fontsize=9,
+            wrap=True, color="0.25")
+
+
 def pitch_time(job, path):
+    """Pitch against time with the phase ends dotted; a note instead of a curve where the
+    pitch stays below :data:`PITCH_ROUNDOFF_DEG` (round-off)."""
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(7, 4))
-    for k, (name, result) in enumerate(job["runs"].items()):
+    runs = job["runs"].items()
+    moving = [(k, name, result) for k, (name, result) in enumerate(runs)
+              if np.max(np.abs(result.history["pitch_deg"])) >= PITCH_ROUNDOFF_DEG]
+    for k, name, result in moving:
         h = result.history
         ax.plot(h["t_s"] * 1e3, h["pitch_deg"], color=f"C{k}", label=name)
         for ph in result.phases[:-1]:
             ax.axvline(ph["end_time_s"] * 1e3, color=f"C{k}", lw=0.6, ls=":")
-    ax.set_xlabel("t (ms)")
-    ax.set_ylabel("pitch (deg, axis from +z toward +x)")
-    ax.set_title(_title(job) + "\ndotted: phase ends (nose tip crosses an interface, ...)",
-                 fontsize=9)
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
+    if moving:
+        ax.set_xlabel("t (ms)")
+        ax.set_ylabel("pitch (deg, axis from +z toward +x)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    still = [name for name, _ in runs if name not in {m[1] for m in moving}]
+    if still:
+        note = (f"pitch of {', '.join(still)} stays 0 (below {PITCH_ROUNDOFF_DEG:g} deg: "
+                "round-off; a shot in its plane of symmetry does not turn)")
+        if moving:
+            ax.text(0.01, 0.02, note, transform=ax.transAxes, fontsize=8, color="0.25")
+        else:
+            _note(ax, note.replace(" (", "\n("))
+    ax.set_title(_title(job) + ("\ndotted: phase ends (nose tip crosses an interface, ...)"
+                                if moving else ""), fontsize=9)
     return save_figure(fig, path, dpi=120, bbox_inches="tight")
 
 
 def overloads(job, path):
+    """Axial and lateral overload against time and nose-tip depth; a note instead of the
+    lateral curves where they stay below :data:`LATERAL_ROUNDOFF` of the axial peak."""
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     fig, axes = plt.subplots(2, 2, figsize=(10, 7))
-    for k, (name, result) in enumerate(job["runs"].items()):
-        h = result.history
-        for row, key in enumerate(("axial_g", "lateral_g")):
+    runs = list(job["runs"].items())
+    for row, key in enumerate(("axial_g", "lateral_g")):
+        shown = 0
+        for k, (name, result) in enumerate(runs):
+            h = result.history
+            peak = np.max(np.abs(h["axial_g"]))
+            if key == "lateral_g" and np.max(np.abs(h[key])) < LATERAL_ROUNDOFF * peak:
+                continue
+            shown += 1
             axes[row, 0].plot(h["t_s"] * 1e3, h[key] / 1e3, color=f"C{k}", label=name)
             axes[row, 1].plot(h["tip_z_m"], h[key] / 1e3, color=f"C{k}", label=name)
-    for row, key in enumerate(("axial", "lateral")):
-        axes[row, 0].set_ylabel(f"{key} overload (thousands of g)")
+        word = key.split("_")[0]
+        if not shown:
+            for a in axes[row]:
+                _note(a, f"lateral overload 0\n(below {LATERAL_ROUNDOFF:g} of the axial peak: "
+                      "round-off;\na shot in its plane of symmetry\nhas no lateral force)")
+            continue
+        axes[row, 0].set_ylabel(f"{word} overload (thousands of g)")
         axes[row, 0].set_xlabel("t (ms)")
         axes[row, 1].set_xlabel("nose-tip depth (m); dashed: interfaces")
-        _interfaces(axes[row, 1], job["target"], vertical=False)
+        deepest = max(float(np.max(r.history["tip_z_m"])) for _, r in runs)
+        _interfaces(axes[row, 1], job["target"], vertical=False, deepest=deepest)
         for a in axes[row]:
             a.grid(alpha=0.3)
-    axes[0, 0].legend(fontsize=8)
+            a.xaxis.set_major_locator(MaxNLocator(6))  # no overprinted ticks (mm depths)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
     fig.suptitle(_title(job), fontsize=10)
+    if len(runs) > 1:
+        fig.legend(handles, labels, loc="lower center", ncol=len(runs), fontsize=8,
+                   frameon=False, bbox_to_anchor=(0.5, -0.02))
     return save_figure(fig, path, dpi=120, bbox_inches="tight")
 
 
+LAYER_COLOURS = ("#bbbbbb", "#a0785a", "#6b8e23", "#777777")  # the 3-D view's layers, top down
+LAYER_COLOUR_NAMES = ("grey", "brown", "green", "dark grey")
+
+
 def view_3d(job, path):
-    """The path in the layered block, rendered off-screen with pyvista; None if pyvista
-    cannot render here (no OpenGL)."""
+    """The path in the layered block (the half y <= 0, cut open along the plane of obliquity),
+    the body at 6 equal time intervals, with the block's bounds as scales in m, rendered
+    off-screen with pyvista; None if pyvista cannot render here (no OpenGL)."""
     try:
         import pyvista as pv
         from vtkmodules.vtkCommonCore import vtkLogger
@@ -312,7 +404,7 @@ def view_3d(job, path):
     try:
         plotter = pv.Plotter(off_screen=True, window_size=(900, 700))
         tops = [0.0, *target.interface_depths, bottom]
-        colors = ["#bbbbbb", "#a0785a", "#6b8e23", "#777777"]
+        colors = LAYER_COLOURS
         for i in range(len(tops) - 1):
             box = pv.Box(bounds=(lo, hi, ylo, 0.0, -tops[i + 1], -tops[i]))
             plotter.add_mesh(box, color=colors[i % len(colors)], opacity=0.25,
@@ -329,9 +421,22 @@ def view_3d(job, path):
                               direction=(axis[0], axis[1], -axis[2]), radius=body.radius,
                               height=body.length)
             plotter.add_mesh(cyl, color="navy")
-        plotter.add_axes()
+        plotter.show_bounds(xtitle="x (m)", ytitle="y (m)", ztitle="height (m)",
+                            location="outer", font_size=10, color="black", n_xlabels=3,
+                            n_ylabels=2)
+        plotter.add_text(_title(job).replace("; ", "\n"), font_size=8, color="black",
+                         position="upper_left")
+        names = target.layer_names()
+        plotter.add_text("red: centre of mass; navy: the body at 6 equal time intervals\n"
+                         + ", ".join(f"{n} ({LAYER_COLOUR_NAMES[i % len(LAYER_COLOUR_NAMES)]})"
+                                     for i, n in enumerate(names)),
+                         font_size=7, color="black", position="lower_left")
+        plotter.set_background("white")
+        # the whole block in view: look from the front left, above, then fit every actor
         plotter.camera_position = [(lo - 1.0, ylo - 2.5, 1.0), ((lo + hi) / 2, 0, -bottom / 2),
                                    (0, 0, 1)]
+        plotter.reset_camera()
+        plotter.camera.zoom(0.85)
         tmp = str(path) + ".tmp.png"
         plotter.screenshot(tmp)
         plotter.close()

@@ -64,7 +64,7 @@ def run(args, target, projectile):
                  scheduler=scheduler, progress=args.progress)
     seconds = time.monotonic() - began
     result["command"] = command_line(shots_path, calibration_paths, out)
-    written = write_staged(out, lambda stage: write_outputs(result, stage))
+    written = write_staged(out, lambda stage: write_outputs(result, stage, draw=args.figures))
     if args.json:
         return json.dumps(summary(result), indent=2)
     return text(result, seconds, written)
@@ -129,16 +129,18 @@ def summary(result):
 
 # --- files ------------------------------------------------------------------------------------
 
-def write_outputs(result, out):
-    """Write the JSON, CSV, report and figures into ``out``; return the paths."""
+def write_outputs(result, out, draw=True):
+    """Write the JSON, CSV, report and (if ``draw``) the figures into ``out``; return the
+    paths."""
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, content in (("validation.json", json.dumps(summary(result), indent=2) + "\n"),
                           ("predictions.csv", predictions_csv(result)),
-                          ("report.md", report_markdown(result))):
+                          ("report.md", report_markdown(result, figures=draw))):
         write_text_atomic(out / name, content)
         written.append(out / name)
-    written += write_figures(result, out)
+    if draw:
+        written += write_figures(result, out)
     return [str(p) for p in written]
 
 
@@ -214,8 +216,9 @@ def compressibility(result, column):
     return float(np.min(ratios)), float(np.median(ratios)), float(np.max(ratios))
 
 
-def report_markdown(result):
-    """The validation report (markdown); every number is from ``result``."""
+def report_markdown(result, figures=True):
+    """The validation report (markdown); every number is from ``result``; ``figures``: the
+    figures were drawn (else the report says they were not)."""
     models, shots = result["models"], result["shots"]
     info = result["shots_file"]
     mapping = result["mapping"]
@@ -279,8 +282,11 @@ def report_markdown(result):
                  if row["predicted_m"][m] is not None else "failed" for m in models]
         lines.append(f"| {row['id']} | {row['V0_m_s']:g} | {row['fc_Pa'] / 1e6:g} | "
                      f"{row['measured_m'] * 1e3:g} | " + " | ".join(cells) + " |")
-    lines += ["", "![predicted against measured](predicted_vs_measured.png)", "",
-              "![ratio against striking velocity](ratio_vs_velocity.png)", ""]
+    lines += ["", "![predicted against measured (small multiples: the uncalibrated models and "
+              "the empirical formula, then each calibrated model with its fitted shots filled "
+              "and its held-out shots open)](predicted_vs_measured.png)", "",
+              "![ratio against striking velocity](ratio_vs_velocity.png)", ""] if figures \
+        else ["", "(figures not drawn: `--no-figures`)", ""]
     if result["failures"]:
         lines += ["## Failures", ""]
         for model, items in result["failures"].items():
@@ -310,58 +316,117 @@ def _outlier_section(result):
     return lines + [""]
 
 
+FIGURES = ("predicted_vs_measured.png", "ratio_vs_velocity.png")
+
+
 def write_figures(result, out):
-    """Predicted against measured (log-log, 1:1, +-20 %) and ratio against striking velocity."""
+    """Predicted against measured (log-log, 1:1, +-20 %) and ratio against striking velocity,
+    each as small multiples (:func:`_panels`): the cavex models as they are beside the
+    empirical formula, then one panel per calibrated model with its fitted shots filled and
+    its held-out shots open. One legend below the panels, off the data."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    markers = dict(zip(MODELS, ["o", "s", "^", "D", "*"], strict=True))
-    colours = dict(zip(MODELS, ["tab:blue", "tab:orange", "tab:green", "tab:red", "black"],
-                       strict=True))
+    panels = _panels(result)
     measured = np.array([row["measured_m"] for row in result["shots"]])
     velocity = np.array([row["V0_m_s"] for row in result["shots"]])
-    held = set(result.get("held_out", []))
+    columns = min(3, len(panels))
+    rows = -(-len(panels) // columns)
     written = []
-    for name, x_of in (("predicted_vs_measured.png", None), ("ratio_vs_velocity.png", velocity)):
-        fig, ax = plt.subplots(figsize=(7.5, 5.5))
-        for model in result["models"]:
-            base = next(b for b in MODELS if model.startswith(b))
-            calibrated = model != base
-            y = np.array([np.nan if row["predicted_m"][model] is None
-                          else row["predicted_m"][model] for row in result["shots"]])
-            style = {"marker": markers[base], "color": colours[base], "linestyle": "none",
-                     "markersize": 7 if base != EMPIRICAL else 10, "label": model,
-                     "markerfacecolor": colours[base] if calibrated or base == EMPIRICAL
-                     else "none"}
-            if model == COMPRESSIBILITY_COLUMN:
-                style.update(markerfacecolor="white", markeredgewidth=2.0, marker="P")
-            if x_of is None:
-                ax.plot(measured * 1e3, y * 1e3, **style)
-            else:
-                ax.plot(x_of, y / measured, **style)
-        if x_of is None:
-            lo, hi = 0.5 * measured.min() * 1e3, 2.0 * measured.max() * 1e3
-            line = np.array([lo, hi])
-            ax.plot(line, line, "k-", linewidth=1, label="1:1")
-            ax.fill_between(line, line * (1 - BAND), line * (1 + BAND), color="grey",
-                            alpha=0.2, label="+-20 %")
-            ax.set(xscale="log", yscale="log", xlim=(lo, hi), ylim=(lo / 2, hi * 1.5),
-                   xlabel="measured depth (mm)", ylabel="predicted depth (mm)",
-                   title="Predicted against measured penetration depth")
-        else:
-            ax.axhline(1.0, color="k", linewidth=1)
-            ax.axhspan(1 - BAND, 1 + BAND, color="grey", alpha=0.2)
-            for v, row in zip(velocity, result["shots"], strict=True):
-                if row["id"] in held:
-                    ax.axvline(v, color="grey", linewidth=0.5, linestyle=":")
-            ax.set(xlabel="striking velocity (m/s)", ylabel="predicted / measured depth",
-                   title="Ratio against striking velocity" + (
-                       " (dotted: held-out shots)" if held else ""))
-        ax.legend(fontsize=7, loc="best", ncol=2)
-        written.append(_save(fig, out / name, plt))
+    for name, title in zip(FIGURES, ("Predicted against measured penetration depth",
+                                     "Ratio predicted / measured against striking velocity"),
+                           strict=True):
+        predicted = name.startswith("predicted")
+        fig, axes = plt.subplots(rows, columns, figsize=(4.6 * columns, 4.2 * rows + 1.2),
+                                 squeeze=False, sharex=True, sharey=True)
+        for ax, (heading, models) in zip(axes.flat, panels, strict=False):
+            for model in models:
+                _draw_model(ax, result, model, measured, None if predicted else velocity)
+            _frame(ax, measured, predicted)
+            ax.set_title(heading, fontsize=9)
+        for ax in list(axes.flat)[len(panels):]:
+            ax.set_visible(False)
+        handles, labels = axes.flat[0].get_legend_handles_labels()
+        if len(panels) > 1:
+            handles += _fitted_keys()
+            labels += ["calibrated: fitted shot", "calibrated: held-out shot"]
+        fig.suptitle(title, fontsize=11)
+        fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
+        fig.tight_layout(rect=(0, 0.1 if rows == 1 else 0.06, 1, 0.97))
+        written.append(save_figure(fig, out / name, dpi=110))
     return written
+
+
+def _fitted_keys():
+    """Legend keys for a calibrated model's fitted (filled) and held-out (open) shots."""
+    from matplotlib.lines import Line2D
+
+    style = {"marker": "o", "color": "0.3", "linestyle": "none", "markersize": 7}
+    return [Line2D([], [], **style),
+            Line2D([], [], markerfacecolor="white", markeredgewidth=1.5, **style)]
+
+
+def _panels(result):
+    """``[(title, models)]``: the cavex models as they are with the empirical formula, then
+    one panel per calibrated model."""
+    plain = [m for m in result["models"] if m in MODELS]
+    return [("cavex models (uncalibrated), empirical formula", plain),
+            *((m, [m]) for m in result["models"] if m not in MODELS)]
+
+
+def fitted_ids(result, model):
+    """The ids of the shots ``model`` (a calibrated column) was fitted to (the compressibility
+    column uses the derived-dynamic calibration's mapping, hence its shots)."""
+    for calibration in result["calibrations"]:
+        if calibration["column"] == model or (
+                model == result.get("compressibility_column")
+                and calibration["model"] == "derived-dynamic"):
+            return set(calibration["shots"])
+    return set()
+
+
+MARKERS = dict(zip(MODELS, ["o", "s", "^", "D", "*"], strict=True))
+COLOURS = dict(zip(MODELS, ["tab:blue", "tab:orange", "tab:green", "tab:red", "black"],
+                   strict=True))
+
+
+def _draw_model(ax, result, model, measured, velocity):
+    """One model's points: predicted depth (mm) against measured (``velocity`` None), else the
+    ratio predicted/measured against ``velocity``; a calibrated model's fitted shots filled
+    and its held-out shots open."""
+    base = next(b for b in MODELS if model.startswith(b))
+    y = np.array([np.nan if row["predicted_m"][model] is None else row["predicted_m"][model]
+                  for row in result["shots"]])
+    x = measured * 1e3 if velocity is None else velocity
+    y = y * 1e3 if velocity is None else y / measured
+    marker = "P" if model == COMPRESSIBILITY_COLUMN else MARKERS[base]
+    style = {"marker": marker, "color": COLOURS[base], "linestyle": "none",
+             "markersize": 10 if base == EMPIRICAL else 7}
+    if model in MODELS:
+        ax.plot(x, y, label=model, markerfacecolor=COLOURS[base], **style)
+        return
+    fitted = np.array([row["id"] in fitted_ids(result, model) for row in result["shots"]])
+    ax.plot(x[fitted], y[fitted], **style)
+    ax.plot(x[~fitted], y[~fitted], markerfacecolor="white", markeredgewidth=1.5, **style)
+
+
+def _frame(ax, measured, predicted):
+    """The 1:1 line and +-20 % band, scales and labels of one panel."""
+    if predicted:
+        lo, hi = 0.5 * measured.min() * 1e3, 2.0 * measured.max() * 1e3
+        line = np.array([lo, hi])
+        ax.plot(line, line, "k-", linewidth=1, label="1:1")
+        ax.fill_between(line, line * (1 - BAND), line * (1 + BAND), color="grey", alpha=0.2,
+                        label="+-20 %")
+        ax.set(xscale="log", yscale="log", xlim=(lo, hi), ylim=(lo / 2, hi * 1.5),
+               xlabel="measured depth (mm)", ylabel="predicted depth (mm)")
+    else:
+        ax.axhline(1.0, color="k", linewidth=1)
+        ax.axhspan(1 - BAND, 1 + BAND, color="grey", alpha=0.2, label="+-20 %")
+        ax.set(xlabel="striking velocity (m/s)", ylabel="predicted / measured depth")
+    ax.grid(alpha=0.3, which="both")
 
 
 def _save(fig, path, plt):
@@ -374,16 +439,21 @@ def text(result, seconds, written):
     lines = [f"{result['shots_file']['n']} shots from {result['shots_file']['path']}; "
              f"FE tables built {result['tables']['built']}, reused "
              f"{result['tables']['reused']}; {seconds:.1f} s", ""]
-    parts = [("all shots", result["summary"])]
+    fitted = bool(result["calibrations"])
+    parts = [("all shots" + (" (calibrated models: in-sample on their fitted shots)" if fitted
+                             else ""), result["summary"])]
     flagged = result["outliers"]["shots"]
     if flagged:
         shown = ", ".join(flagged[:10]) + (", ..." if len(flagged) > 10 else "")
         parts.append((f"without the {len(flagged)} outlier(s), every model off by more than a "
                       f"factor {result['outliers']['factor']:g} ({shown}; see report.md)",
                       result["summary_without_outliers"]))
-    if "held_out_summary" in result:
+    if result.get("held_out"):
         parts.insert(0, (f"held-out shots ({len(result['held_out'])})",
                          result["held_out_summary"]))
+    elif fitted:
+        lines += ["no held-out shot: every shot was fitted by the calibration(s), so their rows "
+                  "below are in-sample (calibrate on a subset with --ids)", ""]
     for title, summary in parts:
         lines += [f"{title}:", f"{'model':<40} {'n':>3} {'mean ratio':>10} {'std':>7} "
                   f"{'mean|ln r|':>10}"]

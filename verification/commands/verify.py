@@ -50,10 +50,12 @@ def _moved(result, stage, out_dir):
 
 
 def summary(job):
-    """What ``cavex verify --json`` prints: the report's result without ``stats`` (the
-    report and ``grid.nc`` hold the statistics)."""
+    """What ``cavex verify --json`` prints: the report's result, its conclusions both as the
+    report's sentences and as numbers (``accuracy``: one record per closed form and wall layer,
+    :func:`cavex.verification.report.analysis.accuracy_records`)."""
     return {k: job[k] for k in ("out_dir", "files", "quick", "cells", "failed", "picture",
-                                "conclusions", "wall_time_s", "table_wall_time_s", "created")}
+                                "accuracy", "conclusions", "wall_time_s", "table_wall_time_s",
+                                "created")}
 
 
 def text(summary):

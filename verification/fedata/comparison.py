@@ -22,6 +22,7 @@ from cavex.fem.expansion import expand_problems
 from cavex.fem.output import write_result
 from cavex.fem.settings import make_numerics
 from cavex.problem import BOUNDARIES, SphericalProblem
+from cavex.verification.output.number_format import FE_DIGITS
 from cavex.verification.output.paths import check_output_dir
 
 #: Numerics settings renamed in JSON output (their unit appended)
@@ -158,7 +159,8 @@ def compare_at_depth(target, projectile, depth, velocity, nu=None,
         Refine the FE run while its estimated error exceeds this (None: never).
     fields : str or path, optional
         Folder for the FE fields of the run reported: ``fem.xdmf`` (time series) and
-        ``fem_history.csv`` (:func:`cavex.fem.write_result`); checked before the run.
+        ``fem_final.vtu`` (the last snapshot, for ``meshio.read``) and ``fem_history.csv``
+        (:func:`cavex.fem.write_result`, :data:`FE_DIGITS` digits); checked before the run.
     **numerics
         Settings of :class:`cavex.fem.Numerics`.
 
@@ -189,5 +191,5 @@ def compare_at_depth(target, projectile, depth, velocity, nu=None,
     out = comparison_record(fe_record(depth, problem, result),
                             closed_forms([problem.as_tuple()]), 0)
     if fields is not None:
-        out["fields"] = str(write_result(result, fields / "fem"))
+        out["fields"] = str(write_result(result, fields / "fem", digits=FE_DIGITS))
     return out

@@ -265,6 +265,54 @@ def all_stats(grid, target):
     return {key: {i: layer_stats(grid, key, i) for i in present} for key, _, _ in MODELS}
 
 
+#: the model label (README "One resistance vocabulary") of each closed form's key
+MODEL_LABEL = {"dynamic": "derived-dynamic", "quasi_static": "derived-quasi-static",
+               "paper": "paper"}
+
+
+def accuracy_records(grid, target, stats):
+    """The report's conclusions as numbers (``cavex verify --json``): one record per closed
+    form and wall layer, from :func:`layer_stats` and :func:`attribution`.
+
+    Each record: ``model`` (label), ``wall_layer``, ``closest`` (the closed form with the
+    smallest ``|median|`` in that layer), ``cells``, ``fe_failed``,
+    ``median_relative_difference`` and ``worst_relative_difference`` (``closed form / FE - 1``;
+    None without an FE result), ``worst_at_velocity_m_s``, ``worst_at_depth_m``,
+    ``within_1_percent_ratio`` and ``within_5_percent_ratio`` (fractions of the cells),
+    ``all_within_1_percent_up_to_m_s`` and ``all_within_5_percent_up_to_m_s`` (None: not even
+    at the lowest velocity), ``unresolved_cells`` (the FE estimate does not resolve the
+    difference), ``parts_median_relative_difference`` ({part: median}, the parts of
+    :data:`MODEL_PARTS`) and ``parts_worst_relative_difference`` (at the worst cell)."""
+    names = target.layer_names()
+
+    def number(x):
+        return None if x is None or not math.isfinite(x) else float(x)
+
+    records = []
+    for index in sorted(next(iter(stats.values()))):
+        medians = {key: abs(stats[key][index]["median"]) for key in stats}
+        closest = min(medians, key=lambda k: medians[k] if math.isfinite(medians[k])
+                      else math.inf)
+        for key, s in ((k, stats[k][index]) for k in stats):
+            found = math.isfinite(s["median"])
+            parts = attribution(grid, key, index, s["at"]) if found else None
+            records.append({
+                "model": MODEL_LABEL[key], "wall_layer": names[index],
+                "closest": key == closest, "cells": s["cells"], "fe_failed": s["failed"],
+                "median_relative_difference": number(s["median"]),
+                "worst_relative_difference": number(s["max_abs"]),
+                "worst_at_velocity_m_s": s["at"][0] if found else None,
+                "worst_at_depth_m": s["at"][1] if found else None,
+                "within_1_percent_ratio": number(s["within"][0]),
+                "within_5_percent_ratio": number(s["within"][1]),
+                "all_within_1_percent_up_to_m_s": s["v_within"][0],
+                "all_within_5_percent_up_to_m_s": s["v_within"][1],
+                "unresolved_cells": s["unresolved"],
+                "parts_median_relative_difference": parts and parts["medians"],
+                "parts_worst_relative_difference": parts and parts["worst"]})
+    return records
+
+
 def part_medians(grid, index):
     """Median of each error part of the paper model over wall layer ``index``."""
     mask = layer_mask(grid, index)

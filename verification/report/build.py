@@ -29,6 +29,7 @@ from cavex.verification.report import plots, text
 from cavex.verification.report.analysis import (
     RESOLVED_FRACTION,
     TOLERANCES,
+    accuracy_records,
     all_stats,
     analyse,
 )
@@ -237,6 +238,7 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
         markdown_to_html(markdown, "cavex verification report", base_dir=out), encoding="utf-8")
     files.update(report=str(out / "report.md"), html=str(out / "report.html"))
     return {"out_dir": str(out), "files": files, "conclusions": lines, "stats": stats, **info,
+            "accuracy": accuracy_records(grid, target, stats),
             "wall_time_s": time.perf_counter() - started, "table_wall_time_s": table_seconds,
             "created": created}
 

@@ -34,7 +34,6 @@ isolates the law of each phase from the error accumulated before it.
 """
 
 import itertools
-import math
 from dataclasses import asdict, dataclass, replace
 from functools import partial
 
@@ -52,7 +51,9 @@ from cavex.errors import require
 from cavex.verification.studies.table2 import (
     PAPER_REF10_EXIT_VELOCITY,
     PAPER_TABLE2,
+    ROW_KEYS,
     phase_row,
+    row_score,
     table2_rows,
 )
 
@@ -71,9 +72,6 @@ CHOICES = {
 # is that of the single concrete medium, Fig. 4) and no linear crater stage (Eqs. 31-34).
 ADMISSIBLE = {**CHOICES, "crater": ("nose-base",), "crater_medium": ("concrete",),
               "crater_law": ("linear",)}
-ROW_KEYS = ("depth_m", "velocity_m_s", "time_s")
-# half a unit of the last digit Table 2 prints: L to 0.01 m, V to 0.1 m/s, t to 0.01 ms
-PRINT_HALF_UNIT = {"depth_m": 0.005, "velocity_m_s": 0.05, "time_s": 0.005e-3}
 SEGMENT_RTOL = 1e-10  # the segments' relative tolerance (the full runs: the integrator's own)
 
 
@@ -312,19 +310,6 @@ def relative_error(ours, paper, key):
     if ours is None or paper[key] == 0.0:
         return None
     return ours[key] / paper[key] - 1.0
-
-
-def row_score(row):
-    """Worst relative discrepancy of a row beyond the precision Table 2 prints.
-
-    For each of ``L``, ``V``, ``t``: ``max(0, |ours - paper| - half unit of the last printed
-    digit) / paper``; the stop velocity (0 in both) is not counted. ``inf`` if the row is absent.
-    """
-    if row["ours"] is None:
-        return math.inf
-    excess = [max(0.0, abs(row["ours"][k] - row["paper"][k]) - PRINT_HALF_UNIT[k])
-              / row["paper"][k] for k in ROW_KEYS if row["paper"][k] != 0.0]
-    return max(excess)
 
 
 def factorial_readings(axes=CHOICES):

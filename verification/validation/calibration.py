@@ -61,6 +61,9 @@ class Calibration:
     skipped: tuple = ()  # (shot id, reason) of the shots the model could not predict
     outliers: tuple = ()  # fitted shot ids off by more than OUTLIER_FACTOR at the fit
     without_outliers: tuple = ()  # the statistics over the other fitted shots
+    #: ``((param, standard error), ...)`` of the fit (:func:`standard_errors`; not in the
+    #: calibration file: the command prints them)
+    standard_errors: tuple = ()
 
     @property
     def column(self):
@@ -165,8 +168,8 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
     active, skipped = list(shots), []
     while True:
         try:
-            mapping, evaluations = _least_squares(active, model, params, start, tables,
-                                                  progress)
+            mapping, evaluations, errors = _least_squares(active, model, params, start,
+                                                          tables, progress)
             r = log_ratios(active, model, mapping, tables)
             break
         except ShotFailure as failure:
@@ -184,7 +187,7 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
                        statistics=(*fit_statistics(r), ("evaluations", evaluations)),
                        skipped=tuple(skipped),
                        outliers=tuple(s.id for s, f in zip(active, flagged, strict=True) if f),
-                       without_outliers=fit_statistics(r[~flagged]))
+                       without_outliers=fit_statistics(r[~flagged]), standard_errors=errors)
 
 
 def fit_statistics(r):
@@ -198,8 +201,9 @@ def fit_statistics(r):
 
 
 def _least_squares(shots, model, params, start, tables, progress):
-    """The fitted mapping (parameters rounded to :data:`PARAMETER_DIGITS`) and the number of
-    residual evaluations; :class:`ShotFailure` passes through."""
+    """The fitted mapping (parameters rounded to :data:`PARAMETER_DIGITS`), the number of
+    residual evaluations and the parameters' standard errors (:func:`standard_errors`);
+    :class:`ShotFailure` passes through."""
     kind = FE_MODEL if model == FE_MODEL else "closed form"
     count = [0]
     began = time.monotonic()
@@ -227,7 +231,33 @@ def _least_squares(shots, model, params, start, tables, progress):
         raise CavexNumericalError(f"calibration of {model} left the models' range: {exc}") \
             from None
     values = [round_significant(v, PARAMETER_DIGITS) for v in _to_values(solution.x, params)]
-    return start.with_values(params, values), count[0]
+    errors = standard_errors(solution.jac, solution.fun, params, solution.x)
+    return start.with_values(params, values), count[0], tuple(zip(params, errors, strict=True))
+
+
+def standard_errors(jacobian, residuals, params, x):
+    r"""Standard error of each fitted parameter, from the Jacobian ``J`` of the residuals at
+    the solution ``x`` (the linearised least-squares estimate):
+
+    .. math:: \mathrm{cov}(x) = s^2 (J^T J)^{-1}, \qquad s^2 = \frac{\sum_i r_i^2}{n - p}
+
+    with ``n`` shots and ``p`` parameters. A factor fitted as ``ln f`` (:data:`LOG_PARAMETERS`)
+    gets ``f * se(ln f)`` (first order). None for every parameter when ``n <= p`` (no degree of
+    freedom left to estimate the scatter) and where ``J^T J`` is singular (a parameter the
+    depths do not determine: ``inf``)."""
+    jacobian, residuals = np.asarray(jacobian, dtype=float), np.asarray(residuals, dtype=float)
+    n, p = jacobian.shape
+    if n <= p:
+        return [None] * p
+    scatter = float(residuals @ residuals) / (n - p)
+    normal = jacobian.T @ jacobian
+    try:
+        variances = scatter * np.diag(np.linalg.inv(normal))
+    except np.linalg.LinAlgError:
+        return [math.inf] * p
+    values = _to_values(x, params)
+    return [float(math.sqrt(max(v, 0.0)) * (value if name in LOG_PARAMETERS else 1.0))
+            for name, v, value in zip(params, variances, values, strict=True)]
 
 
 class _ForwardDifferences:

@@ -1,0 +1,690 @@
+r"""Dynamic spherical cavity expansion in concrete: elastic, radially cracked and comminuted zones.
+
+After Forrestal and Tzou (1997, Int. J. Solids Struct. 34(31-32), 4127-4146), with the locked
+hydrostat of Luk, Forrestal and Amos (1991). A spherical cavity opens from zero radius at the
+constant velocity ``V`` in one semi-infinite concrete. Compression is positive; ``f_c`` (the
+unconfined compressive strength) normalises every stress, ``s = sigma/f_c``, and the inertia
+number is ``phi = rho V^2 / f_c`` (``rho`` the undisturbed density). The solution is
+self-similar in ``xi = r/(V t)`` (cavity wall ``xi = 1``); ``U = v/V`` is the particle
+velocity and ``R = rho/rho_0`` the density ratio. docs/concrete.md derives every equation below.
+
+Zones, from the wall outward:
+
+- comminuted (plastic), ``1 <= xi <= beta``: exact (Eulerian) balance of mass and momentum,
+
+  .. math:: (U - \xi) R' + R (U' + 2U/\xi) = 0, \qquad
+            s' + 2D/\xi = \phi R (\xi - U) U',
+
+  with ``D = s_r - s_theta = min(tau_0 + lam p, tau_max)``, ``p = s_r - 2D/3``,
+  ``tau_0 = f_c (1 - lam/3)`` (uniaxial compression yields at ``f_c``), and the hydrostat
+  (volumetric strain ``eta = 1 - 1/R``) linear up to the locking strain, then stiff:
+
+  .. math:: \eta = \min(p/K, \eta_l) + \max(0, p - K\eta_l)/K_l
+
+  (``K`` the compaction modulus, ``eta_l`` the locking strain, ``K_l`` the locked modulus;
+  ``K = 0`` is the locked hydrostat of Luk et al., compacted to ``eta_l`` at the front;
+  ``eta_l = 0, K_l = inf`` is incompressible). Solved for ``U'`` and ``s'``:
+
+  .. math:: U' = -\frac{2 (R U + (\xi - U) R_s D)}{\xi R (1 - \phi R_s (\xi - U)^2)},
+
+  ``R_s = dR/ds = R^2 p_s d eta/dp``; the flow behind the front must stay subsonic
+  (``phi R_s (xi - U)^2 < 1``).
+- radially cracked, ``beta <= xi <= gamma``: ``sigma_theta = 0``, ``sigma_r = -E eps_r``, small
+  strain ``u = V t F(xi)``, ``U = F - xi F'``, density ``rho_0``. The linear momentum balance
+  ``(xi^2 s)' = -phi xi^3 F''`` integrates to ``F' = K_1 (1/xi^2 - w_b^2)``,
+  ``F = K_0 - K_1 (1/xi + w_b^2 xi)``, ``w_b = V/c_b``, ``c_b^2 = E/rho``.
+- elastic, ``xi >= gamma`` (or ``beta``): linear elastodynamics, the wave front at
+  ``xi = 1/w``, ``w = V/c_d``; the solution that vanishes with its slope at the front is
+  ``F = C (1/xi^2 - 3 w^2 + 2 w^3 xi)``, so ``U = 3C (1/xi^2 - w^2)``,
+  ``D = 6 mu C (1/xi^3 - w^2/xi)`` and
+
+  .. math:: s = 4\mu F/\xi + 6 C \phi (1/\xi - w) - \phi U^2/2,
+
+  written so that ``nu -> 1/2`` (``w = 0``) is finite; the last term is the integral of the
+  convective acceleration ``U U'`` (second order in the strain; with it the incompressible
+  limit is cavex's derived closed form exactly).
+
+Fronts:
+
+- crack front ``gamma``: the elastic hoop stress reaches the tensile strength,
+  ``s_theta = -f_t/f_c``; ``F`` is continuous and momentum jumps by the linear Rankine-Hugoniot
+  condition ``[s_r] = -phi gamma^2 [F']``;
+- plastic front ``beta``: the material ahead is at yield (cracked: uniaxial,
+  ``s_r = min(1, tau_max/f_c)``; elastic: ``D = min(tau_0 + lam p, tau_max)``), and mass and
+  momentum jump by the exact Rankine-Hugoniot conditions ``R^-(beta - U^-) = R^+(beta - U^+)
+  = j``, ``s^- = s^+ + phi j (U^- - U^+)`` (a shock where the hydrostat compacts);
+- the state behind a front is the first intersection of the Rayleigh line with the hydrostat
+  going up from the state ahead (subsonic behind it); where the flow inside the comminuted zone
+  turns sonic (``phi R_s (xi - U)^2 = 1``), a compaction shock is put at the sonic point;
+- a plastic front faster than the elastic wave (``beta >= 1/w``) runs into undisturbed concrete.
+
+The wall condition ``U(1) = 1`` closes the problem: one unknown front speed (``beta`` without
+cracking, ``gamma`` with it) is found by bracketing and Brent's method; every evaluation
+integrates the comminuted zone inward from ``beta`` with classical Runge-Kutta (RK4) at a fixed
+number of steps in ``ln xi``, a step that crosses a kink of the constitutive law (the cap
+``tau_max``, the locking pressure) split at the crossing so that the order stays 4
+(``tests/test_concrete_cavity.py`` measures it).
+
+Which structure (:data:`STRUCTURES`): the elastic-comminuted solution when its hoop tension at
+``beta`` stays within ``f_t``; else the cracked one (crack front slower than the bar wave
+``c_b``); else the crack front riding on the comminution front (the cracked zone's limit of zero
+width: elastic hoop stress ``-f_t/f_c`` just ahead of ``beta``); a comminuted shock into
+undisturbed concrete when no elastic precursor fits.
+
+Public: :class:`ConcreteCavity` (the dimensionless material), :func:`solve` (one ``phi``),
+:func:`wall_stress` (arrays of velocities), :func:`resistance_table` and :func:`fit_AB`
+(``sigma_r/f_c ~ A + B rho V^2/f_c``). The ``(material, phi)`` answers are cached.
+"""
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+from numba import njit
+
+from cavex.errors import CavexNumericalError, is_finite_number, require
+
+# structure codes of a solution
+ELASTIC_PLASTIC, CRACKED, JOINT_FRONT, SUPERSEISMIC = 0, 1, 2, 3
+STRUCTURES = {ELASTIC_PLASTIC: "elastic-comminuted", CRACKED: "elastic-cracked-comminuted",
+              JOINT_FRONT: "elastic-comminuted, cracking at the comminution front",
+              SUPERSEISMIC: "comminuted shock into undisturbed concrete"}
+DEFAULT_STEPS = 256  # RK4 steps across the comminuted zone (see the convergence test)
+# columns of the parameter vector of the compiled functions
+(E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, LOCKED, TENSILE, W, WB, PHI) = range(12)
+NPAR = 12
+
+
+@dataclass(frozen=True)
+class ConcreteCavity:
+    """Concrete for the cavity expansion, in units of ``f_c`` (dimensionless).
+
+    Parameters
+    ----------
+    modulus : float
+        ``E / f_c`` (> 1).
+    nu : float
+        Poisson's ratio of the elastic zone, in [0, 0.5] (0.5: incompressible elastic zone).
+    lam : float
+        Pressure slope of the comminuted strength ``D = tau_0 + lam p``, in [0, 3).
+    tau_max : float
+        Tresca limit ``tau_max / f_c`` of ``D`` (>= 1; ``inf``: no limit).
+    bulk : float
+        Compaction modulus ``K / f_c`` of the comminuted hydrostat (>= 0; 0: compacted to
+        ``eta_lock`` at the front).
+    eta_lock : float
+        Locking volumetric strain ``eta_l``, in [0, 0.9].
+    bulk_locked : float
+        Modulus ``K_l / f_c`` past the locking strain (> 0; ``inf``: rigid).
+    tensile : float
+        Tensile strength ``f_t / f_c`` (> 0; ``inf``: no cracking).
+    """
+
+    modulus: float
+    nu: float
+    lam: float
+    tau_max: float = math.inf
+    bulk: float = math.inf
+    eta_lock: float = 0.0
+    bulk_locked: float = math.inf
+    tensile: float = math.inf
+
+    def __post_init__(self):
+        for name in ("modulus", "nu", "lam", "eta_lock"):
+            require(is_finite_number(getattr(self, name)), name, "a finite number",
+                    getattr(self, name))
+        require(self.modulus > 1.0, "modulus", "E/f_c > 1", self.modulus)
+        require(0.0 <= self.nu <= 0.5, "nu", "in [0, 0.5]", self.nu)
+        require(0.0 <= self.lam < 3.0, "lam", "in [0, 3)", self.lam)
+        require(self.tau_max >= 1.0, "tau_max", "tau_max/f_c >= 1 (inf: none)", self.tau_max)
+        require(self.bulk >= 0.0, "bulk", "K/f_c >= 0", self.bulk)
+        require(self.bulk_locked > 0.0, "bulk_locked", "K_l/f_c > 0 (inf: rigid)",
+                self.bulk_locked)
+        require(0.0 <= self.eta_lock <= 0.9, "eta_lock", "in [0, 0.9]", self.eta_lock)
+        require(self.tensile > 0.0, "tensile", "f_t/f_c > 0 (inf: no cracking)", self.tensile)
+
+    @property
+    def shear(self):
+        """``mu / f_c = E / (2 (1 + nu) f_c)``."""
+        return self.modulus / (2.0 * (1.0 + self.nu))
+
+    def wave_numbers(self, phi):
+        """``(w, w_b) = (V/c_d, V/c_b)`` at ``phi = rho V^2/f_c``:
+        ``w^2 = phi (1 + nu)(1 - 2 nu)/(e (1 - nu))``, ``w_b^2 = phi/e``."""
+        e, nu = self.modulus, self.nu
+        return (math.sqrt(phi * (1.0 + nu) * (1.0 - 2.0 * nu) / (e * (1.0 - nu))),
+                math.sqrt(phi / e))
+
+    def parameters(self, phi):
+        """The parameter vector of the compiled functions."""
+        w, wb = self.wave_numbers(phi)
+        p = np.empty(NPAR)
+        p[E_], p[MU], p[LAM] = self.modulus, self.shear, self.lam
+        p[TAU0], p[TAU_MAX], p[BULK] = 1.0 - self.lam / 3.0, self.tau_max, self.bulk
+        p[ETA], p[LOCKED], p[TENSILE] = self.eta_lock, self.bulk_locked, self.tensile
+        p[W], p[WB], p[PHI] = w, wb, phi
+        return p
+
+
+@dataclass(frozen=True)
+class CavitySolution:
+    """One self-similar solution: wall stress ``S = sigma_r(a)/f_c`` and its structure."""
+
+    S: float
+    phi: float
+    structure: int
+    plastic_front: float  # beta = c_plastic / V
+    crack_front: float  # gamma (NaN without a cracked zone)
+    amplitude: float  # C of the elastic zone (NaN if none)
+
+    @property
+    def name(self):
+        return STRUCTURES[self.structure]
+
+
+# ------------------------------------------------------------------------------------------
+# Compiled pieces
+# ------------------------------------------------------------------------------------------
+
+@njit(cache=True, error_model="numpy")
+def elastic_state(p, C, x):
+    """``(s_r, D, U, F, F', eps_v)`` of the elastic zone at ``xi = x``, amplitude ``C``."""
+    w, phi, mu = p[W], p[PHI], p[MU]
+    F = C * (1.0 / x ** 2 - 3.0 * w ** 2 + 2.0 * w ** 3 * x)
+    dF = C * (-2.0 / x ** 3 + 2.0 * w ** 3)
+    U = 3.0 * C * (1.0 / x ** 2 - w ** 2)
+    D = 6.0 * mu * C * (1.0 / x ** 3 - w ** 2 / x)
+    s = 4.0 * mu * F / x + 6.0 * C * phi * (1.0 / x - w) - 0.5 * phi * U * U
+    return s, D, U, F, dF, 6.0 * C * w ** 2 * (w - 1.0 / x)
+
+
+@njit(cache=True, error_model="numpy")
+def _quadratic_root(c2, c1, c0):
+    """The smallest positive root of ``c2 C^2 + c1 C + c0 = 0`` (NaN if none); as ``c2 -> 0``
+    the root ``-c0/c1`` (the quadratic terms are the small convective ones)."""
+    disc = c1 * c1 - 4.0 * c2 * c0
+    if disc < 0.0:
+        return np.nan
+    q = -0.5 * (c1 + math.copysign(math.sqrt(disc), c1))
+    best = np.nan
+    for root in (c0 / q if q != 0.0 else np.nan, q / c2 if c2 != 0.0 else np.nan):
+        if root > 0.0 and not root >= best:
+            best = root
+    return best
+
+
+@njit(cache=True, error_model="numpy")
+def _elastic_parts(p, x):
+    """``s_r``, ``D`` and ``s_theta`` of the elastic zone as ``(linear, quadratic)`` parts in C."""
+    w, phi, mu = p[W], p[PHI], p[MU]
+    f = 1.0 / x ** 2 - 3.0 * w ** 2 + 2.0 * w ** 3 * x
+    s1 = 4.0 * mu * f / x + 6.0 * phi * (1.0 / x - w)
+    s2 = -0.5 * phi * 9.0 * (1.0 / x ** 2 - w ** 2) ** 2
+    d1 = 6.0 * mu * (1.0 / x ** 3 - w ** 2 / x)
+    return s1, s2, d1
+
+
+@njit(cache=True, error_model="numpy")
+def yield_amplitude(p, x):
+    """Elastic amplitude ``C`` at which the elastic state at ``xi = x`` first yields:
+    ``D = tau_0 + lam (s - 2D/3)`` or ``D = tau_max``, whichever comes first."""
+    s1, s2, d1 = _elastic_parts(p, x)
+    lam = p[LAM]
+    # D (1 + 2 lam/3) - lam s = tau_0
+    c_mc = _quadratic_root(-lam * s2, d1 * (1.0 + 2.0 * lam / 3.0) - lam * s1, -p[TAU0])
+    c_cap = p[TAU_MAX] / d1 if d1 > 0.0 else np.inf
+    if c_cap < c_mc or not c_mc > 0.0:
+        return c_cap
+    return c_mc
+
+
+@njit(cache=True, error_model="numpy")
+def crack_amplitude(p, x):
+    """Elastic amplitude ``C`` with the hoop stress ``s - D = -f_t/f_c`` at ``xi = x``."""
+    s1, s2, d1 = _elastic_parts(p, x)
+    return _quadratic_root(s2, s1 - d1, p[TENSILE])
+
+
+@njit(cache=True, error_model="numpy")
+def constitutive(p, s, branch=np.nan):
+    """``(D, R, dR/ds)`` of the comminuted zone at radial stress ``s``; ``R = nan`` if the
+    hydrostat is past full compaction. The pieces of the law (below or above the cap and the
+    locking pressure) are chosen at ``branch`` (default ``s``), so that a step ending or
+    starting at a kink stays on one side of it."""
+    lam, tau0, cap = p[LAM], p[TAU0], p[TAU_MAX]
+    b = s if math.isnan(branch) else branch
+    scale = 1.0 / (1.0 + 2.0 * lam / 3.0)
+    capped = tau0 + lam * (b - 2.0 * tau0 / 3.0) * scale > cap
+    if capped:
+        D = cap
+        pressure = s - 2.0 * cap / 3.0
+        dp = 1.0
+    else:
+        pressure = (s - 2.0 * tau0 / 3.0) * scale
+        D = tau0 + lam * pressure
+        dp = scale
+    b_pressure = b - 2.0 * cap / 3.0 if capped else (b - 2.0 * tau0 / 3.0) * scale
+    eta, compliance = hydrostat(p, pressure, b_pressure)
+    if eta >= 1.0:
+        return D, np.nan, np.nan
+    R = 1.0 / (1.0 - eta)
+    return D, R, R * R * dp * compliance
+
+
+@njit(cache=True, error_model="numpy")
+def lock_pressure(p):
+    """Pressure ``K eta_l`` at which the hydrostat locks (0 without compaction)."""
+    return p[BULK] * p[ETA] if p[ETA] > 0.0 else 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def hydrostat(p, pressure, branch):
+    """``(eta, d eta/dp)``: linear to the locking strain, then the locked modulus (the piece
+    chosen at the pressure ``branch``)."""
+    p_lock = lock_pressure(p)
+    if branch < p_lock:
+        return pressure / p[BULK], 1.0 / p[BULK]
+    return p[ETA] + (pressure - p_lock) / p[LOCKED], 1.0 / p[LOCKED]
+
+
+@njit(cache=True, error_model="numpy")
+def _rhs(p, x, s, U, floor, ceiling):
+    """``(ds/d ln xi, dU/d ln xi)`` of the comminuted zone; NaN where the flow is sonic. The
+    law's pieces are chosen at ``s`` clamped to ``[floor, ceiling]``."""
+    D, R, Rs = constitutive(p, s, min(max(s, floor), ceiling))
+    phi = p[PHI]
+    gap = x - U
+    den = R * (1.0 - phi * Rs * gap * gap)
+    if not den > 0.0:
+        return np.nan, np.nan
+    dU = -(2.0 * R * U + 2.0 * gap * Rs * D) / (x * den)
+    ds = -2.0 * D / x + phi * R * gap * dU
+    return x * ds, x * dU
+
+
+@njit(cache=True, error_model="numpy")
+def _rk4(p, t, s, U, h, floor=-np.inf, ceiling=np.inf):
+    x = math.exp(t)
+    k1s, k1u = _rhs(p, x, s, U, floor, ceiling)
+    x2 = math.exp(t + 0.5 * h)
+    k2s, k2u = _rhs(p, x2, s + 0.5 * h * k1s, U + 0.5 * h * k1u, floor, ceiling)
+    k3s, k3u = _rhs(p, x2, s + 0.5 * h * k2s, U + 0.5 * h * k2u, floor, ceiling)
+    k4s, k4u = _rhs(p, math.exp(t + h), s + h * k3s, U + h * k3u, floor, ceiling)
+    return (s + h * (k1s + 2.0 * k2s + 2.0 * k3s + k4s) / 6.0,
+            U + h * (k1u + 2.0 * k2u + 2.0 * k3u + k4u) / 6.0)
+
+
+@njit(cache=True, error_model="numpy")
+def kink_stresses(p):
+    """Radial stresses of the comminuted zone's kinks: where ``tau_0 + lam p`` reaches
+    ``tau_max`` and where the hydrostat locks (inf: none)."""
+    lam, cap = p[LAM], p[TAU_MAX]
+    s_cap = np.inf
+    if lam > 0.0 and math.isfinite(cap):
+        s_cap = (cap - p[TAU0]) / lam + 2.0 * cap / 3.0
+    p_lock = lock_pressure(p)
+    s_lock = np.inf
+    if p_lock > 0.0 and math.isfinite(p_lock):
+        s_lock = p_lock + 2.0 * min(p[TAU0] + lam * p_lock, cap) / 3.0
+    return s_cap, s_lock
+
+
+@njit(cache=True, error_model="numpy")
+def _split_step(p, t, s, U, h, s_kink, floor):
+    """The part of the RK4 step from ``t`` (length ``h``) that ends where ``s`` reaches
+    ``s_kink`` (``s`` below it), by bisection on its length with the law's pieces kept below
+    the kink; returns ``(length, s, U)`` there."""
+    ceiling = s_kink - 1e-12 * (1.0 + abs(s_kink))
+    lo, hi = 0.0, h
+    for _ in range(64):
+        mid = 0.5 * (lo + hi)
+        s_mid = _rk4(p, t, s, U, mid, floor, ceiling)[0]
+        if math.isfinite(s_mid) and s_mid < s_kink:
+            lo = mid
+        else:
+            hi = mid
+    s_end, U_end = _rk4(p, t, s, U, hi, floor, ceiling)
+    return hi, s_end, U_end
+
+
+@njit(cache=True, error_model="numpy")
+def integrate(p, beta, s, U, steps):
+    """RK4 from ``xi = beta`` to the wall ``xi = 1`` in ``ln xi``; returns ``(s, U)`` there.
+
+    ``s`` grows inward. A step that crosses a kink (:func:`kink_stresses`) is split where ``s``
+    reaches it, the part before computed with the law's pieces below the kink and the rest with
+    those above, so that RK4 never differentiates across a kink (order 4 kept). Where the flow
+    turns sonic (``phi R_s (xi - U)^2 = 1``: the compaction cannot keep up continuously), the
+    sonic point is located by bisection on the step length and a compaction shock is put there
+    (:func:`jump`, strong root); at most a few such shocks.
+    """
+    t0 = math.log(beta)
+    h = -t0 / steps
+    t = t0
+    kinks = kink_stresses(p)
+    shocks = 0
+    for k in range(steps):
+        t_end = t0 + (k + 1) * h
+        floor = -np.inf
+        for _ in range(16):  # pieces of this step: kinks, sonic points
+            rest = t_end - t
+            if rest >= -1e-15 * abs(h):
+                break
+            s_new, U_new = _rk4(p, t, s, U, rest, floor)
+            if not (math.isfinite(s_new) and math.isfinite(U_new)):
+                lo, hi = 0.0, rest
+                for _ in range(60):
+                    mid = 0.5 * (lo + hi)
+                    if math.isfinite(_rk4(p, t, s, U, mid, floor)[0]):
+                        lo = mid
+                    else:
+                        hi = mid
+                if lo != 0.0:
+                    s, U = _rk4(p, t, s, U, lo, floor)
+                    t += lo
+                shocks += 1
+                if shocks > 4:
+                    return np.nan, np.nan
+                s, U = jump(p, math.exp(t), s, U, constitutive(p, s, max(s, floor))[1], True)
+                if not math.isfinite(s):
+                    return np.nan, np.nan
+                continue
+            crossed = False
+            for s_kink in (min(kinks), max(kinks)):  # in the order met
+                if s < s_kink < s_new:
+                    part, s, U = _split_step(p, t, s, U, rest, s_kink, floor)
+                    t += part
+                    floor = s_kink + 1e-12 * (1.0 + abs(s_kink))
+                    crossed = True
+                    break
+            if not crossed:
+                s, U = s_new, U_new
+                t = t_end
+    return s, U
+
+
+@njit(cache=True, error_model="numpy")
+def _jump_balance(p, beta, j, s_ahead, U_ahead, s):
+    """Momentum balance across the front, ``s - s^+ - phi j (U^-(s) - U^+)``, with
+    ``U^-(s) = beta - j/R(s)`` from the mass balance (NaN past full compaction)."""
+    R = constitutive(p, s)[1]
+    return s - s_ahead - p[PHI] * j * (beta - j / R - U_ahead)
+
+
+@njit(cache=True, error_model="numpy")
+def jump(p, beta, s_ahead, U_ahead, R_ahead, strong=False):
+    """State ``(s, U)`` just behind a front at ``xi = beta`` (Rankine-Hugoniot).
+
+    The mass flux ``j = R^+ (beta - U^+)`` fixes the Rayleigh line; the state behind is its first
+    intersection with the comminuted hydrostat going up from ``s^+`` (where the Rayleigh line
+    crosses from above, the flow behind is subsonic): the continuous state when the front is
+    slower than the compaction wave, else the compaction shock. ``strong``: the ahead state is
+    comminuted material at its sonic point (then ``s^+`` itself is a root, tangent); the next
+    intersection up is returned.
+    """
+    j = R_ahead * (beta - U_ahead)
+    if not j > 0.0:
+        return np.nan, np.nan
+    scale = 1.0 + abs(s_ahead)
+    lo = s_ahead
+    if strong:
+        lo += 1e-9 * scale
+    f_lo = _jump_balance(p, beta, j, s_ahead, U_ahead, lo)
+    if f_lo > 0.0:
+        D, R, Rs = constitutive(p, lo)
+        if strong and p[PHI] * j * j * Rs < R * R:  # subsonic after all: no shock
+            return s_ahead, U_ahead
+        step = 1e-9 * scale
+        if p[PHI] * j * j * Rs < R * R:  # subsonic: the root lies just below (rarefying)
+            while f_lo > 0.0:
+                lo -= step
+                step *= 2.0
+                f_lo = _jump_balance(p, beta, j, s_ahead, U_ahead, lo)
+                if not math.isfinite(f_lo) or step > 1e3 * scale:
+                    return np.nan, np.nan
+        else:  # supersonic: the balance dips below zero further up (compaction shock)
+            while f_lo > 0.0:
+                lo += step
+                step *= 2.0
+                f_lo = _jump_balance(p, beta, j, s_ahead, U_ahead, lo)
+                if not math.isfinite(f_lo) or step > 1e6 * scale:
+                    return np.nan, np.nan
+    hi, f_hi = lo, f_lo
+    step = 1e-6 * scale
+    while f_hi <= 0.0:
+        lo, f_lo = hi, f_hi
+        hi = lo + step
+        step *= 2.0
+        f_hi = _jump_balance(p, beta, j, s_ahead, U_ahead, hi)
+        if not math.isfinite(f_hi):
+            return np.nan, np.nan
+    for _ in range(200):  # Illinois regula falsi
+        mid = hi - f_hi * (hi - lo) / (f_hi - f_lo)
+        f_mid = _jump_balance(p, beta, j, s_ahead, U_ahead, mid)
+        if f_mid * f_hi < 0.0:
+            lo, f_lo = hi, f_hi
+        else:
+            f_lo *= 0.5
+        hi, f_hi = mid, f_mid
+        if f_mid == 0.0 or abs(hi - lo) <= 4e-16 * abs(hi):
+            break
+    return hi, beta - j / constitutive(p, hi)[1]
+
+
+@njit(cache=True, error_model="numpy")
+def wall_residual(p, beta, s_ahead, U_ahead, R_ahead, steps):
+    """``(U(1) - 1, s(1))``: the front at ``beta`` with the state ahead, then the comminuted
+    zone to the wall (:func:`jump`, :func:`integrate`)."""
+    s0, U0 = jump(p, beta, s_ahead, U_ahead, R_ahead)
+    s1, U1 = integrate(p, beta, s0, U0, steps)
+    return U1 - 1.0, s1
+
+
+@njit(cache=True, error_model="numpy")
+def _elastic_ahead(p, beta, C, steps):
+    """Wall ``(U(1) - 1, s(1), C)`` with the elastic state of amplitude ``C`` ahead of
+    ``beta``."""
+    s_a, D_a, U_a, F_a, dF_a, ev_a = elastic_state(p, C, beta)
+    residual, S = wall_residual(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a), steps)
+    return residual, S, C
+
+
+@njit(cache=True, error_model="numpy")
+def elastic_plastic(p, beta, steps):
+    """Wall ``(U(1) - 1, s(1), C)`` with the elastic zone, at yield, directly ahead of
+    ``beta``."""
+    return _elastic_ahead(p, beta, yield_amplitude(p, beta), steps)
+
+
+@njit(cache=True, error_model="numpy")
+def cracking_plastic(p, beta, steps):
+    """Wall ``(U(1) - 1, s(1), C)`` with the crack and comminution fronts together at ``beta``:
+    the elastic state ahead has the hoop stress ``-f_t/f_c`` (the limit of a cracked zone of
+    vanishing width)."""
+    C = crack_amplitude(p, beta)
+    if not C <= yield_amplitude(p, beta):  # the elastic state would yield before cracking
+        return np.nan, np.nan, C
+    return _elastic_ahead(p, beta, C, steps)
+
+
+@njit(cache=True, error_model="numpy")
+def superseismic(p, beta, steps):
+    """Wall ``(U(1) - 1, s(1))`` of a plastic front into undisturbed concrete."""
+    return wall_residual(p, beta, 0.0, 0.0, 1.0, steps)
+
+
+@njit(cache=True, error_model="numpy")
+def cracked_front(p, gamma):
+    """``(beta, s, U, eps_v, C)`` at the plastic front of the cracked solution with the crack
+    front at ``gamma`` (``beta = nan`` when it does not lie in ``(1, gamma)``)."""
+    e, phi, wb = p[E_], p[PHI], p[WB]
+    C = crack_amplitude(p, gamma)
+    s_e, D_e, U_e, F_e, dF_e, ev_e = elastic_state(p, C, gamma)
+    stiff = e - phi * gamma * gamma
+    if not (0.0 < C <= yield_amplitude(p, gamma) and stiff > 0.0):
+        return np.nan, 0.0, 0.0, 0.0, C
+    dF_c = -(s_e + phi * gamma * gamma * dF_e) / stiff
+    K1 = dF_c / (1.0 / gamma ** 2 - wb ** 2)
+    K0 = F_e + K1 * (1.0 / gamma + wb ** 2 * gamma)
+    s_yield = min(1.0, p[TAU_MAX])
+    inverse_square = wb ** 2 - s_yield / (e * K1)
+    if not (K1 < 0.0 and inverse_square > 0.0):
+        return np.nan, 0.0, 0.0, 0.0, C
+    beta = 1.0 / math.sqrt(inverse_square)
+    if not (1.0 < beta < gamma):
+        return np.nan, 0.0, 0.0, 0.0, C
+    F = K0 - K1 * (1.0 / beta + wb ** 2 * beta)
+    dF = K1 * (1.0 / beta ** 2 - wb ** 2)
+    return beta, s_yield, K0 - 2.0 * K1 / beta, dF + 2.0 * F / beta, C
+
+
+@njit(cache=True, error_model="numpy")
+def cracked(p, gamma, steps):
+    """Wall ``(U(1) - 1, s(1), beta, C)`` of the cracked solution with crack front ``gamma``."""
+    beta, s_a, U_a, ev_a, C = cracked_front(p, gamma)
+    if not beta > 1.0:
+        return np.nan, np.nan, beta, C
+    residual, S = wall_residual(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a), steps)
+    return residual, S, beta, C
+
+
+# ------------------------------------------------------------------------------------------
+# Root finding (Python: brentq on the compiled residuals)
+# ------------------------------------------------------------------------------------------
+
+XTOL = 1e-14
+BRACKET_POINTS = 96
+
+
+def _bracket(residual, lo, hi, points=BRACKET_POINTS):
+    """First sign change of ``residual`` on a grid of ``(lo, hi)`` geometric in ``xi``, or None.
+
+    Where the residual turns NaN (no admissible state) after a finite value, the edge of the
+    finite part is found by bisection and checked for a sign change too.
+    """
+    previous = None
+    for x in np.geomspace(lo, hi, points):
+        value = residual(x)
+        if previous is not None and math.isfinite(value) and value * previous[1] <= 0.0:
+            return previous[0], x
+        if previous is not None and not math.isfinite(value):
+            edge = _finite_edge(residual, previous, x)
+            if edge is not None:
+                return previous[0], edge
+        if math.isfinite(value):
+            previous = (x, value)
+    return None
+
+
+def _finite_edge(residual, finite, beyond, halvings=50):
+    """Bisect between a finite ``(x, value)`` and ``beyond`` (NaN) for a sign change."""
+    x0, v0 = finite
+    x1 = beyond
+    for _ in range(halvings):
+        mid = 0.5 * (x0 + x1)
+        value = residual(mid)
+        if not math.isfinite(value):
+            x1 = mid
+        elif value * v0 <= 0.0:
+            return mid
+        else:
+            x0 = mid
+    return None
+
+
+def _root(residual, lo, hi):
+    """A root of ``residual`` in ``(lo, hi)`` (:func:`_bracket`, then Illinois regula falsi that
+    bisects where the residual is NaN), or None."""
+    bracket = _bracket(residual, lo, hi)
+    if bracket is None:
+        return None
+    a, b = bracket
+    fa, fb = residual(a), residual(b)
+    for _ in range(200):
+        if fb == 0.0 or abs(b - a) <= XTOL * abs(b):
+            return b
+        c = b - fb * (b - a) / (fb - fa) if fb != fa else 0.5 * (a + b)
+        fc = residual(c)
+        if not math.isfinite(fc):
+            c = 0.5 * (a + b)
+            fc = residual(c)
+            if not math.isfinite(fc):
+                return None
+        if fc * fb < 0.0:
+            a, fa = b, fb
+        else:
+            fa *= 0.5
+        b, fb = c, fc
+    return b
+
+
+def _upper_front(p):
+    """Largest admissible front (the elastic wave front ``1/w``; 1e4 when ``w = 0``)."""
+    return (1.0 / p[W]) * (1.0 - 1e-12) if p[W] > 0.0 else 1e4
+
+
+def solve(material, phi, steps=DEFAULT_STEPS):
+    """The self-similar solution at ``phi = rho V^2 / f_c`` (see the module docstring).
+
+    Raises
+    ------
+    CavexNumericalError
+        No structure satisfies the wall condition (e.g. sonic flow in the comminuted zone).
+    """
+    require(is_finite_number(phi) and phi >= 0.0, "phi", "rho V^2/f_c, a finite number >= 0", phi)
+    return _solve(material, float(phi), int(steps))
+
+
+@lru_cache(maxsize=65536)
+def _solve(material, phi, steps):
+    p = material.parameters(phi)
+    upper = _upper_front(p)
+    beta = _root(lambda b: elastic_plastic(p, b, steps)[0], 1.0 + 1e-6, upper)
+    if beta is not None:
+        _, S, C = elastic_plastic(p, beta, steps)
+        s_a, D_a = elastic_state(p, C, beta)[:2]
+        if s_a - D_a >= -p[TENSILE] * (1.0 + 1e-12):
+            return CavitySolution(S, phi, ELASTIC_PLASTIC, beta, math.nan, C)
+    if math.isfinite(p[TENSILE]):
+        gamma_hi = min(upper, (1.0 / p[WB]) * (1.0 - 1e-12) if p[WB] > 0.0 else 1e6)
+        gamma = _root(lambda g: cracked(p, g, steps)[0], 1.0 + 1e-6, gamma_hi)
+        if gamma is not None:
+            _, S, beta, C = cracked(p, gamma, steps)
+            return CavitySolution(S, phi, CRACKED, beta, gamma, C)
+        beta = _root(lambda b: cracking_plastic(p, b, steps)[0], 1.0 + 1e-6, upper)
+        if beta is not None:
+            _, S, C = cracking_plastic(p, beta, steps)
+            return CavitySolution(S, phi, JOINT_FRONT, beta, beta, C)
+    if p[W] > 0.0:
+        beta = _root(lambda b: superseismic(p, b, steps)[0], 1.0 / p[W], 1e4)
+        if beta is not None:
+            return CavitySolution(superseismic(p, beta, steps)[1], phi, SUPERSEISMIC, beta,
+                                  math.nan, math.nan)
+    raise CavexNumericalError(f"no self-similar concrete cavity solution at rho V^2/f_c = {phi:g} "
+                              f"({material})")
+
+
+def wall_stress(material, phi, steps=DEFAULT_STEPS):
+    """``S = sigma_r(a)/f_c`` for an array (or scalar) of ``phi = rho V^2/f_c``."""
+    phi = np.asarray(phi, dtype=float)
+    out = np.array([solve(material, float(x), steps).S for x in phi.reshape(-1)])
+    return float(out[0]) if phi.ndim == 0 else out.reshape(phi.shape)
+
+
+def resistance_table(material, phi_max, points=17, steps=DEFAULT_STEPS):
+    """``(phi, S)`` at ``phi = phi_max (i/(points - 1))^2``, ``i = 0 .. points - 1`` (uniform
+    in ``V``)."""
+    require(is_finite_number(phi_max) and phi_max > 0.0, "phi_max", "a finite number > 0",
+            phi_max)
+    phi = phi_max * np.linspace(0.0, 1.0, points) ** 2
+    return phi, wall_stress(material, phi, steps)
+
+
+def fit_AB(phi, S):
+    """``(A, B)`` of ``S ~ A + B phi``: ``A = S(0)`` (the quasi-static solution, ``phi[0]``
+    must be 0) and ``B`` by least squares of ``S - A`` on ``phi``."""
+    phi, S = np.asarray(phi, dtype=float), np.asarray(S, dtype=float)
+    require(phi[0] == 0.0, "phi", "a table starting at 0", phi[0])
+    A = float(S[0])
+    return A, float(np.dot(phi, S - A) / np.dot(phi, phi))

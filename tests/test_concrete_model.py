@@ -1,0 +1,172 @@
+"""The predictive concrete model (verification/validation/concrete_model.py) and the committed
+study (results/concrete, made by verification/studies/concrete_validation.py)."""
+
+import csv
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from cavex.verification.studies import concrete_validation as study
+from cavex.verification.validation import empirical
+from cavex.verification.validation.concrete_model import (
+    TableResistance,
+    concrete_cavity,
+    crater_calibres,
+    li_chen_depth,
+    model_depth,
+    rigid_flag,
+    table_depth,
+    tensile_strength,
+)
+from cavex.verification.validation.shots import read_shots, shot_projectile
+
+ROOT = Path(__file__).resolve().parents[1]
+SHOTS = ROOT / "examples" / "shots_compilation_dev.csv"
+RESULTS = ROOT / "results" / "concrete"
+
+
+@pytest.fixture(scope="module")
+def shots():
+    return read_shots(SHOTS).shots
+
+
+def test_tensile_strength_fib():
+    assert tensile_strength(30e6) == pytest.approx(0.3 * 22.0 ** (2.0 / 3.0) * 1e6)
+    below, above = tensile_strength(58e6), tensile_strength(58e6 * (1 + 1e-12))
+    assert above == pytest.approx(below, rel=3e-3)  # the two branches meet (4.07 / 4.06 MPa)
+
+
+def test_crater_of_li_and_chen():
+    assert crater_calibres(2.0) == pytest.approx(0.707 + math.sqrt(7.0) / 2.0)
+
+
+class ParabolaResistance(TableResistance):
+    """``sigma_r = f_c (A + B rho V^2 / f_c)`` exactly, through the table machinery."""
+
+    def __init__(self, shot, A, B):
+        super().__init__(shot)
+        self.A, self.B = A, B
+
+    def wall_stress(self, velocity):
+        return self.shot.fc * self.A + self.B * self.shot.rho * np.asarray(velocity) ** 2
+
+
+@pytest.mark.parametrize("index", [0, 40, 120])
+def test_crater_and_integrator_reproduce_forrestal_closed_form(shots, index):
+    """With ``sigma_r = A f_c + B rho V^2`` the depth is Forrestal's closed form with
+    ``S = A`` and ``N* B`` (i.e. ``rho B``) and the same crater: the crater stage, the nose
+    quadrature and cavex's integrator together (integrator rtol 1e-9)."""
+    shot = shots[index]
+    A, B = 11.0, 1.3
+    depth = table_depth(shot, ParabolaResistance(shot, A, B))
+    closed = shot.diameter * empirical.penetration_calibres(
+        shot.mass, shot.diameter, shot.crh, shot.V0, shot.fc, B * shot.rho, S=A,
+        crater_calibres=crater_calibres(shot.crh))
+    assert depth == pytest.approx(closed, rel=1e-7)
+
+
+def test_stop_in_the_crater(shots):
+    slow = replace(shots[0], V0=5.0)
+    resistance = ParabolaResistance(slow, 11.0, 1.3)
+    crater = crater_calibres(slow.crh) * slow.diameter
+    depth = table_depth(slow, resistance)
+    assert depth < crater
+    assert depth == pytest.approx(math.sqrt(slow.mass * slow.V0 ** 2 * crater
+                                            / resistance.force(0.0, 0.0)))
+
+
+def test_li_chen_headline_numbers(shots):
+    """Li and Chen (2003) on the 286 development shots: mean |ln ratio| 0.483 (all), 0.356
+    (f_c <= 100 MPa, V0 <= 1000 m/s), 1.152 (f_c > 100 MPa) (issue 19 quotes 0.48 / 0.36 /
+    1.15)."""
+    logs = np.array([math.log(li_chen_depth(s) / s.depth) for s in shots])
+    fc = np.array([s.fc for s in shots])
+    v = np.array([s.V0 for s in shots])
+    assert len(shots) == 286
+    assert np.mean(np.abs(logs)) == pytest.approx(0.483, abs=5e-4)
+    assert np.mean(np.abs(logs[(fc <= 100e6) & (v <= 1000.0)])) == pytest.approx(0.356, abs=5e-4)
+    assert np.mean(np.abs(logs[fc > 100e6])) == pytest.approx(1.152, abs=5e-4)
+
+
+def test_rigid_flag(shots):
+    shot = shots[0]
+    resistance = TableResistance(shot)
+    soft = replace(shot, extra={**shot.extra, "proj_yield_MPa": "50"})
+    hard = replace(shot, extra={**shot.extra, "proj_yield_MPa": "5000"})
+    unknown = replace(shot, extra={**shot.extra, "proj_yield_MPa": ""})
+    assert rigid_flag(soft, resistance) == "non-rigid"
+    assert rigid_flag(hard, resistance) == ""
+    assert rigid_flag(unknown, resistance) == ""
+
+
+def test_material_from_correlations():
+    material = concrete_cavity(40e6, 2300.0)
+    assert material.lam == pytest.approx(3.0 * 3.1 / 6.1)
+    assert material.tau_max == 7.0
+    assert material.eta_lock == pytest.approx(0.1 / 1.1)
+    assert material.bulk * 40e6 == pytest.approx(0.8e9 / (0.1 / 1.1))
+    assert material.tensile * 40e6 == pytest.approx(tensile_strength(40e6))
+
+
+def test_table_resistance_is_the_nose_quadrature(shots):
+    shot = shots[10]
+    resistance = TableResistance(shot)
+    nodes = resistance._cosines
+    assert resistance.force(0.3, 200.0) == pytest.approx(
+        float(np.dot(resistance._weights, resistance.wall_stress(200.0 * nodes))))
+    assert shot_projectile(shot).psi == pytest.approx(shot.crh)
+
+
+# --- the committed study ------------------------------------------------------------------
+
+def read_csv(path):
+    with open(path, newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+@pytest.fixture(scope="module")
+def committed():
+    return read_csv(RESULTS / "predictions.csv"), read_csv(RESULTS / "grid_depths.csv")
+
+
+def test_committed_study_is_consistent(shots, committed):
+    """Every statistic of report.md is recomputed from the committed per-shot depths; the
+    empirical depths are recomputed; the published-constants model is recomputed for every
+    20th shot; LORO and the in-sample fit are redone from the committed grid."""
+    rows, grid_rows = committed
+    assert [r["id"] for r in rows] == [s.id for s in shots]
+    depths = {m: [float(r[m]) if r[m] else None for r in rows] for m in study.MODELS}
+    flags = [r["flag"] for r in rows]
+    for i, shot in enumerate(shots):
+        assert depths[study.LI_CHEN][i] == pytest.approx(li_chen_depth(shot), rel=1e-5)
+        assert depths[study.FORRESTAL][i] == pytest.approx(empirical.shot_depth(shot), rel=1e-5)
+    for i in range(0, len(shots), 20):
+        assert depths[study.MODEL][i] == pytest.approx(model_depth(shots[i]), rel=1e-5)
+    grid = {point: [float(r[f"S_max={point[0]:g};p_l={point[1]:g}"]) for r in grid_rows]
+            for point in study.GRID}
+    assert grid[study.PUBLISHED] == depths[study.MODEL]
+    loro_depths, chosen = study.loro(grid, shots)
+    assert loro_depths == depths[study.LORO]
+    assert grid[study.best_point(grid, shots, range(len(shots)))] == depths[study.FIT]
+    report = (RESULTS / "report.md").read_text()
+    for model in study.MODELS:
+        stats = study.statistics(depths[model], shots, flags)
+        cells = " | ".join(f"{stats[r][1]:.3f} / {stats[r][2]:+.3f}" for r in study.REGIMES)
+        assert f"| {model} | {cells} |" in report
+
+
+def test_headline_numbers(shots, committed):
+    """The numbers docs/concrete.md quotes (mean |ln ratio| per regime), from the committed
+    depths (which test_committed_study_is_consistent ties to the code)."""
+    rows, _ = committed
+    flags = [r["flag"] for r in rows]
+    expected = {study.MODEL: (0.486, 0.403, 0.470, 0.872), study.LORO: (0.536, 0.460, 0.387, 0.937),
+                study.LI_CHEN: (0.483, 0.356, 0.251, 1.152),
+                study.CAVEX: (0.707, 0.646, 1.167, 0.822)}
+    for model, numbers in expected.items():
+        stats = study.statistics([float(r[model]) for r in rows], shots, flags)
+        got = tuple(stats[regime][1] for regime in list(study.REGIMES)[:4])
+        assert got == pytest.approx(numbers, abs=5e-4)

@@ -1,0 +1,130 @@
+"""What an interactive user meets first: ``--help`` and bad input answer without loading the
+numerical libraries, ``python -m cavex`` runs the command line, every option states its default,
+``cavex config`` prints the embedded configuration, ``--no-figures`` writes no PNG, and numba's
+compiling is announced once (issue 21, item 1)."""
+
+import argparse
+import io
+import subprocess
+import sys
+
+import pytest
+
+from cavex.config import default_config_text, load_config
+from cavex.verification.cli import announce_compiling, build_parser, main
+
+HEAVY = ("numba", "scipy", "matplotlib", "skfem", "xarray", "dask", "pyvista")
+
+
+def _run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_the_parser_loads_no_numerical_library():
+    """``cavex --help`` and argument errors need only the parser: none of :data:`HEAVY` is
+    imported by building it (the time itself: benchmarks/commands.py)."""
+    probe = ("import sys; from cavex.verification.cli import build_parser; build_parser(); "
+             f"print(sorted(m for m in {HEAVY!r} if m in sys.modules))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          timeout=120, check=True)
+    assert done.stdout.strip() == "[]"
+
+
+def test_python_dash_m_cavex_is_the_command_line():
+    done = subprocess.run([sys.executable, "-m", "cavex", "stress", "--velocity", "-1",
+                           "--depth", "0.3"], capture_output=True, text=True, timeout=120,
+                          check=False)
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr.splitlines() == [
+        "cavex: error: parameter 'velocity' must be in [0, 10000] m/s (got -1.0)"]
+
+
+def _subcommands():
+    parser = build_parser()
+    actions = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    return actions[0].choices
+
+
+@pytest.mark.parametrize("command", sorted(_subcommands()))
+def test_every_option_states_its_default(command):
+    """Each option's help says its default or that it is required; only flags (off unless
+    given) and --help say neither."""
+    sub = _subcommands()[command]
+    formatter = sub._get_formatter()
+    silent = []
+    for action in sub._actions:
+        if action.help == argparse.SUPPRESS or isinstance(action, argparse._HelpAction):
+            continue
+        if action.nargs == 0 and action.default is False:
+            continue  # a flag
+        shown = formatter._get_help_string(action) % vars(action)
+        if "default" not in shown and "required" not in shown:
+            silent.append(action.option_strings or action.dest)
+    assert not silent, f"cavex {command}: no default shown for {silent}"
+
+
+def test_a_zero_default_is_shown(capsys):
+    with pytest.raises(SystemExit):
+        main(["trajectory", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "target normal (deg) (default: 0.0)" in text
+
+
+def test_config_prints_the_embedded_configuration(capsys, tmp_path):
+    code, out, err = _run(capsys, "config", "--default")
+    assert (code, err) == (0, "") and out == default_config_text().rstrip("\n") + "\n"
+    copy = tmp_path / "copy.toml"
+    copy.write_text(out)
+    assert load_config(copy) == load_config()
+    assert _run(capsys, "config")[1] == out
+    code, out, err = _run(capsys, "config", "--config", str(copy), "--default")
+    assert code == 2 and out == "" and len(err.splitlines()) == 1
+
+
+def test_config_of_a_bad_file_is_refused(capsys, tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(default_config_text().replace("[projectile]", "[projectil]"))
+    code, out, err = _run(capsys, "config", "--config", str(bad))
+    assert code == 2 and out == "" and err.startswith(f"cavex: error: '{bad}'")
+
+
+def test_penetrate_no_figures_writes_no_png(capsys, tmp_path):
+    code, out, err = _run(capsys, "penetrate", "--no-figures", "--out", str(tmp_path / "p"))
+    assert (code, err) == (0, "")
+    written = sorted(p.name for p in (tmp_path / "p").iterdir())
+    assert written == ["phases_runway.csv", "trajectory_first_layer_only.csv",
+                       "trajectory_runway.csv"]
+
+
+def test_compiling_is_announced_once():
+    """Two kernels compiled (cache misses: fresh functions, not cached) give one line."""
+    from numba import njit
+    from numba.core import event
+
+    stream = io.StringIO()
+    listener = announce_compiling(stream)
+    try:
+        njit(lambda x: x + 1)(1)
+        njit(lambda x: x * 2.0)(1.0)
+    finally:
+        event.unregister("numba:compile", listener)
+    assert stream.getvalue().splitlines() == [
+        "cavex: compiling the numerical kernels (first run after installing or updating; "
+        "cached for later runs)"]
+
+
+def test_no_announcement_without_compiling():
+    from numba import njit
+    from numba.core import event
+
+    kernel = njit(lambda x: x - 1)
+    kernel(1)  # compiled before the listener is there
+    stream = io.StringIO()
+    listener = announce_compiling(stream)
+    try:
+        kernel(2)
+    finally:
+        event.unregister("numba:compile", listener)
+    assert stream.getvalue() == ""

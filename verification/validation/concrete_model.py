@@ -1,0 +1,200 @@
+r"""Predicted penetration depth into thick concrete from the concrete cavity expansion.
+
+From a shot's columns (``f_c``, ``rho``, projectile mass, diameter, CRH, ``V0``) to a depth:
+
+1. **Material** (:func:`concrete_cavity`), every parameter from a published correlation with
+   ``f_c`` (and ``rho``), none fitted to the shots unless :class:`Constants` says so:
+
+   - ``E = 0.043 rho^1.5 sqrt(f_c)`` (MPa; ACI 318-19, 19.2.2.1a), ``nu = 0.2`` (EN 1992-1-1);
+   - ``f_t = 0.3 (f_c - 8)^(2/3)`` for ``f_c <= 58`` MPa, ``2.12 ln(1 + f_c/10)`` above (fib
+     Model Code 2010, Eq. 5.1-3, with ``f_ck = f_cm - 8`` MPa);
+   - comminuted strength ``D = tau_0 + lam p`` with ``lam = 3 (k - 1)/(k + 2)``, ``k = 4.1``
+     (Richart, Brandtzaeg and Brown 1928: ``f_cc = f_c + 4.1 f_l``) and ``tau_0 = f_c (1 -
+     lam/3)`` (the line passes through the uniaxial strength), capped at ``tau_max = S_max f_c``,
+     ``S_max = 7`` (Holmquist, Johnson and Cook 1993, HJC);
+   - hydrostat of HJC (1993): compaction linear to the locking strain ``mu_l = 0.1``
+     (``eta_l = mu_l/(1 + mu_l)``) at the locking pressure ``p_l = 0.8`` GPa, so ``K = p_l/eta_l``;
+     then the solid's ``K_1 = 85`` GPa.
+2. **Resistance** (:class:`TableResistance`): the wall stress ``sigma_r(V) = f_c S(rho V^2/f_c)``
+   of :mod:`cavex.analytic.concrete_cavity`, tabulated once per concrete (``f_c``, ``rho``) at
+   33 velocities uniform in ``V`` up to ``phi = 16 2^n`` (:func:`material_table`, shared by all
+   the shots into that concrete) and interpolated (PCHIP in ``V``), integrated over the tangent
+   ogive by cavex's nose quadrature (:func:`cavex.analytic.penetration.nose.nose_rule`); the
+   fitted ``A, B`` (:func:`cavex.analytic.concrete_cavity.fit_AB`) are reported, the depth uses
+   the table. Reused: the table per (concrete, top) here, the cavity solution per
+   (material, ``phi``) in :mod:`~cavex.analytic.concrete_cavity`.
+3. **Depth**: a crater of ``k d`` with Li and Chen's (2003) ``k = 0.707 + h/d`` (``h`` the nose
+   length; ``k = 2.03`` at CRH 2, Forrestal's two calibres), force ``c z`` continuous with the
+   tunnel force at ``z = k d`` (:func:`cavex.analytic.penetration.integrator.crater_exit`),
+   then cavex's tunnel integrator (:func:`cavex.analytic.penetration.integrator.penetrate`)
+   from ``V_1``; a projectile that stops in the crater reaches ``sqrt(m V0^2 k d / F(0))``.
+
+Li and Chen's (2003) empirical model (Forrestal's form with ``S = 72 f_c^-0.5``, the same
+crater) is :func:`li_chen_depth`. Rigid-regime flag (:func:`rigid_flag`): a shot is flagged
+``non-rigid`` when the mean nose pressure at impact ``F(V0)/(pi a^2)`` of the model exceeds the
+projectile's listed yield strength (the nose then deforms or erodes, which no rigid model
+covers); flagged shots stay in every table.
+"""
+
+import math
+from dataclasses import dataclass, fields, replace
+from functools import lru_cache
+
+import numpy as np
+from scipy.interpolate import PchipInterpolator
+
+from cavex.analytic.concrete_cavity import ConcreteCavity, fit_AB, wall_stress
+from cavex.analytic.penetration.integrator import crater_exit, penetrate
+from cavex.analytic.penetration.nose import nose_rule
+from cavex.errors import require
+from cavex.materials import Material, Projectile, Target
+from cavex.verification.validation import empirical
+from cavex.verification.validation.concrete import DEFAULT_NU, aci_modulus, mohr_coulomb_lambda
+from cavex.verification.validation.shots import shot_projectile
+
+LI_CHEN_COEFFICIENT = 72.0  # S = 72 f_c^-0.5, f_c in MPa (Li and Chen 2003)
+TABLE_POINTS = 33
+PHI_TOP = 16.0  # smallest table top (rho V^2/f_c)
+
+
+@dataclass(frozen=True)
+class Constants:
+    """The global constants of the mapping (defaults: the published values in the docstring).
+
+    ``cap`` is ``S_max = tau_max/f_c``, ``lock_pressure`` ``p_l`` (Pa), ``lock_strain`` HJC's
+    ``mu_l``, ``locked_modulus`` ``K_1`` (Pa), ``confinement`` Richart's ``k``.
+    """
+
+    cap: float = 7.0
+    lock_pressure: float = 0.8e9
+    lock_strain: float = 0.1
+    locked_modulus: float = 85e9
+    confinement: float = 4.1
+    nu: float = DEFAULT_NU
+
+    def with_values(self, names, values):
+        return replace(self, **{n: float(v) for n, v in zip(names, values, strict=True)})
+
+    def as_dict(self):
+        return {item.name: getattr(self, item.name) for item in fields(self)}
+
+
+def tensile_strength(fc):
+    """fib Model Code 2010 mean tensile strength (Pa) of a concrete of mean strength ``fc`` (Pa):
+    ``0.3 (f_c - 8)^(2/3)`` MPa up to 58 MPa, ``2.12 ln(1 + f_c/10)`` MPa above."""
+    f = fc / 1e6
+    if f <= 58.0:
+        return 0.3 * max(f - 8.0, 1.0) ** (2.0 / 3.0) * 1e6
+    return 2.12 * math.log(1.0 + 0.1 * f) * 1e6
+
+
+def concrete_cavity(fc, rho, constants=None):
+    """The :class:`~cavex.analytic.concrete_cavity.ConcreteCavity` of ``(f_c, rho)``."""
+    c = constants or Constants()
+    eta_lock = c.lock_strain / (1.0 + c.lock_strain)
+    return ConcreteCavity(modulus=aci_modulus(fc, rho) / fc, nu=c.nu,
+                          lam=mohr_coulomb_lambda(c.confinement), tau_max=c.cap,
+                          bulk=c.lock_pressure / eta_lock / fc, eta_lock=eta_lock,
+                          bulk_locked=c.locked_modulus / fc, tensile=tensile_strength(fc) / fc)
+
+
+def crater_calibres(crh):
+    """Li and Chen's (2003) crater depth ``k = 0.707 + h/d``, ``h/d = sqrt(4 CRH - 1)/2``."""
+    return 0.707 + 0.5 * math.sqrt(4.0 * crh - 1.0)
+
+
+def table_top(phi):
+    """Top of the table that covers ``phi``: ``PHI_TOP 2^n``, the smallest such >= ``phi``
+    (so that shots into one concrete share a few tables)."""
+    return PHI_TOP * 2.0 ** max(0, math.ceil(math.log2(max(phi, 1e-300) / PHI_TOP)))
+
+
+@lru_cache(maxsize=4096)
+def material_table(material, top):
+    """``(phi, S)`` of ``material`` at ``phi = top (i/(TABLE_POINTS - 1))^2`` (uniform in
+    ``V``), computed once per material and top and shared by every shot that uses it."""
+    phi = top * np.linspace(0.0, 1.0, TABLE_POINTS) ** 2
+    S = wall_stress(material, phi)
+    phi.setflags(write=False)
+    S.setflags(write=False)
+    return phi, S
+
+
+class TableResistance:
+    """Nose force of a one-layer concrete target from the tabulated cavity wall stress.
+
+    Has the integrator's interface (``force``, ``label``, ``crater_force``); the force does not
+    depend on the depth (thick target). ``A, B`` are :func:`fit_AB` over the table up to the
+    shot's ``phi_0 = rho V0^2/f_c`` (at least its first three points).
+    """
+
+    def __init__(self, shot, constants=None):
+        self.shot = shot
+        self.material = concrete_cavity(shot.fc, shot.rho, constants)
+        self.phi_max = shot.rho * shot.V0 ** 2 / shot.fc
+        phi, self.S = material_table(self.material, table_top(self.phi_max))
+        used = max(3, int(np.searchsorted(phi, self.phi_max, side="right")))
+        self.A, self.B = fit_AB(phi[:used], self.S[:used])
+        self._stress = PchipInterpolator(np.sqrt(phi * shot.fc / shot.rho), shot.fc * self.S)
+        self._cosines, self._weights = nose_rule(shot_projectile(shot))
+
+    def wall_stress(self, velocity):
+        """``sigma_r`` (Pa) at expansion velocity ``velocity`` (<= V0; clipped to it)."""
+        return self._stress(np.minimum(velocity, self.shot.V0))
+
+    def force(self, depth, velocity):
+        return float(np.dot(self._weights, self.wall_stress(velocity * self._cosines)))
+
+    def crater_force(self, velocity):
+        return self.force(0.0, velocity)
+
+    def label(self, depth, velocity):
+        return "concrete"
+
+
+def _target(shot):
+    """A placeholder one-layer target for the integrator (the resistance ignores it)."""
+    return Target((Material(E=1.0, nu=0.2, rho=shot.rho, lam=0.0, tau=1.0),), ())
+
+
+def table_depth(shot, resistance):
+    """Depth (m) with the crater of :func:`crater_calibres` and cavex's tunnel integrator."""
+    crater = crater_calibres(shot.crh) * shot.diameter
+    projectile = shot_projectile(shot)
+    energy = shot.mass * shot.V0 ** 2
+    static = resistance.force(0.0, 0.0)
+    if energy <= crater * static:
+        return math.sqrt(energy * crater / static)
+    v1, _ = crater_exit(projectile, resistance.crater_force, crater)
+    tunnel = Projectile(r=projectile.r, l=projectile.l, m=projectile.m, V0=v1, R=projectile.R)
+    return crater + float(penetrate(_target(shot), tunnel, resistance, crater=None).depth[-1])
+
+
+def model_depth(shot, constants=None):
+    """Predicted depth (m) of the concrete cavity-expansion model for ``shot``."""
+    return table_depth(shot, TableResistance(shot, constants))
+
+
+def li_chen_depth(shot):
+    """Li and Chen (2003): Forrestal's form with ``S = 72 f_c^-0.5`` and ``k = 0.707 + h/d``."""
+    S = LI_CHEN_COEFFICIENT * (shot.fc / 1e6) ** -0.5
+    return shot.diameter * empirical.penetration_calibres(
+        shot.mass, shot.diameter, shot.crh, shot.V0, shot.fc, shot.rho, S=S,
+        crater_calibres=crater_calibres(shot.crh))
+
+
+def nose_pressure(shot, resistance):
+    """Mean nose pressure at impact ``F(V0)/(pi a^2)`` (Pa)."""
+    return resistance.force(0.0, shot.V0) / (math.pi * 0.25 * shot.diameter ** 2)
+
+
+def rigid_flag(shot, resistance):
+    """``"non-rigid"`` when the mean nose pressure at impact exceeds the projectile's listed
+    yield strength (column ``proj_yield_MPa``), ``""`` otherwise or when it is not listed."""
+    text = shot.extra.get("proj_yield_MPa", "")
+    try:
+        strength = float(text) * 1e6
+    except ValueError:
+        return ""
+    require(strength > 0.0, "proj_yield_MPa", "a positive strength in MPa", text)
+    return "non-rigid" if nose_pressure(shot, resistance) > strength else ""
