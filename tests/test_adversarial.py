@@ -315,6 +315,12 @@ case("calibrate-paper", ["calibrate", "--shots", "{tmp}/s.csv", "--resistance", 
 case("calibrate-shot-beyond-the-model", ["calibrate", "--shots", "{tmp}/s.csv", "--params",
                                          "strength_factor", "--out", "{tmp}/c.toml"], 0,
      {"s.csv": _shots(*ROWS, "HEAVY,1e6,2e-4,,1000,10000,1e6,1000,1")})
+# five identical shots: the three parameters are not determined (J^T J singular): once
+# "+- inf" and a JSON Infinity, now "no standard error" and null
+case("calibrate-undetermined-parameters", ["calibrate", "--shots", "{tmp}/s.csv", "--params",
+                                           "lam", "strength_factor", "modulus_factor", "--json",
+                                           "--out", "{tmp}/c.toml"], 0,
+     {"s.csv": _shots(*(f"S{i}" + ROWS[0][2:] for i in range(5)))})
 case("calibrate-every-shot-beyond", ["calibrate", "--shots", "{tmp}/s.csv", "--params",
                                      "strength_factor", "--out", "{tmp}/c.toml"], 1,
      {"s.csv": _shots("H1,1e6,2e-4,,1000,10000,1e6,1000,1", "H2,1e6,2e-4,,1000,9000,1e6,1000,1")})
@@ -347,6 +353,7 @@ def test_adversarial(tmp_path, capsys, argv, files, code):
     assert "Traceback" not in err
     if code == 0:
         assert got == 0, err
+        assert not NOT_FINITE.search(err), err
         assert not NOT_FINITE.search(out), out
         for path, text in _written_text(tmp_path, before):
             assert not NOT_FINITE.search(text), path

@@ -114,7 +114,10 @@ def text(summary):
     predict (left out of the fit), the file."""
     s = summary
     errors = s["standard_errors"]
-    values = ", ".join(f"{p} = {v:.6g}" + _error(errors.get(p)) for p, v in s["fitted"].items())
+    why = ("as many shots as parameters" if len(s["shots"]) <= len(s["fitted"])
+           else "the shots do not determine it")
+    values = ", ".join(f"{p} = {v:.6g}" + _error(errors.get(p), why)
+                       for p, v in s["fitted"].items())
     return "\n".join([
         f"model   {s['model']}, {len(s['shots'])} shots: {', '.join(s['shots'])}",
         f"fitted  {values}",
@@ -127,10 +130,10 @@ def text(summary):
     ])
 
 
-def _error(se):
-    """`` +- se`` (the fit's standard error, 2 significant digits), or why there is none."""
+def _error(se, why):
+    """`` +- se`` (the fit's standard error, 2 significant digits), or ``why`` there is none."""
     if se is None:
-        return " (no standard error: as many shots as parameters)"
+        return f" (no standard error: {why})"
     return f" +- {se:.2g}"
 
 

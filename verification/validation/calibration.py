@@ -243,8 +243,8 @@ def standard_errors(jacobian, residuals, params, x):
 
     with ``n`` shots and ``p`` parameters. A factor fitted as ``ln f`` (:data:`LOG_PARAMETERS`)
     gets ``f * se(ln f)`` (first order). None for every parameter when ``n <= p`` (no degree of
-    freedom left to estimate the scatter) and where ``J^T J`` is singular (a parameter the
-    depths do not determine: ``inf``)."""
+    freedom left to estimate the scatter) and where ``J^T J`` is singular or the variance not
+    finite (a parameter the depths do not determine; once ``inf``, printed as such)."""
     jacobian, residuals = np.asarray(jacobian, dtype=float), np.asarray(residuals, dtype=float)
     n, p = jacobian.shape
     if n <= p:
@@ -254,10 +254,11 @@ def standard_errors(jacobian, residuals, params, x):
     try:
         variances = scatter * np.diag(np.linalg.inv(normal))
     except np.linalg.LinAlgError:
-        return [math.inf] * p
+        return [None] * p
     values = _to_values(x, params)
-    return [float(math.sqrt(max(v, 0.0)) * (value if name in LOG_PARAMETERS else 1.0))
-            for name, v, value in zip(params, variances, values, strict=True)]
+    errors = [float(math.sqrt(max(v, 0.0)) * (value if name in LOG_PARAMETERS else 1.0))
+              for name, v, value in zip(params, variances, values, strict=True)]
+    return [e if math.isfinite(e) else None for e in errors]
 
 
 class _ForwardDifferences:
