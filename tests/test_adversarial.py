@@ -118,6 +118,17 @@ for value in ("0", "-1", "1.5", "abc", "1e400"):
 case("scheduler-not-an-address", ["table", "--velocities", "100", "--depths", "0",
                                   "--scheduler", "nowhere", "-o", "{tmp}/t.nc"], 2)
 
+CALIBRATION = CONFIG + """
+[calibration]
+model = "derived-dynamic"
+params = ["lam", "strength_factor"]
+lam = 0.5
+strength_factor = 1.0
+modulus_factor = 1.0
+nu = 0.2
+shots = ["A1", "A2"]
+"""
+
 # --- configuration files: every command that reads one ---------------------------------------
 CONFIG_FAULTS = {
     "missing": None,
@@ -143,11 +154,16 @@ CONFIG_COMMANDS = {
     "trajectory": ["trajectory", "--no-figures", "--out", "{tmp}/o"],
     "table": ["table", "--velocities", "100", "--depths", "0", "-o", "{tmp}/t.nc"],
     "verify": ["verify", "--quick", "--out", "{tmp}/o"],
+    "config": ["config"],
 }
 for fault, text in CONFIG_FAULTS.items():
     for command, argv in CONFIG_COMMANDS.items():
         case(f"config-{fault}-{command}", [*argv, "--config", "{tmp}/c.toml"], 2,
              None if text is None else {"c.toml": text})
+case("config-default-and-file", ["config", "--default", "--config", "{tmp}/c.toml"], 2,
+     {"c.toml": CONFIG})
+case("config-reads-a-calibration", ["config", "--config", "{tmp}/cal.toml"], 0,
+     {"cal.toml": CALIBRATION.replace('["A1", "A2"]', '["\U0001F600", "x\\ny"]')})
 case("config-is-a-folder", ["penetrate", "--config", "{tmp}", "--out", "{tmp}/o"], 2)
 
 # --- shot files: calibrate and validate ------------------------------------------------------
@@ -198,16 +214,6 @@ case("calibrate-out-folder", ["calibrate", "--shots", "{tmp}/s.csv", "--out", "{
      {"s.csv": SHOTS})
 
 # --- calibration files: validate --calibration and --config ---------------------------------
-CALIBRATION = CONFIG + """
-[calibration]
-model = "derived-dynamic"
-params = ["lam", "strength_factor"]
-lam = 0.5
-strength_factor = 1.0
-modulus_factor = 1.0
-nu = 0.2
-shots = ["A1", "A2"]
-"""
 CALIBRATION_FAULTS = {
     "no-table": CONFIG,
     "old-label": CALIBRATION.replace('"derived-dynamic"', '"fe-table"'),
