@@ -124,7 +124,36 @@ def config_text(target, projectile):
 
 
 def _toml_value(value):
-    return json.dumps(value) if isinstance(value, str) else repr(float(value))
+    return toml_string(value) if isinstance(value, str) else repr(float(value))
+
+
+def _toml_escape(text):
+    """``text`` with backslash, quote and the control characters TOML forbids unescaped
+    (U+0000-U+001F but tab, U+007F) as ``\\uXXXX``; a lone surrogate (a file name's undecodable
+    byte), which no TOML file can hold, as U+FFFD. Everything else is written as itself."""
+    out = []
+    for char in str(text):
+        code = ord(char)
+        if char in '"\\':
+            out.append("\\" + char)
+        elif (code < 0x20 and char != "\t") or code == 0x7F:
+            out.append(f"\\u{code:04X}")
+        elif 0xD800 <= code <= 0xDFFF:
+            out.append("\ufffd")
+        else:
+            out.append(char)
+    return "".join(out)
+
+
+def toml_string(text):
+    """A TOML basic string that reads back to ``text`` (any Unicode, any control character)."""
+    return f'"{_toml_escape(text)}"'
+
+
+def toml_comment(text):
+    """A one-line TOML comment holding ``text`` (control characters escaped as in
+    :func:`toml_string`)."""
+    return f"# {_toml_escape(text)}"
 
 
 def fingerprint_data(target, projectile):

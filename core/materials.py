@@ -192,6 +192,12 @@ class Target:
 DEFAULT_DENSITY = 7850.0  # kg/m^3, steel: the body's length when ``length`` is absent
 MAX_CALIBRES = 1000  # longest body, in shank diameters (long-rod penetrators: ~30)
 MAX_FRICTION = 10.0  # largest Coulomb coefficient mu (dry friction: below ~1)
+# the projectile's accepted geometry and mass: where the nose quadrature's areas and the
+# energies stay finite (a radius near 1e150 m overflows R^2 there) and wide of every real
+# penetrator (shank radius ~1 mm to ~0.5 m, CRH ~1 to ~20, mass up to ~1e4 kg)
+RADIUS_RANGE = (1e-4, 10.0)  # m, shank radius r
+MAX_CRH = 1000.0  # largest calibre-radius-head R / (2 r)
+MASS_RANGE = (1e-6, 1e6)  # kg
 
 
 @dataclass(frozen=True)
@@ -201,13 +207,14 @@ class Projectile:
     Parameters
     ----------
     r : float
-        Shank radius (m).
+        Shank radius (m), in :data:`RADIUS_RANGE`.
     l : float
-        Nose length used to place the cavity centre (m), as the paper's Table 1.
+        Nose length used to place the cavity centre (m), as the paper's Table 1; at most
+        :data:`MAX_CALIBRES` calibres.
     R : float
-        Ogive radius (m), ``R >= r``; give this or ``crh = R / (2 r)``.
+        Ogive radius (m), ``r <= R <= 2 MAX_CRH r``; give this or ``crh = R / (2 r)``.
     m : float
-        Mass (kg).
+        Mass (kg), in :data:`MASS_RANGE`.
     V0 : float
         Striking velocity (m/s), in (0, 1e4].
     length : float, optional
@@ -240,12 +247,21 @@ class Projectile:
             _positive(name, getattr(self, name))
         require(self.V0 <= MAX_VELOCITY, "V0",
                 f"<= {MAX_VELOCITY:g} m/s (rigid-projectile penetration)", self.V0)
+        require(RADIUS_RANGE[0] <= self.r <= RADIUS_RANGE[1], "r",
+                f"in [{RADIUS_RANGE[0]:g}, {RADIUS_RANGE[1]:g}] m", self.r)
+        require(self.l <= MAX_CALIBRES * 2.0 * self.r, "l",
+                f"<= {MAX_CALIBRES} calibres ({MAX_CALIBRES * 2.0 * self.r:g} m)", self.l)
+        require(MASS_RANGE[0] <= self.m <= MASS_RANGE[1], "m",
+                f"in [{MASS_RANGE[0]:g}, {MASS_RANGE[1]:g}] kg", self.m)
         _exactly_one("R", "crh", (self.R, self.crh))
         if self.R is None:
             _positive("crh", self.crh)
+            require(self.crh <= MAX_CRH, "crh", f"<= {MAX_CRH:g}", self.crh)
             object.__setattr__(self, "R", 2.0 * self.r * self.crh)
         _positive("R", self.R)
-        require(self.R >= self.r, "R", f">= r = {self.r} (ogive)", self.R)
+        require(self.r <= self.R <= 2.0 * MAX_CRH * self.r, "R",
+                f">= r = {self.r} (ogive) and <= {2.0 * MAX_CRH:g} r = "
+                f"{2.0 * MAX_CRH * self.r:g} m (CRH <= {MAX_CRH:g})", self.R)
         if self.length is not None:
             _positive("length", self.length)
             require(self.ogive_length < self.length <= MAX_CALIBRES * 2.0 * self.r, "length",

@@ -126,13 +126,15 @@ def test_penetrate_figures(capsys, tmp_path, drawn, case, config):
         not_blank(out / name)
 
 
-def test_penetrate_refuses_a_crater_stop_and_draws_nothing(capsys, tmp_path, drawn):
-    """The 1-D integrator has no phase inside the crater (paper Eqs. 31-34): one line, exit 1,
-    no figure (the 3-D trajectory below draws that shot)."""
+def test_penetrate_draws_a_crater_stop(capsys, tmp_path, drawn):
+    """A shot the crater stops (paper Eqs. 31-34 with ``K L_c = F(0)``, issue 22: once refused)
+    has its one crater phase drawn like any other."""
     out = tmp_path / "p"
-    assert main(["penetrate", "--out", str(out), *_config(tmp_path, CRATER_STOP)]) == 1
-    assert "stops inside the crater" in capsys.readouterr().err
-    assert drawn.checked == {} and not out.exists()
+    assert main(["penetrate", "--out", str(out), *_config(tmp_path, CRATER_STOP)]) == 0
+    assert "projectile stopped" in capsys.readouterr().out
+    assert set(drawn.checked) == {"velocity_time.png", "deceleration_depth.png"}
+    for name in drawn.checked:
+        not_blank(out / name)
 
 
 @pytest.mark.parametrize(("case", "argv", "config"), [

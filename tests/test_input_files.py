@@ -83,8 +83,9 @@ def calibration_faults(text):
                    "(Expected ']' at the end of a table declaration)"),
         "unknown key": (text.replace("reference_shot = ", "reference = "),
                         "calibration.reference is not a known key (accepted: evaluations, lam, "
-                        "mean_abs_log_ratio, model, modulus_factor, n, nu, params, "
-                        "reference_shot, rms_log_ratio, shots, shots_file, strength_factor)"),
+                        "mean_abs_log_ratio, model, modulus_factor, n, nu, outliers, params, "
+                        "reference_shot, rms_log_ratio, shots, shots_file, skipped, "
+                        "strength_factor)"),
         "missing key": (text.replace("\nshots = ", "\n# shots = "),
                         "calibration.shots is missing (required)"),
         "wrong type": (text.replace("\nnu = ", '\nnu = "x" # ', 1),
@@ -96,7 +97,7 @@ def calibration_faults(text):
 
 def shot_faults(text):
     header, row = line_of(text, "id,"), line_of(text, "F94-39,")
-    shot = f"line {row} (shot 'F94-39'), column V0_m_s must be a finite number in (0, 10000] " \
+    shot = f"line {row} (shot 'F94-39'), column V0_m_s must be a number in [1, 10000] " \
            "(rigid-projectile penetration)"
     return {
         "syntax": (text.replace("F94-39,0.904,", "F94-39,"),

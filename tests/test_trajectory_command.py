@@ -14,8 +14,9 @@ from cavex.config import load_config
 from cavex.verification.cli import main
 from cavex.verification.studies.oblique_study import RAMPS, findings, overload_peaks, table_csv
 
-# contact ramp 1 m/s (the default is 0.01): these tests are about the files, not the contact
-LAW = ["--resistance", "law", "--law-A", "2e8", "--law-B", "2500", "--contact-ramp", "1"]
+# contact ramp 0.03 m/s, the largest accepted (the default is 0.01): these tests are about the
+# files, not the contact
+LAW = ["--resistance", "law", "--law-A", "2e8", "--law-B", "2500", "--contact-ramp", "0.03"]
 
 
 @pytest.fixture(scope="module")
@@ -33,9 +34,9 @@ def test_files_figures_and_json_hold_the_api_trajectory(command_run, capsys):
     target, projectile = load_config()
     strike = Strike(500.0, obliquity=25.0)
     api = fly(target, projectile, strike, "law", law_A=2e8, law_B=2500.0,
-            contact_ramp=1.0)
+            contact_ramp=0.03)
     single = fly(target.single(0), projectile, strike, "law", law_A=2e8, law_B=2500.0,
-            contact_ramp=1.0)
+            contact_ramp=0.03)
     # the same code on the same data: the same numbers
     assert document["end"]["nose_tip_m"] == api.end["nose_tip_m"]
     assert document["end"]["pitch_deg"] == api.end["pitch_deg"]
@@ -69,7 +70,7 @@ def test_no_figures_writes_the_same_numbers_without_pictures(command_run, tmp_pa
     assert sorted(document["outputs"]) == sorted(str(p) for p in out.iterdir())
     target, projectile = load_config()
     api = fly(target, projectile, Strike(500.0, obliquity=25.0), "law", law_A=2e8, law_B=2500.0,
-              contact_ramp=1.0)
+              contact_ramp=0.03)
     assert document["end"] == api.end
 
 
@@ -140,7 +141,7 @@ def test_progress_is_called_once_per_step():
     target, projectile = load_config()
     seen = []
     result = fly(target, projectile, Strike(500.0, obliquity=15.0), "law", law_A=2e8,
-                 law_B=2500.0, contact_ramp=1.0, progress=lambda t, y: seen.append(t))
+                 law_B=2500.0, contact_ramp=0.03, progress=lambda t, y: seen.append(t))
     steps = sum(s.t.size - 1 for s in result.solutions)
     assert len(seen) == steps
     assert np.array_equal(seen, np.concatenate([s.t[1:] for s in result.solutions]))

@@ -87,19 +87,30 @@ def crater_stage(projectile, force, depth, samples=50, start=None):
     """Crater trajectory samples ``(t, L, V, a)`` and the exit ``(t_c, V_c)``, from
     ``start = (t0, L0, V0)`` (None: the entry face, ``(0, 0, V_0)``): ``L = L0 + V0/omega
     sin(omega (t - t0))``, ``V = V0 cos(omega (t - t0))``, ``omega = sqrt(K/m)``, for a nose-tip
-    travel ``depth`` (:func:`cavex.analytic.penetration.zones.crater_depth`)."""
+    travel ``depth`` (:func:`cavex.analytic.penetration.zones.crater_depth`).
+
+    A projectile the crater stops (``m V0^2 <= L_c F(0)``) rests at
+    ``L_s = V0 sqrt(m / K) = sqrt(m V0^2 L_c / F(0))``, ``K L_c = F(0)`` (the crater's force
+    continuous with the tunnel's at rest), at ``t_s = (pi / 2) sqrt(m / K)``, ``V_c = 0``; at
+    the threshold ``L_s = L_c``, continuous with the tunnel branch."""
     t0, depth0, v0 = (0.0, 0.0, projectile.V0) if start is None else start
-    vc, stiffness = crater_exit(projectile, force, depth, v0)
-    omega = math.sqrt(stiffness / projectile.m)
-    if not omega > 0.0:  # V_c = V0 to round-off: a mass that the target cannot slow
-        raise CavexNumericalError(f"the crater does not slow the projectile (m = "
-                                  f"{projectile.m:g} kg, V0 = {v0:g} m/s)")
-    tc = math.acos(vc / v0) / omega
+    m = projectile.m
+    if m * v0 ** 2 <= depth * force(0.0):
+        stiffness = force(0.0) / depth
+        omega = math.sqrt(stiffness / m)
+        tc, vc, end = 0.5 * math.pi / omega, 0.0, v0 / omega
+    else:
+        vc, stiffness = crater_exit(projectile, force, depth, v0)
+        omega = math.sqrt(stiffness / m)
+        if not omega > 0.0:  # V_c = V0 to round-off: a mass that the target cannot slow
+            raise CavexNumericalError(f"the crater does not slow the projectile (m = "
+                                      f"{m:g} kg, V0 = {v0:g} m/s)")
+        tc, end = math.acos(vc / v0) / omega, depth
     t = np.linspace(0.0, tc, samples)
     depths = v0 / omega * np.sin(omega * t)
     velocity = v0 * np.cos(omega * t)
-    depths[-1], velocity[-1] = depth, vc  # the exit state exactly, not re-rounded
-    deceleration = stiffness * depths / projectile.m
+    depths[-1], velocity[-1] = end, vc  # the exit state exactly, not re-rounded
+    deceleration = stiffness * depths / m
     if start is not None:
         t, depths = t + t0, depths + depth0
     return (t, depths, velocity, deceleration), t0 + tc, vc
@@ -131,7 +142,9 @@ def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, 
         depth0 = crater_depth(projectile, crater)
         samples, t0, v0 = crater_stage(projectile, resistance.crater_force, depth0)
         _append(columns, *samples, 0)
-        phases.append(Phase("crater", depth0, v0, t0, "crater depth reached", "crater"))
+        depth0 = samples[1][-1]  # short of the crater depth where the crater stops it
+        phases.append(Phase("crater", depth0, v0, t0,
+                            "crater depth reached" if v0 > 0.0 else STOPPED, "crater"))
     return _tunnel(target, projectile, resistance, (t0, depth0, v0), columns, phases,
                    crater=crater, rtol=rtol, atol=atol)
 
@@ -194,8 +207,9 @@ def _interface_crater(target, projectile, resistance, start, columns, phases, cr
     samples, t_end, v_end = crater_stage(
         projectile, lambda v: resistance.layer_force(index, v), length, start=start)
     _append(columns, *samples, len(phases))
-    phases.append(Phase("crater", samples[1][-1], v_end, t_end,
-                        f"crater depth reached ({target.layer_name(index)})", "crater"))
+    reason = (f"crater depth reached ({target.layer_name(index)})" if v_end > 0.0
+              else STOPPED)  # the crater may stop it, short of its depth
+    phases.append(Phase("crater", samples[1][-1], v_end, t_end, reason, "crater"))
     return t_end, float(samples[1][-1]), v_end
 
 
@@ -205,6 +219,9 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
     of: rest (``V = 0``), the nose tip at ``stop_depth``, the response state leaving ``label``.
 
     ``scipy.integrate.solve_ivp`` (DOP853, dense output) with a terminal event for each end.
+    The force is evaluated at ``(max(L, L0), max(V, 0))``: the true motion has ``V >= 0``, but a
+    trial stage of a step that overshoots rest (``V < 0``) can carry ``L`` back above the start,
+    even to the free surface.
 
     Parameters
     ----------
@@ -232,13 +249,18 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
     """
     t0, depth0, v0 = start
 
-    def rhs(t, y):
-        return (y[1], -resistance.force(y[0], max(y[1], 0.0)) / mass)
+    def rhs(t, y):  # depth never falls below the start: a trial stage past rest is clamped
+        return (y[1], -resistance.force(max(y[0], depth0), max(y[1], 0.0)) / mass)
 
     events = _phase_events(resistance, stop_depth, stop_reason, label)
     sol = solve_ivp(rhs, (t0, t0 + MAX_PHASE_DURATION), (depth0, v0),
                     method="DOP853", events=[e for e, _ in events], dense_output=True,
                     rtol=rtol, atol=atol)
+    if sol.status == 0:  # reached t0 + MAX_PHASE_DURATION: no event
+        raise CavexNumericalError(
+            f"the projectile was still moving {MAX_PHASE_DURATION:g} s into a phase (depth "
+            f"{sol.y[0, -1]:.4g} m, {sol.y[1, -1]:.4g} m/s): a body this heavy or slender for "
+            "the target is beyond the model")
     if sol.status != 1:
         raise CavexNumericalError(f"penetration integration failed at t={sol.t[-1]} s, "
                                   f"depth {sol.y[0, -1]} m: {sol.message}")

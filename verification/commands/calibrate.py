@@ -24,11 +24,13 @@ def run(args, target, projectile):
     result = job(shots, resistance=settings["resistance"], boundary=settings["boundary"],
                  params=params, workers=args.workers, scheduler=args.scheduler,
                  progress=args.progress, out=out)
-    command = command_line(args.shots, args.out, result["calibration"].model, params, args.ids)
+    calibration = result["calibration"]
+    command = command_line(args.shots, args.out, calibration.model, params, args.ids)
     warning = all_fitted_warning(shots, len(shot_file.shots))
     if warning:
         print(f"cavex calibrate: warning: {warning}", file=sys.stderr)
-    document = summary(result, write_outputs(result, args.shots, shots[0], command, out))
+    reference = next(s for s in shots if s.id in calibration.shots)  # the first one fitted
+    document = summary(result, write_outputs(result, args.shots, reference, command, out))
     return json.dumps(document, indent=2) if args.json else text(document)
 
 
@@ -75,38 +77,63 @@ def write_outputs(job, shots_path, reference, command, out):
     return out
 
 
+def _outlier_lines(s):
+    """The fitted shots the model misses by more than the factor, and the fit without them."""
+    if not s["outliers"]:
+        return []
+    w = s["without_outliers"]
+    fit = ("no shot left" if w["n"] == 0 else
+           f"mean |ln(predicted/measured)| {w['mean_abs_log_ratio']:.4f}, rms "
+           f"{w['rms_log_ratio']:.4f} over {w['n']} shots")
+    return [f"outliers {len(s['outliers'])} shot(s) off by more than a factor "
+            f"{s['outlier_factor']:g} at the fit (flagged, still fitted): "
+            f"{', '.join(s['outliers'])}", f"without  {fit}"]
+
+
 def summary(job, out):
     """What ``cavex calibrate --json`` prints: the model, the fitted parameters (all
-    dimensionless), the mapping, the shots fitted, the fit statistics, the wall time and the
-    file written."""
+    dimensionless), the mapping, the shots fitted, the fit statistics, the shots skipped, the
+    outliers and the statistics without them, the wall time and the file written."""
+    from cavex.verification.validation.predict import OUTLIER_FACTOR
+
     calibration = job["calibration"]
     return {"model": calibration.model, "params": list(calibration.params),
             "fitted": {p: getattr(calibration.mapping, p) for p in calibration.params},
             "standard_errors": dict(calibration.standard_errors),
             "mapping": calibration.mapping.as_dict(), "shots": list(calibration.shots),
-            **dict(calibration.statistics), "wall_time_s": float(job["seconds"]),
+            **dict(calibration.statistics),
+            "skipped": {shot: reason for shot, reason in calibration.skipped},
+            "outlier_factor": OUTLIER_FACTOR, "outliers": list(calibration.outliers),
+            "without_outliers": dict(calibration.without_outliers),
+            "wall_time_s": float(job["seconds"]),
             "output": str(out)}
 
 
 def text(summary):
-    """The model and its shots, the fitted values, the fit, the file."""
+    """The model and its shots, the fitted values, the fit, the shots the model could not
+    predict (left out of the fit), the file."""
     s = summary
     errors = s["standard_errors"]
-    values = ", ".join(f"{p} = {v:.6g}" + _error(errors.get(p)) for p, v in s["fitted"].items())
+    why = ("as many shots as parameters" if len(s["shots"]) <= len(s["fitted"])
+           else "the shots do not determine it")
+    values = ", ".join(f"{p} = {v:.6g}" + _error(errors.get(p), why)
+                       for p, v in s["fitted"].items())
     return "\n".join([
         f"model   {s['model']}, {len(s['shots'])} shots: {', '.join(s['shots'])}",
         f"fitted  {values}",
         f"fit     mean |ln(predicted/measured)| {s['mean_abs_log_ratio']:.4f}, rms "
         f"{s['rms_log_ratio']:.4f}, {s['evaluations']} evaluations, "
         f"{s['wall_time_s']:.1f} s",
+        *(f"skipped {shot}: {reason}" for shot, reason in s["skipped"].items()),
+        *_outlier_lines(s),
         f"wrote   {s['output']}",
     ])
 
 
-def _error(se):
-    """`` +- se`` (the fit's standard error, 2 significant digits), or why there is none."""
+def _error(se, why):
+    """`` +- se`` (the fit's standard error, 2 significant digits), or ``why`` there is none."""
     if se is None:
-        return " (no standard error: as many shots as parameters)"
+        return f" (no standard error: {why})"
     return f" +- {se:.2g}"
 
 

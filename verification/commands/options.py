@@ -51,8 +51,9 @@ def add_resistance_options(command, offered=RESISTANCES, table=True, epsilon=Tru
         command.add_argument("--table", help="NetCDF table from `cavex table` (--resistance "
                              "table; the first layer alone: the derived model; default: none)")
     if epsilon:
-        command.add_argument("--epsilon", choices=EPSILON_READINGS, default="quasi-static",
-                             help="the paper model's reading of epsilon (docs/table2.md)")
+        command.add_argument("--epsilon", choices=EPSILON_READINGS,
+                             help="the paper model's reading of epsilon (docs/table2.md) "
+                             "(default: quasi-static)")
     command.add_argument("--model", dest="old_model", help=argparse.SUPPRESS)
 
 
@@ -68,7 +69,8 @@ def resistance_settings(args, offered=RESISTANCES):
     """``{"resistance", "boundary", "epsilon", "table"}`` of the parsed options, checked: no
     old spelling, the resistance is one of ``offered``, ``--table FILE`` goes with
     ``--resistance table`` (both or neither, where the command has ``--table``: ``calibrate``
-    builds its own tables), the paper model takes only its own boundary. ``boundary`` is
+    builds its own tables), the paper model takes only its own boundary, ``--epsilon`` only
+    with the paper model (default quasi-static). ``boundary`` is
     resolved (for a table or a law the derived model's default: the first layer alone, where
     it is flown, is derived)."""
     if args.old_model is not None:
@@ -90,10 +92,14 @@ def resistance_settings(args, offered=RESISTANCES):
                               "neither)")
     if resistance in CLOSED_FORMS:
         check_model(resistance, args.boundary)
+    epsilon = getattr(args, "epsilon", None)
+    if epsilon is not None and resistance != "paper":
+        raise CavexInputError(f"option '--epsilon' goes with '--resistance paper' (the paper "
+                              f"model's reading of epsilon; got --resistance {resistance})")
     return {"resistance": resistance,
             "boundary": model_boundary(resistance if resistance in CLOSED_FORMS else "derived",
                                        args.boundary),
-            "epsilon": getattr(args, "epsilon", "quasi-static"), "table": table}
+            "epsilon": epsilon or "quasi-static", "table": table}
 
 
 def add_interface_option(command):

@@ -32,6 +32,13 @@ DEFAULT_DIR = "results/trajectory"
 # m/s: below it the damping Jacobian frozen over a ROS2 step misjudges the switching contact
 # and the steps explode (1e-4 m/s: 241 823 steps against 419 at 1e-3, docs/oblique.md)
 MIN_CONTACT_RAMP = 0.001
+# m/s: up to it the final depth is within the stated 0.1 % of its V_r -> 0 limit (docs/oblique.md
+# convergence table: +1.3e-4 at 0.03, +1.0e-3 at 0.1, +1.7e-3 at 0.3; 100 m/s gave 3x the depth;
+# tests/test_edges.py measures 0.03 against 0.001)
+MAX_CONTACT_RAMP = 0.03
+# integrator steps per run before it is stopped as a numerical failure: measured shots take
+# 300-7 000 (docs/oblique.md); the largest spin once accepted took 599 113 steps (272 s)
+MAX_STEPS = 100_000
 
 
 def trajectory_job(target, projectile, strike, resistance="derived", *, boundary="dynamic",
@@ -41,9 +48,12 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
     ``progress``: a tqdm bar per run on stderr (steps, simulated time, speed)."""
     contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
     # the command keeps the regularisation on: without it (or far below the default) an
-    # oblique shot's sliding shank needs millions of steps (docs/oblique.md)
-    require(is_finite_number(contact_ramp) and MIN_CONTACT_RAMP <= contact_ramp <= 100.0,
-            "contact_ramp", f"in [{MIN_CONTACT_RAMP:g}, 100] m/s", contact_ramp)
+    # oblique shot's sliding shank needs millions of steps (docs/oblique.md); above
+    # MAX_CONTACT_RAMP the depth leaves the stated accuracy
+    require(is_finite_number(contact_ramp)
+            and MIN_CONTACT_RAMP <= contact_ramp <= MAX_CONTACT_RAMP, "contact_ramp",
+            f"in [{MIN_CONTACT_RAMP:g}, {MAX_CONTACT_RAMP:g}] m/s (final depth within 0.1 % "
+            "of the V_r -> 0 limit)", contact_ramp)
     options = {"boundary": boundary, "epsilon": epsilon, "free_surface": free_surface,
                "table": table, "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp}
     if table is not None:
@@ -51,6 +61,7 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
         options["table"] = load_table(table)
     with _steps("runway", progress) as step:
         runs = {"runway": fly(target, projectile, strike, resistance, progress=step, **options)}
+    check_answered("runway", runs["runway"])
     if compare_homogeneous and len(target.layers) > 1:
         single = target.single(0)
         if resistance == "table":  # the table belongs to the runway; first layer by closed form
@@ -61,6 +72,7 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
         with _steps("first layer only", progress) as step:
             runs["first layer only"] = fly(single, projectile, strike, resistance_single,
                                            progress=step, **options)
+        check_answered("first layer only", runs["first layer only"])
     settings = {"speed_m_s": strike.speed, "obliquity_deg": strike.obliquity,
                 "attack_deg": strike.attack, "attack_plane_deg": strike.attack_plane,
                 "spin_rad_s": strike.spin, "resistance": resistance, "boundary": boundary,
@@ -71,17 +83,54 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
     return {"runs": runs, "settings": settings, "target": target}
 
 
+def check_answered(name, result):
+    """A run that reached the 1 s time limit still moving is no answer (numerical failure):
+    either the body has turned tail-first and slides through the target, which resists only
+    surfaces moving into it and has no tail face to plough (a large attack, or one against the
+    obliquity, gets there), or it is too heavy for the target to stop within the time limit."""
+    from cavex.errors import CavexNumericalError
+
+    end = result.end
+    if end["state"] != "time limit":
+        return
+    y = result.solutions[-1].y[:, -1]
+    where = (f"to the {end['time_s']:g} s time limit ({end['speed_m_s']:.3g} m/s, nose tip "
+             f"{end['nose_tip_m'][2]:.3g} m deep)")
+    if float(np.dot(result.model.axis(y), y[7:10])) < 0.0:
+        why = ("the body turned tail-first and slid " + where + "; the model loads only "
+               "surfaces moving into the target (no tail face): use a smaller --attack or one "
+               "toward the obliquity")
+    else:
+        why = (f"the body was still moving nose-first {where}: a body this heavy for the target "
+               "is beyond the model's time")
+    raise CavexNumericalError(f"the {name} trajectory did not end: {why}")
+
+
 @contextmanager
 def _steps(name, enabled):
-    """``callable(t, y)`` advancing a tqdm bar of integrator steps (None when disabled)."""
+    """``callable(t, y)`` counting integrator steps (a numerical failure past
+    :data:`MAX_STEPS`) and, when ``enabled``, advancing a tqdm bar of them."""
+    from cavex.errors import CavexNumericalError
+
+    count = [0]
+
+    def budget(t, y):
+        count[0] += 1
+        if count[0] > MAX_STEPS:
+            raise CavexNumericalError(
+                f"the {name} trajectory needed more than {MAX_STEPS} integrator steps (stopped "
+                f"at t = {t * 1e3:.4g} ms): a spin, attack or contact ramp at the edge of its "
+                "range; measured shots take under 10 000 (docs/oblique.md)")
+
     if not enabled:
-        yield None
+        yield budget
         return
     from tqdm.auto import tqdm
 
     bar = tqdm(desc=name, unit=" steps", file=sys.stderr, dynamic_ncols=True, leave=False)
 
     def step(t, y):
+        budget(t, y)
         bar.update()
         bar.set_postfix_str(f"t = {t * 1e3:.3f} ms, {float(np.linalg.norm(y[7:10])):.1f} m/s",
                             refresh=False)
@@ -416,7 +465,6 @@ def run(args, target, projectile):
     kill), returns the text or JSON to print."""
     from cavex.analytic.penetration.resistance import RESISTANCES
     from cavex.errors import CavexInputError, CavexNumericalError
-    from cavex.materials import MAX_VELOCITY
     from cavex.verification.commands.options import interface_target, resistance_settings
 
     settings = resistance_settings(args, (*RESISTANCES, "law"))
@@ -425,16 +473,24 @@ def run(args, target, projectile):
     if not all(law) if args.resistance == "law" else any(law):
         raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
                               "'--resistance law' (all or none)")
+    if args.resistance == "law" and args.boundary is not None:
+        raise CavexInputError("option '--boundary' goes with '--resistance derived' (or table); "
+                              "'--resistance law' has no boundary convention")
+    if args.no_free_surface and args.resistance in ("law", "paper"):
+        raise CavexInputError(f"option '--no-free-surface' goes with '--resistance derived' (or "
+                              f"table); '--resistance {args.resistance}' has no free-surface "
+                              "reduction")
     if args.compare_homogeneous and len(target.layers) < 2:
         raise CavexInputError("option '--compare-homogeneous' needs a target of two or more "
                               "layers (this one is its first layer alone already)")
     folder = check_output_dir(args.out, "out")
     speed = projectile.V0 if args.velocity is None else args.velocity  # Strike checks it
-    top = MAX_VELOCITY / projectile.r  # the shank's surface speed <= MAX_VELOCITY
-    require(math.isfinite(args.spin) and abs(args.spin) <= top, "spin",
-            f"in [-{top:g}, {top:g}] rad/s (shank surface speed <= {MAX_VELOCITY:g} m/s)",
-            args.spin)
     strike = Strike(speed, args.obliquity, args.attack, args.attack_plane, args.spin)
+    # rifling turns the shank's surface at 0.1-0.5 of the speed; each turn costs ~1 600 steps
+    top = strike.speed / projectile.r  # the shank's surface speed <= the striking speed
+    require(abs(strike.spin) <= top, "spin",
+            f"in [-{top:.6g}, {top:.6g}] rad/s (shank surface speed |spin| r <= the striking "
+            f"speed {strike.speed:g} m/s)", strike.spin)
     projectile.body_length  # noqa: B018 (a projectile without a length refuses here)
     try:  # forces beyond the body's mass and inertia overflow (warnings, then a bogus end)
         with np.errstate(over="raise", invalid="raise"):

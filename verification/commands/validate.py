@@ -13,7 +13,9 @@ the same files.
 import csv
 import io
 import json
+import os
 import shlex
+import sys
 import time
 
 import numpy as np
@@ -27,6 +29,7 @@ from cavex.verification.validation.predict import (
     FE_MODEL,
     MODELS,
     TableCache,
+    flag_outliers,
     predictions,
     summaries,
     validate,
@@ -54,6 +57,8 @@ def run(args, target, projectile):
                               "give one per model")
     out = check_output_dir(DEFAULT_OUT if args.out is None else args.out, "out")
     check_execution(workers, scheduler)
+    print(f"cavex: validate {estimate(shot_file.shots, calibrations, out / 'tables', workers)}",
+          file=sys.stderr, flush=True)
     began = time.monotonic()
     result = job(shot_file, calibrations, tables_dir=out / "tables", workers=workers,
                  scheduler=scheduler, progress=args.progress)
@@ -63,6 +68,26 @@ def run(args, target, projectile):
     if args.json:
         return json.dumps(summary(result), indent=2)
     return text(result, seconds, written)
+
+
+def columns_of(calibrations):
+    """Every column :func:`job` fills: the models, the calibrated ones and, with a
+    derived-dynamic calibration, :data:`COMPRESSIBILITY_COLUMN`."""
+    from cavex.verification.validation.predict import validation_columns
+
+    columns = validation_columns(calibrations)
+    dynamic = [c for c in calibrations if c.model == "derived-dynamic"]
+    if dynamic:
+        columns[COMPRESSIBILITY_COLUMN] = (FE_MODEL, dynamic[0].mapping)
+    return columns
+
+
+def estimate(shots, calibrations, tables_dir, workers):
+    """The run's size and time (:func:`cavex.verification.validation.predict.run_estimate`)."""
+    from cavex.verification.validation.predict import run_estimate
+
+    workers = workers or os.cpu_count() or 1
+    return run_estimate(shots, columns_of(calibrations), TableCache(tables_dir), workers)
 
 
 def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=None,
@@ -75,9 +100,8 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
                         progress=show_progress(progress))
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
                       progress=progress)
-    dynamic = [c for c in calibrations if c.model == "derived-dynamic"]
-    if dynamic:
-        columns = {COMPRESSIBILITY_COLUMN: (FE_MODEL, dynamic[0].mapping)}
+    if any(c.model == "derived-dynamic" for c in calibrations):
+        columns = {COMPRESSIBILITY_COLUMN: columns_of(calibrations)[COMPRESSIBILITY_COLUMN]}
         depths, failures = predictions(shot_file.shots, columns, tables, progress)
         for row, depth in zip(result["shots"], depths[COMPRESSIBILITY_COLUMN], strict=True):
             row["predicted_m"][COMPRESSIBILITY_COLUMN] = depth
@@ -90,6 +114,7 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
         held = [r for r in result["shots"] if r["id"] in result["held_out"]]
         result["held_out_summary"] = summaries(held, list(result["summary"]))
         result["models"].append(COMPRESSIBILITY_COLUMN)
+        flag_outliers(result)
     result["shots_file"] = {"path": shot_file.path, "comments": list(shot_file.comments),
                             "n": len(shot_file.shots)}
     result["tables"] = {"built": tables.built, "reused": tables.reused}
@@ -237,6 +262,7 @@ def report_markdown(result, figures=True):
     lines += _summary_table(result["summary"]) + [""]
     lines += ["Ratio = predicted / measured depth; std is the sample standard deviation; "
               "mean abs ln ratio is the mean of |ln(predicted/measured)|.", ""]
+    lines += _outlier_section(result)
     lines += ["## Compressibility: the FE table against the incompressible closed forms", ""]
     for column, what in ((FE_MODEL, "uncalibrated mapping"),
                          (result.get("compressibility_column"),
@@ -267,6 +293,27 @@ def report_markdown(result, figures=True):
             lines += [f"- {model}, shot {i}: {reason}" for i, reason in items.items()]
         lines.append("")
     return "\n".join(lines)
+
+
+def _outlier_section(result):
+    """Report lines: the flagged shots (every model off by more than the factor), each with
+    its measured depth and the range of the models' ratios, and the statistics without them."""
+    flagged, factor = result["outliers"]["shots"], result["outliers"]["factor"]
+    lines = ["## Outliers: shots every model misses by more than a factor "
+             f"{factor:g}", ""]
+    if not flagged:
+        return lines + ["None.", ""]
+    rows = {row["id"]: row for row in result["shots"]}
+    lines += [f"{len(flagged)} shot(s), kept in every statistic above (flagged, not dropped):",
+              "", "| shot | V0 (m/s) | measured (mm) | predicted / measured, every model |",
+              "|---|---:|---:|---|"]
+    for shot in flagged:
+        ratios = [r for r in rows[shot]["ratio"].values() if r is not None]
+        lines.append(f"| {shot} | {rows[shot]['V0_m_s']:g} | "
+                     f"{rows[shot]['measured_m'] * 1e3:g} | {min(ratios):.3g} to "
+                     f"{max(ratios):.3g} |")
+    lines += ["", "Without them:", ""] + _summary_table(result["summary_without_outliers"])
+    return lines + [""]
 
 
 FIGURES = ("predicted_vs_measured.png", "ratio_vs_velocity.png")
@@ -395,6 +442,12 @@ def text(result, seconds, written):
     fitted = bool(result["calibrations"])
     parts = [("all shots" + (" (calibrated models: in-sample on their fitted shots)" if fitted
                              else ""), result["summary"])]
+    flagged = result["outliers"]["shots"]
+    if flagged:
+        shown = ", ".join(flagged[:10]) + (", ..." if len(flagged) > 10 else "")
+        parts.append((f"without the {len(flagged)} outlier(s), every model off by more than a "
+                      f"factor {result['outliers']['factor']:g} ({shown}; see report.md)",
+                      result["summary_without_outliers"]))
     if result.get("held_out"):
         parts.insert(0, (f"held-out shots ({len(result['held_out'])})",
                          result["held_out_summary"]))

@@ -10,6 +10,7 @@ writes.
 import os
 import shutil
 import signal
+import socket
 import sys
 import tempfile
 import threading
@@ -64,6 +65,42 @@ def _check_writable(folder, option, text):
                               f"{text!r}: {exc.strerror or exc})") from None
 
 
+STAGE_PREFIX = ".cavex-partial-"  # then host, process id and a random part
+STALE_SECONDS = 86400.0  # a stage of no known process (an older cavex, another host) after
+
+
+def remove_stale_stages(folder):
+    """Remove the hidden stages a killed run (``kill -9``, power loss: no clean-up ran) left in
+    ``folder``: those of this host whose process is gone, and any untouched for
+    :data:`STALE_SECONDS` (older cavex names no process; another host's cannot be asked)."""
+    import time
+
+    host = socket.gethostname()
+    for stage in folder.glob(STAGE_PREFIX + "*"):
+        owner = stage.name[len(STAGE_PREFIX):].rsplit("-", 2)
+        try:
+            mine = len(owner) == 3 and owner[0] == host
+            dead = mine and not _alive(int(owner[1]))
+            old = time.time() - stage.stat().st_mtime > STALE_SECONDS
+        except (ValueError, OSError):
+            continue
+        if stage.is_dir() and (dead or (old and not mine)):
+            shutil.rmtree(stage, ignore_errors=True)
+
+
+def _alive(pid):
+    """Whether process ``pid`` exists on this host."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's process
+        return True
+    return True
+
+
 @contextmanager
 def staged_output(folder):
     """Write a command's files into a hidden folder inside ``folder`` (the ``with`` target);
@@ -73,12 +110,16 @@ def staged_output(folder):
     An exception or an interrupt (SIGINT or SIGTERM: :class:`KeyboardInterrupt`, also when the
     exception was swallowed on its way, e.g. in a garbage-collector callback) removes the hidden
     folder, and ``folder`` too if this created it and it is empty: Ctrl-C or ``kill`` in the
-    middle of writing leaves no partial set of outputs.
+    middle of writing leaves no partial set of outputs. ``kill -9`` runs no clean-up: its stage
+    (named by host and process id) is removed by the next staged write into ``folder``
+    (:func:`remove_stale_stages`).
     """
     folder = Path(folder)
     created = not folder.exists()
     folder.mkdir(parents=True, exist_ok=True)
-    stage = Path(tempfile.mkdtemp(prefix=".cavex-partial-", dir=folder))
+    remove_stale_stages(folder)
+    stage = Path(tempfile.mkdtemp(prefix=f"{STAGE_PREFIX}{socket.gethostname()}-{os.getpid()}-",
+                                  dir=folder))
     received = []
 
     def interrupt(signum, frame):

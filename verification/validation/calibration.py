@@ -32,7 +32,7 @@ from cavex.errors import CavexInputError, CavexNumericalError, check_keys, prefi
 from cavex.input_files import in_file, read_toml
 from cavex.verification.output.number_format import round_significant
 from cavex.verification.validation.concrete import BOUNDS, FREE_PARAMETERS, Mapping, shot_target
-from cavex.verification.validation.predict import FE_MODEL, TableCache, predict
+from cavex.verification.validation.predict import FE_MODEL, OUTLIER_FACTOR, TableCache, predict
 from cavex.verification.validation.shots import shot_projectile
 
 PARAMETER_DIGITS = 6
@@ -42,7 +42,7 @@ DIFF_STEP = {"closed form": 1e-6, FE_MODEL: 2e-2}
 TOLERANCE = {"closed form": 1e-12, FE_MODEL: 1e-3}  # FE: its depths carry ~1e-3 noise
 CALIBRATION_KEYS = {"model", "params", "lam", "strength_factor", "modulus_factor", "nu",
                     "shots", "shots_file", "reference_shot", "n", "mean_abs_log_ratio",
-                    "rms_log_ratio", "evaluations"}
+                    "rms_log_ratio", "evaluations", "skipped", "outliers"}
 CALIBRATION_REQUIRED = {"model", "params", "lam", "strength_factor", "modulus_factor", "nu",
                         "shots"}
 
@@ -58,6 +58,9 @@ class Calibration:
     shots: tuple
     source: str = ""
     statistics: tuple = ()
+    skipped: tuple = ()  # (shot id, reason) of the shots the model could not predict
+    outliers: tuple = ()  # fitted shot ids off by more than OUTLIER_FACTOR at the fit
+    without_outliers: tuple = ()  # the statistics over the other fitted shots
     #: ``((param, standard error), ...)`` of the fit (:func:`standard_errors`; not in the
     #: calibration file: the command prints them)
     standard_errors: tuple = ()
@@ -69,7 +72,9 @@ class Calibration:
     def describe(self):
         return {"column": self.column, "model": self.model, "file": self.source,
                 "params": list(self.params), "mapping": self.mapping.as_dict(),
-                "shots": list(self.shots), **dict(self.statistics)}
+                "shots": list(self.shots), **dict(self.statistics),
+                "skipped": {shot: reason for shot, reason in self.skipped},
+                "outliers": list(self.outliers)}
 
 
 def check_parameters(params):
@@ -97,9 +102,28 @@ def _bounds(params):
     return lower, upper
 
 
+class ShotFailure(Exception):
+    """``model`` could not predict one shot (its id and the reason)."""
+
+    def __init__(self, shot_id, reason):
+        super().__init__(f"shot '{shot_id}': {reason}")
+        self.shot_id, self.reason = shot_id, reason
+
+
 def log_ratios(shots, model, mapping, tables=None):
-    """``ln(predicted / measured)`` per shot for ``model`` (a model label)."""
-    return np.array([math.log(predict(s, model, mapping, tables) / s.depth) for s in shots])
+    """``ln(predicted / measured)`` per shot for ``model`` (a model label); a shot the model
+    cannot predict (a numerical or range error, a depth not finite and > 0) raises
+    :class:`ShotFailure`."""
+    ratios = []
+    for shot in shots:
+        try:
+            depth = predict(shot, model, mapping, tables)
+        except (CavexInputError, CavexNumericalError) as exc:
+            raise ShotFailure(shot.id, str(exc).splitlines()[0]) from None
+        if not (math.isfinite(depth) and depth > 0.0):
+            raise ShotFailure(shot.id, f"predicted depth {depth!r} m")
+        ratios.append(math.log(depth / shot.depth))
+    return np.array(ratios)
 
 
 def fit(shots, resistance="derived", params=None, start=None, tables=None, progress=False, *,
@@ -122,20 +146,65 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
     progress : bool
         One line per evaluation on stderr.
 
+    A shot the model cannot predict at a parameter the fit visits (:class:`ShotFailure`) is
+    left out, named in ``skipped`` (and on stderr with ``progress``), and the fit starts again
+    without it; too few shots left is a numerical failure.
+
     Returns
     -------
     Calibration
         Fitted parameters rounded to :data:`PARAMETER_DIGITS` significant digits; statistics
         (``n``, ``mean_abs_log_ratio``, ``rms_log_ratio``, ``evaluations``) at the rounded
-        parameters.
+        parameters; the fitted shots off by more than
+        :data:`~cavex.verification.validation.predict.OUTLIER_FACTOR` there (``outliers``:
+        flagged, still fitted) and the statistics without them (``without_outliers``).
     """
     model, params = model_label(resistance, boundary), check_parameters(params)
     require(len(shots) >= len(params), "shots",
             f"at least as many shots as free parameters ({len(params)})", len(shots))
     start = start or Mapping()
-    kind = FE_MODEL if model == FE_MODEL else "closed form"
     tables = tables or TableCache(progress=False)
     tables.velocities_for(shots)
+    active, skipped = list(shots), []
+    while True:
+        try:
+            mapping, evaluations, errors = _least_squares(active, model, params, start,
+                                                          tables, progress)
+            r = log_ratios(active, model, mapping, tables)
+            break
+        except ShotFailure as failure:
+            skipped.append((failure.shot_id, failure.reason))
+            active = [s for s in active if s.id != failure.shot_id]
+            if progress:
+                print(f"cavex: calibrate {model}: {failure}; fitting again without it",
+                      file=sys.stderr, flush=True)
+            if len(active) < len(params):
+                raise CavexNumericalError(
+                    f"calibration of {model}: {len(skipped)} shot(s) the model cannot "
+                    f"predict, too few left (last {failure})") from None
+    flagged = np.abs(r) > math.log(OUTLIER_FACTOR)
+    return Calibration(model, mapping, params, tuple(s.id for s in active),
+                       statistics=(*fit_statistics(r), ("evaluations", evaluations)),
+                       skipped=tuple(skipped),
+                       outliers=tuple(s.id for s, f in zip(active, flagged, strict=True) if f),
+                       without_outliers=fit_statistics(r[~flagged]), standard_errors=errors)
+
+
+def fit_statistics(r):
+    """``n``, mean ``|ln ratio|`` and rms ``ln ratio`` of the log ratios ``r`` (6 significant
+    digits; the means None without shots)."""
+    def rounded(value):
+        return round_significant(float(value), 6) if r.size else None
+
+    return (("n", int(r.size)), ("mean_abs_log_ratio", rounded(np.abs(r).mean())),
+            ("rms_log_ratio", rounded(np.sqrt((r ** 2).mean()))))
+
+
+def _least_squares(shots, model, params, start, tables, progress):
+    """The fitted mapping (parameters rounded to :data:`PARAMETER_DIGITS`), the number of
+    residual evaluations and the parameters' standard errors (:func:`standard_errors`);
+    :class:`ShotFailure` passes through."""
+    kind = FE_MODEL if model == FE_MODEL else "closed form"
     count = [0]
     began = time.monotonic()
 
@@ -162,16 +231,8 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
         raise CavexNumericalError(f"calibration of {model} left the models' range: {exc}") \
             from None
     values = [round_significant(v, PARAMETER_DIGITS) for v in _to_values(solution.x, params)]
-    mapping = start.with_values(params, values)
-    r = log_ratios(shots, model, mapping, tables)
-    statistics = (("n", len(shots)),
-                  ("mean_abs_log_ratio", round_significant(float(np.abs(r).mean()), 6)),
-                  ("rms_log_ratio", round_significant(float(np.sqrt((r ** 2).mean())), 6)),
-                  ("evaluations", count[0]))
     errors = standard_errors(solution.jac, solution.fun, params, solution.x)
-    return Calibration(model, mapping, params, tuple(s.id for s in shots),
-                       statistics=statistics,
-                       standard_errors=tuple(zip(params, errors, strict=True)))
+    return start.with_values(params, values), count[0], tuple(zip(params, errors, strict=True))
 
 
 def standard_errors(jacobian, residuals, params, x):
@@ -182,8 +243,8 @@ def standard_errors(jacobian, residuals, params, x):
 
     with ``n`` shots and ``p`` parameters. A factor fitted as ``ln f`` (:data:`LOG_PARAMETERS`)
     gets ``f * se(ln f)`` (first order). None for every parameter when ``n <= p`` (no degree of
-    freedom left to estimate the scatter) and where ``J^T J`` is singular (a parameter the
-    depths do not determine: ``inf``)."""
+    freedom left to estimate the scatter) and where ``J^T J`` is singular or the variance not
+    finite (a parameter the depths do not determine; once ``inf``, printed as such)."""
     jacobian, residuals = np.asarray(jacobian, dtype=float), np.asarray(residuals, dtype=float)
     n, p = jacobian.shape
     if n <= p:
@@ -193,10 +254,11 @@ def standard_errors(jacobian, residuals, params, x):
     try:
         variances = scatter * np.diag(np.linalg.inv(normal))
     except np.linalg.LinAlgError:
-        return [math.inf] * p
+        return [None] * p
     values = _to_values(x, params)
-    return [float(math.sqrt(max(v, 0.0)) * (value if name in LOG_PARAMETERS else 1.0))
-            for name, v, value in zip(params, variances, values, strict=True)]
+    errors = [float(math.sqrt(max(v, 0.0)) * (value if name in LOG_PARAMETERS else 1.0))
+              for name, v, value in zip(params, variances, values, strict=True)]
+    return [e if math.isfinite(e) else None for e in errors]
 
 
 class _ForwardDifferences:
@@ -232,34 +294,34 @@ class _ForwardDifferences:
 # --- files ------------------------------------------------------------------------------------
 
 def calibration_text(calibration, shots_file, reference, command=None):
-    """The TOML text of a calibration file (see the module docstring)."""
-    from cavex.config import config_text
+    """The TOML text of a calibration file (see the module docstring); every string and comment
+    escaped (:func:`cavex.config.toml_string`), so any shot id or path reads back."""
+    from cavex.config import config_text, toml_comment, toml_string
 
     stats = dict(calibration.statistics)
     m = calibration.mapping
     lines = ["# cavex calibration, written by `cavex calibrate`.",
-             *([f"# command: {command}"] if command else []),
-             f"# [projectile] and [[layers]]: the calibrated target of shot '{reference.id}', so",
+             *([toml_comment(f"command: {command}")] if command else []),
+             toml_comment(f"[projectile] and [[layers]]: the calibrated target of shot "
+                          f"'{reference.id}', so"),
              "# `cavex penetrate --config THIS_FILE` runs it (derived-quasi-static: add",
              "# --boundary quasi-static; paper: --resistance paper). `cavex validate --calibration",
              "# THIS_FILE` reads [calibration] and applies its mapping to every shot.",
              "", "[calibration]",
-             f"model = {_toml_string(calibration.model)}",
-             f"params = [{', '.join(_toml_string(p) for p in calibration.params)}]",
+             f"model = {toml_string(calibration.model)}",
+             f"params = [{', '.join(toml_string(p) for p in calibration.params)}]",
              *(f"{name} = {getattr(m, name)!r}" for name in ("lam", "strength_factor",
                                                               "modulus_factor", "nu")),
-             f"shots_file = {_toml_string(str(shots_file))}",
-             f"shots = [{', '.join(_toml_string(i) for i in calibration.shots)}]",
-             f"reference_shot = {_toml_string(reference.id)}",
+             f"shots_file = {toml_string(str(shots_file))}",
+             f"shots = [{', '.join(toml_string(i) for i in calibration.shots)}]",
+             *([f"skipped = [{', '.join(toml_string(i) for i, _ in calibration.skipped)}]"]
+               if calibration.skipped else []),
+             *([f"outliers = [{', '.join(toml_string(i) for i in calibration.outliers)}]"]
+               if calibration.outliers else []),
+             f"reference_shot = {toml_string(reference.id)}",
              *(f"{k} = {v!r}" for k, v in stats.items()), "", ""]
     target, projectile = shot_target(reference, m), shot_projectile(reference)
     return "\n".join(lines) + config_text(target, projectile)
-
-
-def _toml_string(text):
-    import json
-
-    return json.dumps(str(text))
 
 
 def read_calibration(path):
@@ -288,7 +350,13 @@ def parse_calibration(data, source=""):
     shots = table["shots"]
     require(isinstance(shots, list) and shots and all(isinstance(s, str) for s in shots),
             "calibration.shots", "a non-empty array of shot ids", shots)
+    skipped, outliers = table.get("skipped", []), table.get("outliers", [])
+    for name, ids in (("skipped", skipped), ("outliers", outliers)):
+        require(isinstance(ids, list) and all(isinstance(s, str) for s in ids),
+                f"calibration.{name}", "an array of shot ids", ids)
     statistics = tuple((k, table[k]) for k in ("n", "mean_abs_log_ratio", "rms_log_ratio",
                                                "evaluations") if k in table)
     return Calibration(table["model"], mapping, params, tuple(shots), source=source,
-                       statistics=statistics)
+                       statistics=statistics,
+                       skipped=tuple((s, "not predicted in the fit") for s in skipped),
+                       outliers=tuple(outliers))

@@ -17,9 +17,8 @@ projectile the shot's (:func:`~cavex.verification.validation.shots.shot_projecti
 cavex's models run the penetration integrator
 (:func:`cavex.analytic.penetration.integrator.penetrate`,
 crater of ``4.5 r`` from the nose base, as ``cavex penetrate``); the predicted depth is the nose
-tip's final depth. A projectile that the crater stage would stop (``m V0^2 <= L_c F(0)``, which
-the integrator refuses) reaches ``sqrt(m V0^2 L_c / F(0))``: the crater's ``K L`` force with
-``K L_c = F(0)``, continuous with the integrator's depth at the threshold.
+tip's final depth; a projectile that the crater stage stops (``m V0^2 <= L_c F(0)``) reaches
+``sqrt(m V0^2 L_c / F(0))`` (:func:`cavex.analytic.penetration.integrator.crater_stage`).
 
 A calibrated model (:mod:`cavex.verification.validation.calibration`) is one of cavex's models with
 the fitted mapping parameters, named ``"<model> calibrated"``.
@@ -33,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.penetration.integrator import crater_depth, penetrate
+from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.nose import nose_rule
 from cavex.analytic.penetration.resistance import MODEL_LABELS, make_resistance, parse_model_label
 from cavex.analytic.penetration.resistance import MODELS as CLOSED_FORMS
@@ -50,17 +49,21 @@ MODELS = (*CAVEX_MODELS, EMPIRICAL)
 DEPTH_DIGITS = FE_DIGITS  # predicted depths and statistics in the result files
 TABLE_VELOCITY_STEP = 50.0  # m/s between FE table velocities (interpolated by PCHIP in V^2)
 TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on depth
+# for run estimates only, measured on the development shots (one worker, x86_64, unloaded):
+# 95 FE tables of 25 velocities and 2 depths in ~90 s; a prediction 1.4-2.6 ms with a closed
+# form, 29 ms with an FE table (5000 shots: 12 min on a machine loaded ~2x)
+TABLE_CASES_PER_SECOND_PER_WORKER = 45.0
+PREDICTION_SECONDS = {"closed form": 2.5e-3, FE_MODEL: 3e-2}
+# a shot every model misses by more than this factor (either way) is flagged as an outlier:
+# 21 of the 286 development shots (C133: 1.2 mm measured at 86 m/s, every model ~25 mm), none
+# of Forrestal's 17
+OUTLIER_FACTOR = 3.0
 
 
 # --- one prediction ---------------------------------------------------------------------------
 
 def penetration_depth(target, projectile, resistance):
-    """Final nose-tip depth (m) of the integrator, or the crater-stage stop (module docstring)."""
-    crater = crater_depth(projectile)
-    energy = projectile.m * projectile.V0 ** 2
-    static = resistance.crater_force(0.0)
-    if energy <= crater * static:
-        return math.sqrt(energy * crater / static)
+    """Final nose-tip depth (m) of the integrator (also where the crater stops it)."""
     return float(penetrate(target, projectile, resistance).depth[-1])
 
 
@@ -133,6 +136,16 @@ class TableCache:
         """Set the velocity grid to cover ``shots`` (call before :meth:`table`)."""
         self._velocities = table_velocities(shots)
 
+    def plan(self, shots, mappings):
+        """``(to build, on disk)``: the distinct FE tables ``shots`` need under ``mappings``
+        (call :meth:`velocities_for` first)."""
+        keys = {self.key(shot_target(shot, m), shot_projectile(shot), self._velocities)
+                for m in mappings for shot in shots}
+        keys -= set(self._tables)
+        on_disk = {k for k in keys if self.directory is not None
+                   and (self.directory / f"table_{k}.nc").exists()}
+        return len(keys - on_disk), len(on_disk)
+
     def key(self, target, projectile, velocities):
         from cavex.config import fingerprint
         from cavex.verification.fedata.table import settings_json
@@ -180,6 +193,26 @@ class TableCache:
 
 # --- many shots -------------------------------------------------------------------------------
 
+def run_estimate(shots, models, tables, workers):
+    """One line: the size of a run of ``models`` (column -> ``(model, mapping)``) over
+    ``shots`` and its time, from :data:`TABLE_CASES_PER_SECOND_PER_WORKER` and
+    :data:`PREDICTION_SECONDS` (the empirical model costs nothing)."""
+    tables.velocities_for(shots)
+    table_mappings = [mapping or Mapping() for model, mapping in models.values()
+                      if model == FE_MODEL]
+    build, reused = tables.plan(shots, table_mappings) if table_mappings else (0, 0)
+    cases = build * len(tables._velocities) * len(TABLE_DEPTHS)
+    per_shot = sum(PREDICTION_SECONDS[FE_MODEL if model == FE_MODEL else "closed form"]
+                   for model, _ in models.values() if model != EMPIRICAL)
+    seconds = (cases / (TABLE_CASES_PER_SECOND_PER_WORKER * max(1, workers))
+               + len(shots) * per_shot)
+    when = ("under a minute" if seconds < 60.0 else f"about {seconds / 60.0:.0f} min"
+            if seconds < 3600.0 else f"about {seconds / 3600.0:.1f} h")
+    return (f"{len(shots)} shots x {len(models)} models = {len(shots) * len(models)} "
+            f"predictions; FE tables: {build} to build ({cases} FE cases), {reused} on disk; "
+            f"{when} on {workers} worker(s) of an unloaded machine")
+
+
 def predictions(shots, models, tables=None, progress=None):
     """``{model: [depth or None]}`` and ``{model: {shot id: reason}}`` for the failures.
 
@@ -206,8 +239,10 @@ def predictions(shots, models, tables=None, progress=None):
 
 def ratio_statistics(ratios):
     """``n``, mean and sample standard deviation of ``ratios`` and their mean ``|ln ratio|``
-    (None where undefined), rounded to :data:`DEPTH_DIGITS` significant digits."""
-    r = np.array([x for x in ratios if x is not None], dtype=float)
+    (None where undefined; a missing, non-finite or non-positive ratio is not counted), rounded
+    to :data:`DEPTH_DIGITS` significant digits."""
+    r = np.array([x for x in ratios if x is not None and math.isfinite(x) and x > 0.0],
+                 dtype=float)
     n = int(r.size)
 
     def rounded(value):
@@ -218,6 +253,16 @@ def ratio_statistics(ratios):
             "mean_ratio": rounded(r.mean()) if n else None,
             "std_ratio": rounded(r.std(ddof=1)) if n > 1 else None,
             "mean_abs_log_ratio": rounded(np.abs(np.log(r)).mean()) if n else None}
+
+
+def validation_columns(calibrations=(), mapping=None):
+    """Column name -> ``(model, mapping)``: every model of :data:`MODELS` under ``mapping``
+    (default :class:`Mapping`), then ``"<model> calibrated"`` per calibration."""
+    mapping = mapping or Mapping()
+    columns = {name: (name, mapping) for name in MODELS}
+    for calibration in calibrations:
+        columns[calibration.column] = (calibration.model, calibration.mapping)
+    return columns
 
 
 def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None):
@@ -238,12 +283,11 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         ``shots`` (``id``, ``V0_m_s``, ``fc_Pa``, ``rho_kg_m3``, ``measured_m``,
         ``predicted_m`` and ``ratio`` per model), ``summary`` (per model, all shots),
         ``held_out`` (ids in no calibration's fit) and ``held_out_summary`` (with
-        calibrations), ``failures``, ``models``, ``calibrations``.
+        calibrations), ``outliers`` and ``summary_without_outliers`` (:func:`flag_outliers`),
+        ``failures``, ``models``, ``calibrations``.
     """
     mapping = mapping or Mapping()
-    columns = {name: (name, mapping) for name in MODELS}
-    for calibration in calibrations:
-        columns[calibration.column] = (calibration.model, calibration.mapping)
+    columns = validation_columns(calibrations, mapping)
     tables = tables or TableCache()
     tables.velocities_for(shots)
     depths, failures = predictions(shots, columns, tables, progress)
@@ -263,6 +307,28 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         result["held_out"] = held_out
         result["held_out_summary"] = summaries(
             [row for row in rows if row["id"] in held_out], columns)
+    flag_outliers(result)
+    return result
+
+
+def is_outlier(ratios, factor=OUTLIER_FACTOR):
+    """Whether every model that gave a depth (at least one) is off by more than ``factor``:
+    ``|ln(predicted / measured)| > ln factor`` for every ratio that is not None."""
+    given = [r for r in ratios if r is not None]
+    return bool(given) and all(abs(math.log(r)) > math.log(factor) for r in given)
+
+
+def flag_outliers(result, factor=OUTLIER_FACTOR):
+    """Set ``result["outliers"]`` (``factor``, the flagged shot ids) and
+    ``result["summary_without_outliers"]`` (:func:`summaries` over the other shots) from its
+    ``shots`` and the columns of its ``summary``. The flagged shots stay in every other
+    statistic: they are flagged, not dropped."""
+    columns = list(result["summary"])
+    flagged = [row["id"] for row in result["shots"]
+               if is_outlier([row["ratio"][c] for c in columns], factor)]
+    result["outliers"] = {"factor": factor, "shots": flagged}
+    result["summary_without_outliers"] = summaries(
+        [row for row in result["shots"] if row["id"] not in flagged], columns)
     return result
 
 

@@ -22,28 +22,36 @@ from dataclasses import dataclass, field
 
 from cavex.errors import CavexInputError
 from cavex.input_files import in_file, read_text
-from cavex.materials import MAX_VELOCITY, Projectile
+from cavex.materials import MASS_RANGE, MAX_CRH, MAX_VELOCITY, RADIUS_RANGE, Projectile
 
 REQUIRED_COLUMNS = ("id", "mass_kg", "diameter_m", "crh", "V0_m_s", "fc_Pa", "rho_kg_m3",
                     "depth_m")
 OPTIONAL_COLUMNS = ("length_m",)
 COLUMNS = ("id", "mass_kg", "diameter_m", "length_m", "crh", "V0_m_s", "fc_Pa", "rho_kg_m3",
            "depth_m")
+MIN_SHOT_VELOCITY = 1.0  # m/s: a test fires the projectile
+MEASURED_DEPTH_RANGE = (1e-4, 1e3)  # m: a tenth of a millimetre to a kilometre
 # column -> (attribute, lower, upper, accepted range as said in a message)
 NUMBER_COLUMNS = {
-    "mass_kg": ("mass", 0.0, math.inf, "a finite number > 0"),
-    "diameter_m": ("diameter", 0.0, math.inf, "a finite number > 0"),
+    # mass, diameter, crh: the projectile's accepted range (cavex.materials.Projectile)
+    "mass_kg": ("mass", MASS_RANGE[0], MASS_RANGE[1],
+                f"a number in [{MASS_RANGE[0]:g}, {MASS_RANGE[1]:g}]"),
+    "diameter_m": ("diameter", 2.0 * RADIUS_RANGE[0], 2.0 * RADIUS_RANGE[1],
+                   f"a number in [{2.0 * RADIUS_RANGE[0]:g}, {2.0 * RADIUS_RANGE[1]:g}]"),
     "length_m": ("length", 0.0, math.inf, "empty or a finite number > 0"),
     # a tangent ogive needs R = crh d >= d/2 (crh 0.5 is a hemisphere)
-    "crh": ("crh", 0.5, math.inf, "a finite number >= 0.5 (ogive radius R = crh d >= d/2)"),
-    "V0_m_s": ("V0", 0.0, MAX_VELOCITY,
-               f"a finite number in (0, {MAX_VELOCITY:g}] (rigid-projectile penetration)"),
+    "crh": ("crh", 0.5, MAX_CRH,
+            f"a number in [0.5, {MAX_CRH:g}] (ogive radius R = crh d >= d/2)"),
+    "V0_m_s": ("V0", MIN_SHOT_VELOCITY, MAX_VELOCITY,
+               f"a number in [{MIN_SHOT_VELOCITY:g}, {MAX_VELOCITY:g}] (rigid-projectile "
+               "penetration)"),
     "fc_Pa": ("fc", 1e6, 1e9, "a compressive strength in Pa in [1e+06, 1e+09] (is it in MPa?)"),
     "rho_kg_m3": ("rho", 1000.0, 4000.0,
                   "a concrete density in kg/m^3 in [1000, 4000] (is it in g/cm^3?)"),
-    "depth_m": ("depth", 0.0, math.inf, "a finite number > 0"),
+    "depth_m": ("depth", *MEASURED_DEPTH_RANGE,
+                f"a number in [{MEASURED_DEPTH_RANGE[0]:g}, {MEASURED_DEPTH_RANGE[1]:g}] m"),
 }
-INCLUSIVE_LOWER = {"crh", "fc_Pa", "rho_kg_m3"}
+INCLUSIVE_LOWER = set(NUMBER_COLUMNS) - {"length_m"}
 
 
 @dataclass(frozen=True)
@@ -94,7 +102,12 @@ class ShotFile:
     columns: tuple
 
     def by_id(self, ids):
-        """The shots with ``ids``, in the order given; an unknown id is an input error."""
+        """The shots with ``ids``, in the order given; an unknown or repeated id is an input
+        error (a repeat would weigh a shot twice in a fit)."""
+        repeated = sorted({i for i in ids if list(ids).count(i) > 1})
+        if repeated:
+            raise CavexInputError(f"shot id(s) {', '.join(map(repr, repeated))} given more than "
+                                  "once", "ids")
         known = {s.id: s for s in self.shots}
         missing = [i for i in ids if i not in known]
         if missing:
