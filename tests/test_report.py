@@ -73,8 +73,8 @@ def test_report_numbers_equal_grid(quick_report):
             continue
         assert float(row[col["FE sigma_r (MPa)"]]) == pytest.approx(
             float(cell["sigma_r"]) / 1e6, abs=5e-5)
-        for key, name in (("dynamic", "derived dynamic error"),
-                          ("quasi_static", "derived quasi-static error"),
+        for key, name in (("dynamic", "derived-dynamic error"),
+                          ("quasi_static", "derived-quasi-static error"),
                           ("paper", "paper error")):
             printed = float(PERCENT.match(row[col[name]]).group(1))
             assert printed == pytest.approx(100 * float(cell[f"rel_err_{key}"]), abs=5e-4)
@@ -93,9 +93,9 @@ def test_quick_report_is_complete(quick_report):
     assert "not possible" not in md and "![trajectories](trajectories.png)" in section
     rows = [x for x in section.split("\n## ", 1)[0].splitlines() if x.startswith("| ")]
     names = [r.strip("|").split("|")[0].strip() for r in rows[1:5]]
-    assert names == ["derived quasi-static", "derived dynamic", "paper", "FE table"]
+    assert names == ["derived-quasi-static", "derived-dynamic", "paper", "table"]
     trajectories = json.loads(grid.attrs["trajectories"])
-    assert trajectories["FE table"]["final_depth_m"] > 1.3  # through all three layers
+    assert trajectories["table"]["final_depth_m"] > 1.3  # through all three layers
     target, projectile = load_config()
     assert grid.depth.values[0] <= 0.06 + 4.5 * projectile.r  # the crater's end (nose base)
     assert grid.velocity.values[-1] >= projectile.V0
@@ -133,7 +133,7 @@ def test_report_html_is_self_contained_and_leads_with_a_figure(quick_report):
     assert body.find("div").find("table") is not None
     # numbers do not wrap inside table cells
     assert "td.num{text-align:right;white-space:nowrap}" in html
-    assert '<td class="num">+' in html and '<td>derived dynamic</td>' in html
+    assert '<td class="num">+' in html and '<td>derived-dynamic</td>' in html
 
 
 def test_grid_nc_is_cf(quick_report):
@@ -166,7 +166,7 @@ def test_response_states_are_explained(quick_report):
 def test_accuracy_table_and_conclusion_from_grid(quick_report):
     out, summary, grid = quick_report
     md = (out / "report.md").read_text()
-    for key, label in (("dynamic", "derived dynamic"), ("paper", "paper (She 2020)")):
+    for key, label in (("dynamic", "derived-dynamic"), ("paper", "paper (She 2020)")):
         for index, name in enumerate(("concrete", "macadam", "soil")):
             mask = (grid["wall_layer"] == index).broadcast_like(grid["sigma_r"])
             rel = grid[f"rel_err_{key}"].where(mask).values
@@ -224,7 +224,7 @@ def test_conclusions_attribute_the_error_from_recomputed_parts(quick_report):
     velocities, depths = grid.velocity.values, grid.depth.values
     var = {"dynamic": "sigma_r_dynamic", "quasi_static": "sigma_r_quasi_static",
            "paper": "sigma_r_paper"}
-    labels = {"dynamic": "derived dynamic", "quasi_static": "derived quasi-static",
+    labels = {"dynamic": "derived-dynamic", "quasi_static": "derived-quasi-static",
               "paper": "paper (She 2020)"}
     checked = set()
     for key in PARTS:

@@ -290,8 +290,8 @@ def test_small_fe_table_builds_and_drives_the_integrator(fe_table, runway, tmp_p
     assert [p.label for p in trajectory.phases[1:4]] == ["concrete (table)"] * 2 + [
         "macadam (table)"]
     summary = compare_trajectories(target, projectile, load_table(path))
-    assert set(summary) == {"derived quasi-static", "derived dynamic", "paper", "FE table"}
-    fe, dynamic = summary["FE table"]["at_H1"], summary["derived dynamic"]["at_H1"]
+    assert set(summary) == {"derived-quasi-static", "derived-dynamic", "paper", "table"}
+    fe, dynamic = summary["table"]["at_H1"], summary["derived-dynamic"]["at_H1"]
     assert fe["velocity_m_s"] == pytest.approx(dynamic["velocity_m_s"], rel=0.1)
 
 

@@ -287,11 +287,11 @@ def comparison_runs(target, projectile, table, crater="nose-base"):
     if not hasattr(table, "attrs"):
         table = load_table(table)
     models = {
-        "derived quasi-static": ClosedFormResistance(target, projectile, "derived",
+        "derived-quasi-static": ClosedFormResistance(target, projectile, "derived",
                                                      "quasi-static"),
-        "derived dynamic": ClosedFormResistance(target, projectile, "derived", "dynamic"),
+        "derived-dynamic": ClosedFormResistance(target, projectile, "derived", "dynamic"),
         "paper": ClosedFormResistance(target, projectile, "paper"),
-        "FE table": TabulatedResistance(table, target, projectile),
+        "table": TabulatedResistance(table, target, projectile),
     }
     return {name: penetrate(target, projectile, r, crater=crater) for name, r in models.items()}
 

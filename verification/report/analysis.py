@@ -27,8 +27,8 @@ from cavex.verification.output.cf_metadata import decode_flags, flag_attrs
 from cavex.verification.output.number_format import round_dataset
 
 # (key, label, sigma_r variable) of each closed form, in report order.
-MODELS = (("dynamic", "derived dynamic", "sigma_r_dynamic"),
-          ("quasi_static", "derived quasi-static", "sigma_r_quasi_static"),
+MODELS = (("dynamic", "derived-dynamic", "sigma_r_dynamic"),
+          ("quasi_static", "derived-quasi-static", "sigma_r_quasi_static"),
           ("paper", "paper (She 2020)", "sigma_r_paper"))
 TOLERANCES = (0.01, 0.05)
 # validity codes: within 1 %, within 5 %, beyond 5 %, FE cell failed

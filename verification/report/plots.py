@@ -43,8 +43,8 @@ BREAK_FRACTION = 0.5
 # Okabe-Ito (colour-blind-safe) for the response states, grey instead of black
 STATE_COLOURS = ("#0072B2", "#E69F00", "#009E73", "#F0E442", "#56B4E9", "#D55E00", "#CC79A7",
                  "#999999")
-MODEL_STYLES = {"derived quasi-static": ("C0", "--"), "derived dynamic": ("C1", "-"),
-                "paper": ("C2", ":"), "FE table": ("k", "-")}
+MODEL_STYLES = {"derived-quasi-static": ("C0", "--"), "derived-dynamic": ("C1", "-"),
+                "paper": ("C2", ":"), "table": ("k", "-")}
 
 
 def _pct(fraction):
@@ -388,9 +388,9 @@ def plastic_radius_plot(grid, target, out, velocities):
         ax.plot(row.depth.values[ok], 1e3 * row["plastic_radius"].values[ok], "o", color=colour,
                 ms=4, label=f"FE, V = {V:g} m/s")
         ax.plot(row.depth.values, 1e3 * row["b_dynamic"].values, "-", color=colour, lw=1,
-                label="derived dynamic" if i == 0 else None)
+                label="derived-dynamic" if i == 0 else None)
         ax.plot(row.depth.values, 1e3 * row["b_quasi_static"].values, "--", color=colour, lw=1,
-                label="derived quasi-static" if i == 0 else None)
+                label="derived-quasi-static" if i == 0 else None)
     _depth_limit(ax, grid, target)
     _interfaces_v(ax, target)
     ax.set(xlabel="nose-tip depth L (m)", ylabel="plastic radius b (mm)")
@@ -405,7 +405,7 @@ def trajectory_plot(runs, target, out):
     fig, ax = plt.subplots(figsize=(7, 4.6))
     for name, run in runs.items():
         colour, style = MODEL_STYLES.get(name, (None, "-"))
-        lw = 2.2 if name == "FE table" else 1.3
+        lw = 2.2 if name == "table" else 1.3
         ax.plot(run.depth, run.velocity, style, color=colour, lw=lw,
                 label=f"{name} (stops at {run.depth[-1]:.2f} m)")
         ax.plot(run.depth[-1], 0.0, "o", color=colour, ms=5)

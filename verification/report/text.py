@@ -187,7 +187,7 @@ def _mm(value):
 
 
 CELL_HEADER = ["V (m/s)", "L (m)", "wall layer", "FE sigma_r (MPa)", "FE error estimate",
-               "derived dynamic error", "derived quasi-static error", "paper error",
+               "derived-dynamic error", "derived-quasi-static error", "paper error",
                "state (dynamic)", "state (quasi-static)", "FE b (mm)", "dynamic b (mm)",
                "quasi-static b (mm)", "flags"]
 
@@ -197,11 +197,11 @@ def trajectory_section(trajectories):
     if isinstance(trajectories, str):
         return trajectories
     rows = []
-    fe = trajectories.get("FE table")
+    fe = trajectories.get("table")
     for name, t in trajectories.items():
         h1 = t["at_H1"]
         v1 = "stops before" if h1 is None else f"{h1['velocity_m_s']:.2f}"
-        dv = ("n/a" if h1 is None or fe is None or fe["at_H1"] is None or name == "FE table"
+        dv = ("n/a" if h1 is None or fe is None or fe["at_H1"] is None or name == "table"
               else f"{h1['velocity_m_s'] - fe['at_H1']['velocity_m_s']:+.2f}")
         rows.append([name, f"{t['phases'][0]['end_velocity_m_s']:.2f}", v1, dv,
                      "n/a" if h1 is None else f"{1e3 * h1['time_s']:.4f}",
