@@ -451,3 +451,14 @@ def test_committed_validation_report_is_consistent():
             empirical.shot_depth(shot), rel=DIGITS_6)
     sentence = verdict(result["held_out_summary"], result["calibrations"])
     assert sentence in (folder / "report.md").read_text()
+
+
+def test_a_shot_id_of_any_characters_is_one_markdown_table_cell():
+    """report.md's tables stay tables for ids with '|', line breaks, tabs or emoji."""
+    from cavex.verification.commands.validate import table_cell
+
+    for shot_id, cell in (("A|1", "A\\|1"), ("two\nlines", "two lines"), ("t\tab", "t ab"),
+                          ("\U0001F3AF", "\U0001F3AF"), ("\x07bell", " bell")):
+        assert table_cell(shot_id) == cell
+        row = f"| {table_cell(shot_id)} | 1 |"
+        assert row.replace("\\|", "").count("|") == 3 and "\n" not in row

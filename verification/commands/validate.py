@@ -280,7 +280,7 @@ def report_markdown(result, figures=True):
     for row in shots:
         cells = [f"{row['predicted_m'][m] * 1e3:.1f} ({row['ratio'][m]:.3f})"
                  if row["predicted_m"][m] is not None else "failed" for m in models]
-        lines.append(f"| {row['id']} | {row['V0_m_s']:g} | {row['fc_Pa'] / 1e6:g} | "
+        lines.append(f"| {table_cell(row['id'])} | {row['V0_m_s']:g} | {row['fc_Pa'] / 1e6:g} | "
                      f"{row['measured_m'] * 1e3:g} | " + " | ".join(cells) + " |")
     lines += ["", "![predicted against measured (small multiples: the uncalibrated models and "
               "the empirical formula, then each calibrated model with its fitted shots filled "
@@ -293,6 +293,13 @@ def report_markdown(result, figures=True):
             lines += [f"- {model}, shot {i}: {reason}" for i, reason in items.items()]
         lines.append("")
     return "\n".join(lines)
+
+
+def table_cell(text):
+    """``text`` as one markdown table cell: ``|`` escaped, line breaks and other control
+    characters as spaces (a shot id may hold any character)."""
+    return "".join(" " if ch.isspace() or not ch.isprintable() else ch
+                   for ch in str(text)).replace("|", "\\|")
 
 
 def _outlier_section(result):
@@ -309,7 +316,7 @@ def _outlier_section(result):
               "|---|---:|---:|---|"]
     for shot in flagged:
         ratios = [r for r in rows[shot]["ratio"].values() if r is not None]
-        lines.append(f"| {shot} | {rows[shot]['V0_m_s']:g} | "
+        lines.append(f"| {table_cell(shot)} | {rows[shot]['V0_m_s']:g} | "
                      f"{rows[shot]['measured_m'] * 1e3:g} | {min(ratios):.3g} to "
                      f"{max(ratios):.3g} |")
     lines += ["", "Without them:", ""] + _summary_table(result["summary_without_outliers"])
