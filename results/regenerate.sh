@@ -25,5 +25,8 @@ cavex validate --shots examples/shots_forrestal1994.csv --calibration \
   --out results/validation --no-progress > /dev/null
 cavex verify --no-progress > /dev/null
 python -m cavex.verification.studies.oblique_study --no-progress > /dev/null
+shot=$(mktemp -d)  # the command's own figures of the paper's 20 deg, 600 m/s shot (PNGs only)
+cavex trajectory --obliquity 20 --velocity 600 --compare-homogeneous --out "$shot" > /dev/null
+cp "$shot"/*.png results/oblique/shot_20deg_600/ && rm -r "$shot"
 python -m cavex.verification.studies.concrete_validation --workers 2 > /dev/null
 git status --short results

@@ -10,6 +10,7 @@ interfaces marked, a 3-D view of the path in the layered block (pyvista, off-scr
 import json
 import math
 import sys
+import textwrap
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -280,7 +281,7 @@ def side_view(job, path):
         zs += [h["cg_z_m"], *(o[1] for o in outlines)]
     (x0, x1), (z0, z1) = side_limits(np.concatenate(xs), np.concatenate(zs), target)
     height = min(max(SIDE_WIDTH_IN * (z1 - z0) / (x1 - x0), 2.2), 8.0)
-    fig, ax = plt.subplots(figsize=(SIDE_WIDTH_IN, height + 1.0))
+    fig, ax = plt.subplots(figsize=(SIDE_WIDTH_IN, height + 1.0), layout="constrained")
     for name, color, h, outlines in curves:
         ax.plot(h["cg_x_m"], h["cg_z_m"], color=color, lw=1, label=f"{name}: centre of mass")
         for k, (ox, oz) in enumerate(outlines):
@@ -296,15 +297,16 @@ def side_view(job, path):
     _layer_names(ax, target)
     ax.set_xlabel("x (m, horizontal, plane of obliquity)")
     ax.set_ylabel("z (m, depth)")
-    ax.set_title(_title(job), fontsize=9, pad=24)
-    ax.legend(fontsize=8, loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=2,
-              frameon=False)  # between the title and the axes: off the data
+    # the title (wrapped to the narrow figure) above the axes, the legend below: off the data
+    fig.suptitle(textwrap.fill(_title(job), 64), fontsize=9)
+    fig.legend(*ax.get_legend_handles_labels(), fontsize=8, loc="outside lower center",
+               ncol=2 if len(job["runs"]) > 1 else 1, frameon=False)
     return save_figure(fig, path, dpi=120, bbox_inches="tight")
 
 
 def _title(job):
     s = job["settings"]
-    law = s["resistance"] + (f" {s['boundary']}" if s["resistance"] == "derived" else "")
+    law = s["resistance"] + (f"-{s['boundary']}" if s["resistance"] == "derived" else "")
     return (f"V0 = {s['speed_m_s']:g} m/s, obliquity {s['obliquity_deg']:g} deg, attack "
             f"{s['attack_deg']:g} deg; resistance {law}, contact ramp "
             f"{s['contact_ramp_m_s']:g} m/s")
