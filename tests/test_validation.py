@@ -377,7 +377,7 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
         final, rel=DIGITS_6)
     # the JSON of the issue, and the statistics recomputed from it
     assert set(result["summary"]) == {"derived-quasi-static", "derived-dynamic", "paper",
-                                      "table", "forrestal-1994",
+                                      "table", "concrete", "forrestal-1994",
                                       "derived-quasi-static calibrated"}
     for model, stats in result["summary"].items():
         ratios = [row["predicted_m"][model] / row["measured_m"] for row in result["shots"]]
@@ -406,6 +406,52 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
                          "--out", str(out_dir))
     assert code == 0 and "FE tables built 0, reused 2" in out
     assert (out_dir / "validation.json").read_text() == first
+
+
+def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
+    """``--models concrete forrestal-1994``: those two columns and nothing else, in JSON, CSV and
+    report; the concrete model's depths are :func:`concrete_model.model_depth`'s; the
+    recommended model and its sentence are there."""
+    from cavex.verification.commands.validate import recommendation
+    from cavex.verification.validation import concrete_model
+
+    out_dir = tmp_path / "val"
+    code, out, err = run(capsys, "validate", "--shots", SHOTS, "--models", "concrete",
+                         "forrestal-1994", "--json", "--out", str(out_dir))
+    assert code == 0 and err.startswith("cavex: validate 17 shots x 2 models = 34 predictions")
+    result = json.loads(out)
+    assert result["models"] == ["concrete", "forrestal-1994"]
+    assert result["recommended_model"] == "concrete"
+    assert json.loads((out_dir / "validation.json").read_text()) == result
+    assert set(result["summary"]) == {"concrete", "forrestal-1994"}
+    assert result["failures"] == {}
+    shots = read_shots(SHOTS).shots
+    for row, shot in zip(result["shots"], shots, strict=True):
+        assert set(row["predicted_m"]) == {"concrete", "forrestal-1994"}
+        assert row["predicted_m"]["concrete"] == pytest.approx(
+            concrete_model.model_depth(shot), rel=DIGITS_6)
+        assert row["predicted_m"]["forrestal-1994"] == pytest.approx(
+            empirical.shot_depth(shot), rel=DIGITS_6)
+    header = (out_dir / "predictions.csv").read_text().splitlines()[0].split(",")
+    assert header[5:] == ["concrete_m", "forrestal_1994_m", "concrete_ratio",
+                          "forrestal_1994_ratio"]
+    report = (out_dir / "report.md").read_text()
+    sentence = recommendation("concrete", result["summary"])
+    assert sentence.startswith("Recommended model: `concrete`") and sentence in report
+    assert "--models concrete forrestal-1994" in report
+    assert "| derived-dynamic |" not in report and "| table |" not in report
+
+
+def test_validate_refuses_an_unknown_model_in_one_line(capsys, tmp_path):
+    out_dir = tmp_path / "val"
+    code, out, err = run(capsys, "validate", "--shots", SHOTS, "--models", "concrete", "li-chen",
+                         "--out", str(out_dir))
+    assert (code, out) == (2, "") and err.count("\n") == 1
+    assert "'models'" in err and "'li-chen'" in err
+    for label in ("derived-quasi-static", "derived-dynamic", "paper", "table", "concrete",
+                  "forrestal-1994"):
+        assert f"'{label}'" in err
+    assert not out_dir.exists()
 
 
 def read_shots_text_lines(ids):

@@ -9,6 +9,7 @@ import re
 import sys
 
 from cavex import __version__
+from cavex.analytic.penetration.labels import VALIDATION_LABELS
 from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
 from cavex.verification.commands.options import add_interface_option, add_resistance_options
@@ -120,6 +121,9 @@ def build_parser():
     validate.add_argument("--calibration", nargs="+", action="extend",
                           help="calibration TOML file(s) from `cavex calibrate` (default: "
                           "none, the uncalibrated models only)")
+    validate.add_argument("--models", nargs="+", action="extend", metavar="NAME",
+                          help="run only these models: " + ", ".join(VALIDATION_LABELS)
+                          + " (default: all; calibrations add their columns)")
     validate.add_argument("--json", action="store_true", help="print JSON")
     validate.add_argument("--out", help="output folder (default results/validation)")
     _figures(validate, "validation.json, predictions.csv and report.md")

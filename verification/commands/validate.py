@@ -25,6 +25,7 @@ from cavex.verification.fedata.runner import check_execution
 from cavex.verification.output.files import save_figure, write_text_atomic
 from cavex.verification.output.paths import check_output_dir, write_staged
 from cavex.verification.validation.predict import (
+    CONCRETE,
     EMPIRICAL,
     FE_MODEL,
     MODELS,
@@ -48,6 +49,7 @@ def run(args, target, projectile):
 
     shots_path, calibration_paths = args.shots, args.calibration
     workers, scheduler = args.workers, args.scheduler
+    models = check_models(args.models)
     shot_file = read_shots(shots_path)
     calibrations = [read_calibration(p) for p in calibration_paths or ()]
     columns = [c.column for c in calibrations]
@@ -57,41 +59,50 @@ def run(args, target, projectile):
                               "give one per model")
     out = check_output_dir(DEFAULT_OUT if args.out is None else args.out, "out")
     check_execution(workers, scheduler)
-    print(f"cavex: validate {estimate(shot_file.shots, calibrations, out / 'tables', workers)}",
-          file=sys.stderr, flush=True)
+    size = estimate(shot_file.shots, calibrations, out / "tables", workers, models)
+    print(f"cavex: validate {size}", file=sys.stderr, flush=True)
     began = time.monotonic()
     result = job(shot_file, calibrations, tables_dir=out / "tables", workers=workers,
-                 scheduler=scheduler, progress=args.progress)
+                 scheduler=scheduler, progress=args.progress, models=models)
     seconds = time.monotonic() - began
-    result["command"] = command_line(shots_path, calibration_paths, out)
+    result["command"] = command_line(shots_path, calibration_paths, out, args.models)
     written = write_staged(out, lambda stage: write_outputs(result, stage, draw=args.figures))
     if args.json:
         return json.dumps(summary(result), indent=2)
     return text(result, seconds, written)
 
 
-def columns_of(calibrations):
-    """Every column :func:`job` fills: the models, the calibrated ones and, with a
-    derived-dynamic calibration, :data:`COMPRESSIBILITY_COLUMN`."""
+def check_models(models):
+    """The ``--models`` labels (None: all), checked
+    (:func:`cavex.verification.validation.predict.check_models`)."""
+    from cavex.verification.validation.predict import check_models as check
+
+    return check(models)
+
+
+def columns_of(calibrations, models=None):
+    """Every column :func:`job` fills: the models (default all), the calibrated ones and, with
+    a derived-dynamic calibration, :data:`COMPRESSIBILITY_COLUMN`."""
     from cavex.verification.validation.predict import validation_columns
 
-    columns = validation_columns(calibrations)
+    columns = validation_columns(calibrations, models=models)
     dynamic = [c for c in calibrations if c.model == "derived-dynamic"]
     if dynamic:
         columns[COMPRESSIBILITY_COLUMN] = (FE_MODEL, dynamic[0].mapping)
     return columns
 
 
-def estimate(shots, calibrations, tables_dir, workers):
+def estimate(shots, calibrations, tables_dir, workers, models=None):
     """The run's size and time (:func:`cavex.verification.validation.predict.run_estimate`)."""
     from cavex.verification.validation.predict import run_estimate
 
     workers = workers or os.cpu_count() or 1
-    return run_estimate(shots, columns_of(calibrations), TableCache(tables_dir), workers)
+    return run_estimate(shots, columns_of(calibrations, models), TableCache(tables_dir),
+                        workers)
 
 
 def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=None,
-        progress=None):
+        progress=None, models=None):
     """:func:`cavex.verification.validation.predict.validate` plus the compressibility column and
     the shots file's description."""
     from cavex.verification.fedata.runner import show_progress
@@ -99,7 +110,7 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
     tables = TableCache(tables_dir, workers=workers, scheduler=scheduler,
                         progress=show_progress(progress))
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
-                      progress=progress)
+                      progress=progress, models=models)
     if any(c.model == "derived-dynamic" for c in calibrations):
         columns = {COMPRESSIBILITY_COLUMN: columns_of(calibrations)[COMPRESSIBILITY_COLUMN]}
         depths, failures = predictions(shot_file.shots, columns, tables, progress)
@@ -192,6 +203,23 @@ def verdict(summary, calibrations):
             f"{EMPIRICAL}'s {empirical:.4f}")
 
 
+def recommendation(model, summary):
+    """One sentence: why ``model`` (the recommended one) is recommended and how it does on
+    ``summary``'s shots against :data:`EMPIRICAL` (None when it was not run)."""
+    ours = summary.get(model, {}).get("mean_abs_log_ratio")
+    if ours is None:
+        return None
+    sentence = (f"Recommended model: `{model}`, because it is the uncalibrated model with no "
+                f"constant fitted to the shots; on these {summary[model]['n']} shots its mean "
+                f"abs ln ratio is {ours:.4f}")
+    empirical = summary.get(EMPIRICAL, {}).get("mean_abs_log_ratio")
+    if empirical is not None:
+        relation = "no larger than" if ours <= empirical else "LARGER than"
+        sentence += (f", {relation} {EMPIRICAL}'s {empirical:.4f} (a formula fitted by its "
+                     "authors to their own shots)")
+    return sentence + "."
+
+
 def _summary_table(summary):
     lines = ["| model | n | mean ratio | std ratio | mean abs ln ratio |",
              "|---|---:|---:|---:|---:|"]
@@ -232,6 +260,10 @@ def report_markdown(result, figures=True):
               "closed forms with the penetration integrator (crater 4.5 r from the nose base);",
               f"- `{FE_MODEL}`: the FE-tabulated resistance, compressible (nu = "
               f"{mapping['nu']:g}) and finite-strain, one FE table per distinct target;",
+              f"- `{CONCRETE}`: the concrete cavity-expansion model (docs/concrete.md): "
+              "Mohr-Coulomb capped at 7 f_c, radial cracking, compaction to lock-up, every "
+              "constant published (none fitted to shots), its own crater (Li and Chen 2003); "
+              "it does not use the mapping below;",
               f"- `{EMPIRICAL}`: S = 82.6 f_c^-0.544 (f_c in MPa), crater of two calibres "
               "(Forrestal et al. 1994). Forrestal et al. fitted S to their own shots, so on "
               "their data it is not an out-of-sample prediction;",
@@ -260,6 +292,9 @@ def report_markdown(result, figures=True):
             lines += [f"On the held-out shots the {sentence}.", ""]
     lines += ["## How each model does on all shots", ""]
     lines += _summary_table(result["summary"]) + [""]
+    sentence = recommendation(result["recommended_model"], result["summary"])
+    if sentence:
+        lines += [sentence, ""]
     lines += ["Ratio = predicted / measured depth; std is the sample standard deviation; "
               "mean abs ln ratio is the mean of |ln(predicted/measured)|.", ""]
     lines += _outlier_section(result)
@@ -394,9 +429,9 @@ def fitted_ids(result, model):
     return set()
 
 
-MARKERS = dict(zip(MODELS, ["o", "s", "^", "D", "*"], strict=True))
-COLOURS = dict(zip(MODELS, ["tab:blue", "tab:orange", "tab:green", "tab:red", "black"],
-                   strict=True))
+MARKERS = dict(zip(MODELS, ["o", "s", "^", "D", "v", "*"], strict=True))
+COLOURS = dict(zip(MODELS, ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple",
+                            "black"], strict=True))
 
 
 def _draw_model(ax, result, model, measured, velocity):
@@ -479,9 +514,11 @@ def text(result, seconds, written):
     return "\n".join(lines)
 
 
-def command_line(shots_path, calibration_paths, out_dir):
+def command_line(shots_path, calibration_paths, out_dir, models=None):
     """The ``cavex validate`` command that makes these outputs (the report's provenance)."""
     words = ["cavex", "validate", "--shots", str(shots_path)]
+    if models:
+        words += ["--models", *models]
     if calibration_paths:
         words += ["--calibration", *map(str, calibration_paths)]
     return " ".join(shlex.quote(w) for w in [*words, "--out", str(out_dir)])

@@ -12,6 +12,10 @@ projectile the shot's (:func:`~cavex.verification.validation.shots.shot_projecti
   (:class:`cavex.analytic.penetration.tabulated.TabulatedResistance`) of a table built by
   :func:`cavex.verification.fedata.table.build_table` for the shot's target with the mapping's
   Poisson's ratio (0.2): compressible, finite strain, which no closed form gives;
+- ``concrete``: the concrete cavity-expansion model
+  (:mod:`cavex.verification.validation.concrete_model`, published constants, none fitted to the
+  shots; its own crater and material, not the mapping), the recommended model
+  (:data:`RECOMMENDED_MODEL`);
 - ``forrestal-1994``: the empirical model (:mod:`cavex.verification.validation.empirical`).
 
 cavex's models run the penetration integrator
@@ -33,19 +37,24 @@ from pathlib import Path
 import numpy as np
 
 from cavex.analytic.penetration.integrator import penetrate
+from cavex.analytic.penetration.labels import CONCRETE_LABEL, EMPIRICAL_LABEL, VALIDATION_LABELS
 from cavex.analytic.penetration.nose import nose_rule
 from cavex.analytic.penetration.resistance import MODEL_LABELS, make_resistance, parse_model_label
 from cavex.analytic.penetration.resistance import MODELS as CLOSED_FORMS
 from cavex.errors import CavexInputError, CavexNumericalError, require_choice
 from cavex.verification.output.number_format import FE_DIGITS, round_dataset, round_significant
-from cavex.verification.validation import empirical
+from cavex.verification.validation import concrete_model, empirical
 from cavex.verification.validation.concrete import Mapping, shot_target
 from cavex.verification.validation.shots import shot_projectile
 
 FE_MODEL = "table"
-EMPIRICAL = "forrestal-1994"
+EMPIRICAL = EMPIRICAL_LABEL
+CONCRETE = CONCRETE_LABEL
 CAVEX_MODELS = MODEL_LABELS  # the closed forms and the FE table: what a calibration can fit
-MODELS = (*CAVEX_MODELS, EMPIRICAL)
+MODELS = VALIDATION_LABELS  # the cavex models, the concrete model, the empirical formula
+#: The model ``cavex validate`` recommends: the uncalibrated one with no constant fitted to any
+#: shot (docs/concrete.md)
+RECOMMENDED_MODEL = CONCRETE
 DEPTH_DIGITS = FE_DIGITS  # predicted depths and statistics in the result files
 TABLE_VELOCITY_STEP = 50.0  # m/s between FE table velocities (interpolated by PCHIP in V^2)
 TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on depth
@@ -53,7 +62,9 @@ TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on dep
 # 95 FE tables of 25 velocities and 2 depths in ~90 s; a prediction 1.4-2.6 ms with a closed
 # form, 29 ms with an FE table (5000 shots: 12 min on a machine loaded ~2x)
 TABLE_CASES_PER_SECOND_PER_WORKER = 45.0
-PREDICTION_SECONDS = {"closed form": 2.5e-3, FE_MODEL: 3e-2}
+PREDICTION_SECONDS = {"closed form": 2.5e-3, FE_MODEL: 3e-2,
+                      # docs/concrete.md: 286 development shots (96 cavity tables) in ~17 s
+                      CONCRETE: 6e-2}
 # a shot every model misses by more than this factor (either way) is flagged as an outlier:
 # 21 of the 286 development shots (C133: 1.2 mm measured at 86 m/s, every model ~25 mm), none
 # of Forrestal's 17
@@ -90,6 +101,8 @@ def predict(shot, model, mapping=None, tables=None):
     """
     if model == EMPIRICAL:
         return empirical.shot_depth(shot)
+    if model == CONCRETE:
+        return concrete_model.model_depth(shot)
     resistance, boundary = parse_model_label(model)
     if resistance == "table":
         tables = tables or TableCache()
@@ -202,7 +215,7 @@ def run_estimate(shots, models, tables, workers):
                       if model == FE_MODEL]
     build, reused = tables.plan(shots, table_mappings) if table_mappings else (0, 0)
     cases = build * len(tables._velocities) * len(TABLE_DEPTHS)
-    per_shot = sum(PREDICTION_SECONDS[FE_MODEL if model == FE_MODEL else "closed form"]
+    per_shot = sum(PREDICTION_SECONDS.get(model, PREDICTION_SECONDS["closed form"])
                    for model, _ in models.values() if model != EMPIRICAL)
     seconds = (cases / (TABLE_CASES_PER_SECOND_PER_WORKER * max(1, workers))
                + len(shots) * per_shot)
@@ -255,17 +268,28 @@ def ratio_statistics(ratios):
             "mean_abs_log_ratio": rounded(np.abs(np.log(r)).mean()) if n else None}
 
 
-def validation_columns(calibrations=(), mapping=None):
-    """Column name -> ``(model, mapping)``: every model of :data:`MODELS` under ``mapping``
-    (default :class:`Mapping`), then ``"<model> calibrated"`` per calibration."""
+def check_models(models):
+    """``models`` (None: all of :data:`MODELS`) as a tuple of distinct labels in the order of
+    :data:`MODELS`; an unknown one is refused naming the accepted labels."""
+    if models is None:
+        return MODELS
+    for name in models:
+        require_choice(name, MODELS, "models")
+    return tuple(m for m in MODELS if m in models)
+
+
+def validation_columns(calibrations=(), mapping=None, models=None):
+    """Column name -> ``(model, mapping)``: every model of ``models`` (default :data:`MODELS`,
+    :func:`check_models`) under ``mapping`` (default :class:`Mapping`), then
+    ``"<model> calibrated"`` per calibration."""
     mapping = mapping or Mapping()
-    columns = {name: (name, mapping) for name in MODELS}
+    columns = {name: (name, mapping) for name in check_models(models)}
     for calibration in calibrations:
         columns[calibration.column] = (calibration.model, calibration.mapping)
     return columns
 
 
-def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None):
+def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None, models=None):
     """Per-shot predictions of every model and their statistics.
 
     Parameters
@@ -276,6 +300,8 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     tables : TableCache, optional
     mapping : Mapping, optional
         The uncalibrated mapping (default :class:`~cavex.verification.validation.concrete.Mapping`).
+    models : sequence of str, optional
+        The uncalibrated models to run (labels of :data:`MODELS`; default all).
 
     Returns
     -------
@@ -284,10 +310,10 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         ``predicted_m`` and ``ratio`` per model), ``summary`` (per model, all shots),
         ``held_out`` (ids in no calibration's fit) and ``held_out_summary`` (with
         calibrations), ``outliers`` and ``summary_without_outliers`` (:func:`flag_outliers`),
-        ``failures``, ``models``, ``calibrations``.
+        ``failures``, ``models``, ``calibrations``, ``recommended_model``.
     """
     mapping = mapping or Mapping()
-    columns = validation_columns(calibrations, mapping)
+    columns = validation_columns(calibrations, mapping, models)
     tables = tables or TableCache()
     tables.velocities_for(shots)
     depths, failures = predictions(shots, columns, tables, progress)
@@ -300,7 +326,8 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
                      "ratio": ratio})
     fitted = {i for c in calibrations for i in c.shots}
     held_out = [row["id"] for row in rows if row["id"] not in fitted]
-    result = {"models": list(columns), "mapping": mapping.as_dict(),
+    result = {"models": list(columns), "recommended_model": RECOMMENDED_MODEL,
+              "mapping": mapping.as_dict(),
               "calibrations": [c.describe() for c in calibrations], "shots": rows,
               "summary": summaries(rows, columns), "failures": failures}
     if calibrations:
