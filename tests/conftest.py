@@ -3,9 +3,35 @@
 The numbers here are typed in from the paper's Table 1 (She 2020; docs/problem.md section 3),
 not read from ``core/data/runway.toml``, so that the embedded default can be checked against
 them.
+
+Every test runs with its own FE-table cache (``CAVEX_CACHE_DIR`` in its temporary folder, also
+for the commands it starts), so the suite never reads or writes the user's cache; a session-wide
+temporary cache covers the fixtures of wider scope.
 """
 
+import os
+import shutil
+import tempfile
+
 import pytest
+
+from cavex.verification.fedata.table_cache import CACHE_ENV
+
+_SESSION_CACHE = tempfile.mkdtemp(prefix="cavex-test-cache-")
+os.environ[CACHE_ENV] = _SESSION_CACHE
+
+
+def pytest_unconfigure(config):
+    """Remove the session-wide table cache."""
+    shutil.rmtree(_SESSION_CACHE, ignore_errors=True)
+
+
+@pytest.fixture(autouse=True)
+def table_cache_dir(tmp_path, monkeypatch):
+    """This test's FE-table cache folder (``$CAVEX_CACHE_DIR``)."""
+    folder = tmp_path / "cavex-table-cache"
+    monkeypatch.setenv(CACHE_ENV, str(folder))
+    return folder
 
 TABLE1_PROJECTILE = {"r": 0.0125, "l": 0.06, "R": 0.075, "m": 0.505, "V0": 1000.0}
 

@@ -3,11 +3,12 @@ markdown report and two figures.
 
 Files (in ``--out``, default ``results/validation``): ``validation.json`` (what ``--json``
 prints), ``predictions.csv``, ``report.md``, ``predicted_vs_measured.png``,
-``ratio_vs_velocity.png`` and ``tables/`` (the FE tables, one per distinct target, reused by a
-later run with the same folder). Depths and statistics carry 6 significant digits
-(``validation.DEPTH_DIGITS``); the statistics are computed from the written depths, so every
-printed number is a function of the stored ones, and no wall time is written, so a rerun gives
-the same files.
+``ratio_vs_velocity.png`` and ``tables/`` (a copy of the FE tables the run used, one per
+distinct target; they are built once into the shared cache,
+:mod:`cavex.verification.fedata.table_cache`, and reused by every later run into any folder).
+Depths and statistics carry 6 significant digits (``validation.DEPTH_DIGITS``); the statistics
+are computed from the written depths, so every printed number is a function of the stored ones,
+and no wall time is written, so a rerun gives the same files.
 """
 
 import csv

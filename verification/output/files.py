@@ -1,5 +1,5 @@
 """Files every command writes: atomically (a temporary file, then ``os.replace``), so that a
-killed run never leaves a partial file: text, CSV columns of numbers, matplotlib figures."""
+killed run never leaves a partial file: text, CSV columns of numbers, matplotlib figures, copies."""
 
 import csv
 import io
@@ -46,4 +46,20 @@ def save_figure(fig, path, **savefig):
         if os.path.exists(tmp):
             os.remove(tmp)
         plt.close(fig)
+    return path
+
+
+def copy_atomic(source, path):
+    """Copy the file ``source`` to ``path`` (a temporary file of this process, then
+    ``os.replace``); returns ``path``."""
+    import shutil
+
+    os.makedirs(os.path.dirname(os.fspath(path)) or ".", exist_ok=True)
+    tmp = os.fspath(path) + f".{os.getpid()}.tmp"
+    try:
+        shutil.copyfile(source, tmp)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
     return path

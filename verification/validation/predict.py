@@ -28,8 +28,6 @@ A calibrated model (:mod:`cavex.verification.validation.calibration`) is one of 
 the fitted mapping parameters, named ``"<model> calibrated"``.
 """
 
-import hashlib
-import json
 import math
 import sys
 from pathlib import Path
@@ -42,7 +40,7 @@ from cavex.analytic.penetration.nose import nose_rule
 from cavex.analytic.penetration.resistance import MODEL_LABELS, make_resistance, parse_model_label
 from cavex.analytic.penetration.resistance import MODELS as CLOSED_FORMS
 from cavex.errors import CavexInputError, CavexNumericalError, require_choice
-from cavex.verification.output.number_format import FE_DIGITS, round_dataset, round_significant
+from cavex.verification.output.number_format import FE_DIGITS, round_significant
 from cavex.verification.validation import concrete_model, empirical
 from cavex.verification.validation.concrete import Mapping, shot_target
 from cavex.verification.validation.shots import shot_projectile
@@ -121,23 +119,30 @@ def table_velocities(shots, step=TABLE_VELOCITY_STEP):
 
 
 class TableCache:
-    """FE tables of one-layer targets, built once per distinct target and reused.
+    """FE tables of one-layer targets, built once per distinct target and reused: within a run
+    in memory, across commands and runs through the shared cache
+    (:mod:`cavex.verification.fedata.table_cache`).
 
     Parameters
     ----------
     directory : str or Path, optional
-        Tables are written there (``table_<key>.nc``, rounded as ``write_table`` stores them)
-        and read back on a later run with the same target, grid and FE settings.
+        A copy of every table the run uses is written there (``table_<key>.nc``, as the cache
+        stores it), so that a results folder holds its tables; nothing is read from it.
     numerics : dict, optional
         FE settings (:class:`cavex.fem.Numerics`); default the solver's.
     workers, scheduler : passed to :func:`cavex.verification.fedata.table.build_table`.
     progress : bool, optional
         A line on stderr per table built.
+    cache : str or Path, optional
+        The cache folder; default :func:`cavex.verification.fedata.table_cache.cache_dir`.
     """
 
     def __init__(self, directory=None, numerics=None, workers=None, scheduler=None,
-                 progress=False):
+                 progress=False, cache=None):
+        from cavex.verification.fedata.table_cache import cache_dir
+
         self.directory = None if directory is None else Path(directory)
+        self.cache = cache_dir() if cache is None else Path(cache)
         self.numerics, self.workers, self.scheduler = numerics, workers, scheduler
         self.progress = progress
         self._tables = {}
@@ -151,57 +156,67 @@ class TableCache:
 
     def plan(self, shots, mappings):
         """``(to build, on disk)``: the distinct FE tables ``shots`` need under ``mappings``
-        (call :meth:`velocities_for` first)."""
+        (call :meth:`velocities_for` first); on disk: in the cache (checked when read)."""
         keys = {self.key(shot_target(shot, m), shot_projectile(shot), self._velocities)
                 for m in mappings for shot in shots}
         keys -= set(self._tables)
-        on_disk = {k for k in keys if self.directory is not None
-                   and (self.directory / f"table_{k}.nc").exists()}
-        return len(keys - on_disk), len(on_disk)
+        cached = {k for k in keys if self._entry(k).exists()}
+        return len(keys - cached), len(cached)
 
     def key(self, target, projectile, velocities):
-        from cavex.config import fingerprint
-        from cavex.verification.fedata.table import settings_json
+        """The cache key (:func:`cavex.verification.fedata.table_cache.table_key`)."""
+        from cavex.verification.fedata.table_cache import table_key
 
-        text = json.dumps([fingerprint(target, projectile), list(velocities), list(TABLE_DEPTHS),
-                           settings_json(None, self.numerics)])
-        return hashlib.sha256(text.encode()).hexdigest()[:16]
+        return table_key(target, projectile, velocities, TABLE_DEPTHS, self.numerics)
+
+    def _entry(self, key):
+        from cavex.verification.fedata.table_cache import entry_path
+
+        return entry_path(key, self.cache)
 
     def table(self, shot, mapping=None):
         """The FE table of ``shot``'s target (velocities: :meth:`velocities_for`, else the
-        shot's own)."""
-        from cavex.analytic.penetration.tabulated import load_table
-        from cavex.verification.fedata.table import build_table, write_table
+        shot's own): from memory, else the cache, else built and cached."""
+        from cavex.verification.fedata.table_cache import load_entry
 
         target, projectile = shot_target(shot, mapping), shot_projectile(shot)
         velocities = self._velocities or table_velocities([shot])
         key = self.key(target, projectile, velocities)
         if key in self._tables:
             return self._tables[key]
-        path = None if self.directory is None else self.directory / f"table_{key}.nc"
-        if path is not None and path.exists():
-            table = load_table(path)
-            self.reused += 1
+        table = load_entry(self._entry(key), target, projectile, velocities, self.numerics)
+        if table is None:
+            table = self._build(shot, target, projectile, velocities, key)
         else:
-            if self.progress:
-                print(f"cavex: FE table for f_c = {shot.fc / 1e6:.4g} MPa, rho = {shot.rho:g} "
-                      f"kg/m^3 ({len(velocities)} velocities)", file=sys.stderr, flush=True)
-            table = build_table(target, projectile, velocities, TABLE_DEPTHS,
-                                numerics=self.numerics, workers=self.workers,
-                                scheduler=self.scheduler, progress=False)
-            self.built += 1
-            if path is None:
-                table = round_dataset(table)
-            else:
-                path.parent.mkdir(parents=True, exist_ok=True)
-                write_table(table, path)
-                table = load_table(path)
-            failed = int(table["failed"].sum()) + int(table["failed_first_layer"].sum())
-            if failed:
-                raise CavexNumericalError(f"{failed} FE cell(s) failed building the table for "
-                                          f"shot '{shot.id}': {table.attrs['failures'][:300]}")
+            self.reused += 1
+        failed = int(table["failed"].sum()) + int(table["failed_first_layer"].sum())
+        if failed:
+            raise CavexNumericalError(f"{failed} FE cell(s) failed building the table for "
+                                      f"shot '{shot.id}': {table.attrs['failures'][:300]}")
+        if self.directory is not None:
+            self._copy(key)
         self._tables[key] = table
         return table
+
+    def _build(self, shot, target, projectile, velocities, key):
+        """Build the table, store it in the cache and return it as stored."""
+        from cavex.verification.fedata.table import build_table
+        from cavex.verification.fedata.table_cache import store
+
+        if self.progress:
+            print(f"cavex: FE table for f_c = {shot.fc / 1e6:.4g} MPa, rho = {shot.rho:g} "
+                  f"kg/m^3 ({len(velocities)} velocities)", file=sys.stderr, flush=True)
+        table = build_table(target, projectile, velocities, TABLE_DEPTHS,
+                            numerics=self.numerics, workers=self.workers,
+                            scheduler=self.scheduler, progress=False)
+        self.built += 1
+        return store(table, self._entry(key))
+
+    def _copy(self, key):
+        """Copy the cache entry ``key`` into :attr:`directory` (atomically)."""
+        from cavex.verification.output.files import copy_atomic
+
+        copy_atomic(self._entry(key), self.directory / f"table_{key}.nc")
 
 
 # --- many shots -------------------------------------------------------------------------------
