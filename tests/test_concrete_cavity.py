@@ -241,8 +241,11 @@ def test_power_law_incompressible_against_direct_quadrature(velocity):
         s = (4.0 * mu / 3.0) / beta ** 3 + 2.0 * phi / beta - 0.5 * phi / beta ** 4
         return s, D
 
-    beta = brentq(lambda b: elastic(b)[1] - tau0 - lam * (elastic(b)[0] - 2.0 * elastic(b)[1] / 3.0),
-                  1.0 + 1e-9, 1e3, xtol=1e-15, rtol=1e-15)
+    def yield_gap(b):
+        s, D = elastic(b)
+        return D - tau0 - lam * (s - 2.0 * D / 3.0)
+
+    beta = brentq(yield_gap, 1.0 + 1e-9, 1e3, xtol=1e-15, rtol=1e-15)
 
     def strength(s):
         q = brentq(lambda q: q + 2.0 * 1.6 * q ** 0.61 / 3.0 - s, 0.0, s, xtol=1e-15, rtol=1e-15)
