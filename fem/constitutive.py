@@ -1,4 +1,4 @@
-r"""Hencky elasticity with Mohr-Coulomb perfect plasticity and a tension cut-off.
+r"""Hencky elasticity with Mohr-Coulomb perfect plasticity, a Tresca cap and a tension cut-off.
 
 Spherical symmetry keeps the principal axes fixed (``r``, ``theta = phi``), so the finite-strain
 return map is exact in principal logarithmic strains. Per quadrature point the total log strains
@@ -21,7 +21,13 @@ Kirchhoff stress with the intercepts scaled by ``J``. With ``s = sign(Q)``:
   ``f_MC = c_s |Q| - lam P - tau J`` with ``c_+ = 1``, ``c_- = (3 + lam)/3``;
 - tension cut-off on the least compressive principal stress ``sigma_3 >= -T``:
   ``f_TC = -sigma_3 - T J`` with ``sigma_3 = P - Q/3`` (``s > 0``) or ``P + 2Q/3`` (``s < 0``).
-  The default ``T = tau/lam`` puts it through the cone's apex (no cut-off for Tresca).
+  The default ``T = tau/lam`` puts it through the cone's apex (no cut-off for Tresca);
+  a layer's ``tensile_strength`` (concrete's ``f_t``) replaces it in that layer;
+- Tresca cap (concrete, Forrestal and Tzou 1997) on the principal stress difference,
+  ``f_cap = |Q| - tau_max J`` (``c = 1`` on both sides), associated (``g_cap = (0, -3/2 s)``:
+  volume-preserving, along ``Q`` at fixed ``P``), so that the strength is
+  ``|sigma_r - sigma_theta| <= min(lam sigma + tau, tau_max)``; ``tau_max = inf`` (the default)
+  is no cap.
 
 Flow: Mohr-Coulomb is non-associated with plastic potential ``g = c_s(psi)|Q| - lam_psi P``
 (``lam_psi = 6 sin psi / (3 - sin psi)`` from the dilatancy angle ``psi``; zero by default, i.e.
@@ -42,7 +48,12 @@ linear, so solved in closed form; the consistent tangent is its exact derivative
 Implementation: one compiled (numba) kernel per point, :func:`return_point`, used by the element
 loop of :mod:`cavex.fem.element` for every case. It tries the Mohr-Coulomb-only return first (one
 multiplier, the common case) and falls back, for that point only, to the multi-surface return
-when the trial state or the Mohr-Coulomb-returned one violates the tension cut-off.
+when the trial state or the Mohr-Coulomb-returned one violates the tension cut-off. With a
+finite cap, a point whose trial or returned deviator exceeds ``tau_max J`` is returned again
+from its trial state by the three-surface return :func:`_capped_point` (the active set, one
+surface or a corner of two, the first of MC, cap, TC, MC+cap, MC+TC, cap+TC with positive
+multipliers that violates no other surface; the same closed-form solve and tangent). Without a
+cap (``inf``) those tests are false and every point takes the code path above, bit for bit.
 An independent numpy implementation of the same equations is kept in ``tests/oracles.py`` and
 compared with this kernel point by point (``tests/test_fem_kernels.py``).
 """
