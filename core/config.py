@@ -11,7 +11,10 @@ from cavex.input_files import in_file, read_toml
 from cavex.materials import Material, Projectile, Target
 
 LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c", "bottom",
-              "scab_depth"}
+              "scab_depth", "tau_max", "tensile_strength"}
+#: FE-only layer keys (docs/config.md), written back only when given: targets without them keep
+#: their tables and fingerprints
+OPTIONAL_LAYER_KEYS = ("tau_max", "tensile_strength")
 BOTTOM_KEYS = ("bottom", "scab_depth")  # how a layer's bottom face holds: not on the last layer
 PROJECTILE_KEYS = {"r", "l", "R", "crh", "m", "V0", "length", "inertia", "cg", "mu"}
 TOP_KEYS = {"projectile", "layers"}
@@ -105,6 +108,9 @@ def target_table(target):
                 table["scab_depth"] = float(target.scab_depths[i])
         table.update(E=float(material.E), nu=float(material.nu), rho=float(material.rho),
                      lam=float(material.lam), tau=float(material.tau))
+        for key in OPTIONAL_LAYER_KEYS:
+            if getattr(material, key) is not None:
+                table[key] = float(getattr(material, key))
         tables.append(table)
     return tables
 
