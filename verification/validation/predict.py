@@ -16,6 +16,9 @@ projectile the shot's (:func:`~cavex.verification.validation.shots.shot_projecti
   (:mod:`cavex.verification.validation.concrete_model`, published constants, none fitted to the
   shots; its own crater and material, not the mapping), the recommended model
   (:data:`RECOMMENDED_MODEL`);
+- ``li-chen-2003``: Li and Chen's (2003) empirical formula (Forrestal's form with
+  ``S = 72 f_c^-0.5`` and the crater ``0.707 + h/d`` calibres,
+  :func:`cavex.verification.validation.concrete_model.li_chen_depth`);
 - ``forrestal-1994``: the empirical model (:mod:`cavex.verification.validation.empirical`).
 
 cavex's models run the penetration integrator
@@ -35,7 +38,12 @@ from pathlib import Path
 import numpy as np
 
 from cavex.analytic.penetration.integrator import penetrate
-from cavex.analytic.penetration.labels import CONCRETE_LABEL, EMPIRICAL_LABEL, VALIDATION_LABELS
+from cavex.analytic.penetration.labels import (
+    CONCRETE_LABEL,
+    EMPIRICAL_LABEL,
+    LI_CHEN_LABEL,
+    VALIDATION_LABELS,
+)
 from cavex.analytic.penetration.nose import nose_rule
 from cavex.analytic.penetration.resistance import MODEL_LABELS, make_resistance, parse_model_label
 from cavex.analytic.penetration.resistance import MODELS as CLOSED_FORMS
@@ -43,11 +51,13 @@ from cavex.errors import CavexInputError, CavexNumericalError, require_choice
 from cavex.verification.output.number_format import FE_DIGITS, round_significant
 from cavex.verification.validation import concrete_model, empirical
 from cavex.verification.validation.concrete import Mapping, shot_target
+from cavex.verification.validation.regimes import regime_statistics
 from cavex.verification.validation.shots import shot_projectile
 
 FE_MODEL = "table"
 EMPIRICAL = EMPIRICAL_LABEL
 CONCRETE = CONCRETE_LABEL
+LI_CHEN = LI_CHEN_LABEL
 CAVEX_MODELS = MODEL_LABELS  # the closed forms and the FE table: what a calibration can fit
 MODELS = VALIDATION_LABELS  # the cavex models, the concrete model, the empirical formula
 #: The model ``cavex validate`` recommends: the uncalibrated one with no constant fitted to any
@@ -101,6 +111,8 @@ def predict(shot, model, mapping=None, tables=None):
         return empirical.shot_depth(shot)
     if model == CONCRETE:
         return concrete_model.model_depth(shot)
+    if model == LI_CHEN:
+        return concrete_model.li_chen_depth(shot)
     resistance, boundary = parse_model_label(model)
     if resistance == "table":
         tables = tables or TableCache()
@@ -339,18 +351,42 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         rows.append({"id": shot.id, "V0_m_s": shot.V0, "fc_Pa": shot.fc,
                      "rho_kg_m3": shot.rho, "measured_m": shot.depth, "predicted_m": predicted,
                      "ratio": ratio})
+    add_rigid_flags(rows, shots, [model for model, _ in columns.values()])
     fitted = {i for c in calibrations for i in c.shots}
-    held_out = [row["id"] for row in rows if row["id"] not in fitted]
     result = {"models": list(columns), "recommended_model": RECOMMENDED_MODEL,
               "mapping": mapping.as_dict(),
               "calibrations": [c.describe() for c in calibrations], "shots": rows,
-              "summary": summaries(rows, columns), "failures": failures}
+              "failures": failures}
     if calibrations:
-        result["held_out"] = held_out
-        result["held_out_summary"] = summaries(
-            [row for row in rows if row["id"] in held_out], columns)
-    flag_outliers(result)
-    return result
+        result["held_out"] = [row["id"] for row in rows if row["id"] not in fitted]
+    return add_statistics(result)
+
+
+def add_rigid_flags(rows, shots, models):
+    """Set each row's ``flag``: the rigid-regime rule of
+    :func:`~cavex.verification.validation.concrete_model.rigid_flag` (``"non-rigid"`` or ``""``)
+    when the concrete model is among ``models`` (its resistance is then at hand), else None."""
+    for row, shot in zip(rows, shots, strict=True):
+        row["flag"] = None
+        if CONCRETE in models:
+            try:
+                row["flag"] = concrete_model.rigid_flag(shot, concrete_model.TableResistance(shot))
+            except (CavexInputError, CavexNumericalError):
+                pass
+
+
+def add_statistics(result):
+    """Set ``result``'s statistics from its ``shots`` and ``models``: ``summary`` (all shots),
+    ``held_out_summary`` (when it has ``held_out``), ``regimes``
+    (:func:`cavex.verification.validation.regimes.regime_statistics`), ``outliers`` and
+    ``summary_without_outliers`` (:func:`flag_outliers`)."""
+    rows, columns = result["shots"], result["models"]
+    result["summary"] = summaries(rows, columns)
+    if "held_out" in result:
+        held = set(result["held_out"])
+        result["held_out_summary"] = summaries([r for r in rows if r["id"] in held], columns)
+    result["regimes"] = regime_statistics(rows, columns, DEPTH_DIGITS)
+    return flag_outliers(result)
 
 
 def is_outlier(ratios, factor=OUTLIER_FACTOR):
