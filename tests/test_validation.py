@@ -543,6 +543,33 @@ def test_committed_validation_report_is_consistent():
     assert sentence in (folder / "report.md").read_text()
 
 
+def test_committed_development_validation_is_consistent():
+    """results/validation/compilation_dev/ (the development compilation): every regime's
+    statistics equal the ones recomputed from the per-shot depths and flags written beside
+    them, and the regime table of docs/validation.md is the committed one."""
+    from pathlib import Path
+
+    from cavex.verification.validation.regimes import REGIMES
+
+    folder = Path("results/validation/compilation_dev")
+    result = json.loads((folder / "validation.json").read_text())
+    assert result["shots_file"]["n"] == 286 and result["recommended_model"] == "concrete"
+    for name, models in result["regimes"].items():
+        rows = [r for r in result["shots"] if REGIMES[name](r["fc_Pa"], r["V0_m_s"], r["flag"])]
+        for model, stats in models.items():
+            logs = np.log([r["predicted_m"][model] / r["measured_m"] for r in rows
+                           if r["predicted_m"][model] is not None])
+            assert stats["n"] == len(logs)
+            assert stats["mean_abs_log_ratio"] == pytest.approx(np.abs(logs).mean(),
+                                                                rel=DIGITS_6)
+            assert stats["mean_log_ratio"] == pytest.approx(logs.mean(), rel=DIGITS_6)
+    docs = Path("docs/validation.md").read_text()
+    for model in ("concrete", "li-chen-2003", "forrestal-1994"):
+        cells = [f"{s['mean_abs_log_ratio']:.3f} / {s['mean_log_ratio']:+.3f}"
+                 for s in (result["regimes"][name][model] for name in REGIMES)]
+        assert f"| {model} | " + " | ".join(cells) + " |" in docs
+
+
 def test_a_shot_id_of_any_characters_is_one_markdown_table_cell():
     """report.md's tables stay tables for ids with '|', line breaks, tabs or emoji."""
     from cavex.verification.commands.validate import table_cell

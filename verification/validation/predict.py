@@ -32,6 +32,7 @@ the fitted mapping parameters, named ``"<model> calibrated"``.
 """
 
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -343,15 +344,24 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     columns = validation_columns(calibrations, mapping, models)
     tables = tables or TableCache()
     tables.velocities_for(shots)
-    depths, failures = predictions(shots, columns, tables, progress)
+    concrete = [name for name, (model, _) in columns.items() if model == CONCRETE]
+    depths, failures = predictions(
+        shots, {k: v for k, v in columns.items() if k not in concrete}, tables, progress)
+    flags = [None] * len(shots)
+    if concrete:
+        concrete_depths, flags, concrete_failures = concrete_predictions(shots, tables.workers)
+        for name in concrete:
+            depths[name] = concrete_depths
+            if concrete_failures:
+                failures[name] = concrete_failures
+    depths = {name: depths[name] for name in columns}
     rows = []
     for i, shot in enumerate(shots):
         predicted = {name: depths[name][i] for name in columns}
         ratio = {name: None if d is None else d / shot.depth for name, d in predicted.items()}
         rows.append({"id": shot.id, "V0_m_s": shot.V0, "fc_Pa": shot.fc,
                      "rho_kg_m3": shot.rho, "measured_m": shot.depth, "predicted_m": predicted,
-                     "ratio": ratio})
-    add_rigid_flags(rows, shots, [model for model, _ in columns.values()])
+                     "ratio": ratio, "flag": flags[i]})
     fitted = {i for c in calibrations for i in c.shots}
     result = {"models": list(columns), "recommended_model": RECOMMENDED_MODEL,
               "mapping": mapping.as_dict(),
@@ -362,17 +372,47 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     return add_statistics(result)
 
 
-def add_rigid_flags(rows, shots, models):
-    """Set each row's ``flag``: the rigid-regime rule of
-    :func:`~cavex.verification.validation.concrete_model.rigid_flag` (``"non-rigid"`` or ``""``)
-    when the concrete model is among ``models`` (its resistance is then at hand), else None."""
-    for row, shot in zip(rows, shots, strict=True):
-        row["flag"] = None
-        if CONCRETE in models:
-            try:
-                row["flag"] = concrete_model.rigid_flag(shot, concrete_model.TableResistance(shot))
-            except (CavexInputError, CavexNumericalError):
-                pass
+def concrete_predictions(shots, workers=None):
+    """The concrete model's ``(depths, flags, failures)`` for ``shots``: per shot the depth
+    (rounded like every depth, None if it failed), the rigid-regime flag
+    (:func:`~cavex.verification.validation.concrete_model.rigid_flag`, None if it failed) and
+    ``{shot id: reason}``. The shots of one concrete (``f_c``, ``rho``) go to one task, so its
+    cavity table is built once; tasks run on ``workers`` local processes (default: the CPUs).
+    """
+    from cavex.verification.fedata.runner import process_pool
+
+    groups = {}
+    for i, shot in enumerate(shots):
+        groups.setdefault((shot.fc, shot.rho), []).append(i)
+    tasks = [[shots[i] for i in group] for group in groups.values()]
+    workers = min(workers or os.cpu_count() or 1, len(tasks))
+    if workers > 1:
+        with process_pool(workers) as pool:
+            results = list(pool.map(concrete_group, tasks,
+                                    chunksize=max(1, len(tasks) // (4 * workers))))
+    else:
+        results = [concrete_group(task) for task in tasks]
+    depths, flags, failures = [None] * len(shots), [None] * len(shots), {}
+    for group, answers in zip(groups.values(), results, strict=True):
+        for i, (depth, flag, reason) in zip(group, answers, strict=True):
+            depths[i], flags[i] = depth, flag
+            if reason is not None:
+                failures[shots[i].id] = reason
+    return depths, flags, failures
+
+
+def concrete_group(shots):
+    """``[(depth, flag, reason)]`` of the concrete model for ``shots`` (one concrete)."""
+    out = []
+    for shot in shots:
+        try:
+            resistance = concrete_model.TableResistance(shot)
+            depth = round_significant(concrete_model.table_depth(shot, resistance),
+                                      DEPTH_DIGITS)
+            out.append((depth, concrete_model.rigid_flag(shot, resistance), None))
+        except (CavexInputError, CavexNumericalError) as exc:
+            out.append((None, None, str(exc).splitlines()[0]))
+    return out
 
 
 def add_statistics(result):
