@@ -152,8 +152,9 @@ class TableCache:
 
     def __init__(self, directory=None, numerics=None, workers=None, scheduler=None,
                  progress=False, cache=None):
-        from cavex.verification.fedata.table_cache import cache_dir
+        from cavex.verification.fedata.table_cache import cache_dir, max_bytes
 
+        max_bytes()  # a bad size limit is refused before any work
         self.directory = None if directory is None else Path(directory)
         self.cache = cache_dir() if cache is None else Path(cache)
         self.numerics, self.workers, self.scheduler = numerics, workers, scheduler
