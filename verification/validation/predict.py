@@ -71,9 +71,13 @@ TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on dep
 # 95 FE tables of 25 velocities and 2 depths in ~90 s; a prediction 1.4-2.6 ms with a closed
 # form, 29 ms with an FE table (5000 shots: 12 min on a machine loaded ~2x)
 TABLE_CASES_PER_SECOND_PER_WORKER = 45.0
-PREDICTION_SECONDS = {"closed form": 2.5e-3, FE_MODEL: 3e-2,
-                      # docs/concrete.md: 286 development shots (96 cavity tables) in ~17 s
-                      CONCRETE: 6e-2}
+PREDICTION_SECONDS = {"closed form": 2.5e-3, FE_MODEL: 3e-2, LI_CHEN: 0.0,
+                      # docs/concrete.md: the integrator 6.3 ms a shot, besides its table
+                      CONCRETE: 6.3e-3}
+# one concrete's cavity table (33 self-similar solutions): docs/concrete.md measured 15 s for
+# the 96 tables of the development shots (0.16 s each); benchmarks/validate_scale.py measured
+# about 0.56 CPU s each for 1000 concretes on a machine loaded ~2.5x
+CONCRETE_TABLE_SECONDS = 0.2
 # a shot every model misses by more than this factor (either way) is flagged as an outlier:
 # 21 of the 286 development shots (C133: 1.2 mm measured at 86 m/s, every model ~25 mm), none
 # of Forrestal's 17
@@ -246,8 +250,10 @@ def run_estimate(shots, models, tables, workers):
     cases = build * len(tables._velocities) * len(TABLE_DEPTHS)
     per_shot = sum(PREDICTION_SECONDS.get(model, PREDICTION_SECONDS["closed form"])
                    for model, _ in models.values() if model != EMPIRICAL)
+    concretes = len({(s.fc, s.rho) for s in shots}) if any(
+        model == CONCRETE for model, _ in models.values()) else 0
     seconds = (cases / (TABLE_CASES_PER_SECOND_PER_WORKER * max(1, workers))
-               + len(shots) * per_shot)
+               + len(shots) * per_shot + concretes * CONCRETE_TABLE_SECONDS / max(1, workers))
     when = ("under a minute" if seconds < 60.0 else f"about {seconds / 60.0:.0f} min"
             if seconds < 3600.0 else f"about {seconds / 3600.0:.1f} h")
     return (f"{len(shots)} shots x {len(models)} models = {len(shots) * len(models)} "
