@@ -31,4 +31,5 @@ shot=$(mktemp -d)  # the command's own figures of the paper's 20 deg, 600 m/s sh
 cavex trajectory --obliquity 20 --velocity 600 --compare-homogeneous --out "$shot" > /dev/null
 cp "$shot"/*.png results/oblique/shot_20deg_600/ && rm -r "$shot"
 python -m cavex.verification.studies.concrete_validation --workers 2 > /dev/null
+python -m cavex.verification.studies.concrete_fe > /dev/null
 git status --short results
