@@ -39,7 +39,7 @@ from cavex.analytic.penetration.surface_force import (
     rotation_matrix,
     surface_loads,
 )
-from cavex.analytic.penetration.zones import open_zones
+from cavex.analytic.penetration.zones import open_zones, union
 from cavex.errors import CavexNumericalError, is_finite_number, require
 from cavex.materials import MAX_VELOCITY
 
@@ -218,9 +218,10 @@ class ObliqueModel:
         b = self.body
         self.opened = np.array([z for z in self.zones if z[0] < depth or (
             z[0] == depth and depth > 0.0)], dtype=float).reshape(-1, 2)
+        walls = np.array(union(self.opened.tolist()), dtype=float).reshape(-1, 2)
         self._surface = (b.points, b.normals, b.areas, b.sizes, b.partners, b.length, self.mu,
                          self.contact_ramp, np.inf if self.bottom is None else float(self.bottom),
-                         b.nose, self.opened, *self.law.data)
+                         b.nose, walls, *self.law.data)
 
     # -- forces ---------------------------------------------------------------------------
     def loads(self, y, surface=None):

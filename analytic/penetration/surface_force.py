@@ -128,12 +128,16 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
     frac = min(max(0.5 + z / sizes[i], 0.0), 1.0)
     if bottom < np.inf:
         frac = min(frac, min(max(0.5 + (bottom - z) / sizes[i], 0.0), 1.0))
-    if not nose[i]:  # the shank carries no load in an open zone (crater, scabbed rear zone)
+    if not nose[i] and open_zones.shape[0] > 0:  # the shank carries no load in an open
+        # zone (crater, scabbed rear zone); the zones are disjoint (merged where they touch),
+        # so the element's length inside their union is the sum of its overlaps
+        half = 0.5 * sizes[i]
+        inside = 0.0
         for k in range(open_zones.shape[0]):
-            half = 0.5 * sizes[i]
-            inside = min(z + half, open_zones[k, 1]) - max(z - half, open_zones[k, 0])
-            if inside > 0.0:
-                frac = min(frac, max(1.0 - inside / sizes[i], 0.0))
+            inside += max(min(z + half, open_zones[k, 1]) - max(z - half, open_zones[k, 0]),
+                          0.0)
+        if inside > 0.0:
+            frac = min(frac, max(1.0 - inside / sizes[i], 0.0))
     if frac <= 0.0:
         return OK, 0.0
     n0 = rot[0, 0] * normals[i, 0] + rot[0, 1] * normals[i, 1] + rot[0, 2] * normals[i, 2]

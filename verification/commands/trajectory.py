@@ -81,6 +81,9 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
                 "contact_ramp_m_s": contact_ramp}
     if target.debonded:  # a bonded target's settings (and committed results) are unchanged
         settings["interfaces"] = list(target.bottoms)
+    if resistance == "law":
+        settings["law"] = ({"A_Pa": law_A, "B_kg_m3": law_B} if law_A is not None else
+                           [{"law_A": A, "law_B": B} for A, B in target.plain_laws])
     return {"runs": runs, "settings": settings, "target": target}
 
 
@@ -472,9 +475,17 @@ def run(args, target, projectile):
     settings = resistance_settings(args, (*RESISTANCES, "law"))
     target = interface_target(args, target, settings["resistance"])
     law = [args.law_A is not None, args.law_B is not None]
-    if not all(law) if args.resistance == "law" else any(law):
+    if any(law) and not (all(law) and args.resistance == "law"):
         raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
-                              "'--resistance law' (all or none)")
+                              "'--resistance law' (both, or neither: each layer's law_A, "
+                              "law_B keys)")
+    if args.resistance == "law" and not any(law):
+        missing = next((i for i, plain in enumerate(target.plain_laws) if plain is None), None)
+        if missing is not None:
+            raise CavexInputError("must be given on every layer for '--resistance law' without "
+                                  "'--law-A PA --law-B KG_PER_M3' (the layer's plain law "
+                                  "S = A + B rho V^2 / tau; docs/config.md)",
+                                  f"layers[{missing}].law_A")
     if args.resistance == "law" and args.boundary is not None:
         raise CavexInputError("option '--boundary' goes with '--resistance derived' (or table); "
                               "'--resistance law' has no boundary convention")
