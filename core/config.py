@@ -11,7 +11,7 @@ from cavex.input_files import in_file, read_toml
 from cavex.materials import Material, Projectile, Target
 
 LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c", "bottom",
-              "scab_depth", "law_A", "law_B"}
+              "scab_depth", "law_A", "law_B", "tunnel_wall"}
 BOTTOM_KEYS = ("bottom", "scab_depth")  # how a layer's bottom face holds: not on the last layer
 PROJECTILE_KEYS = {"r", "l", "R", "crh", "m", "V0", "length", "inertia", "cg", "mu"}
 TOP_KEYS = {"projectile", "layers"}
@@ -51,7 +51,7 @@ def parse_config(data):
 def parse_target(layers):
     """Build a :class:`Target` from a list of ``[[layers]]`` tables."""
     require(isinstance(layers, list) and layers, "layers", "a non-empty array of tables", layers)
-    materials, thicknesses, bottoms, scabs, laws = [], [], [], [], []
+    materials, thicknesses, bottoms, scabs, laws, walls = [], [], [], [], [], []
     for i, table in enumerate(layers):
         where = f"layers[{i}]."
         require(isinstance(table, dict), f"layers[{i}]", "a table", table)
@@ -75,12 +75,13 @@ def parse_target(layers):
             raise CavexInputError("must be given with law_A and law_B both (the plain law "
                                   "S = A + B rho V^2 / tau)", f"{where}{missing}")
         laws.append(None if law[0] is None else law)
+        walls.append(numbers.pop("tunnel_wall", 1.0))
         materials.append(prefixed(Material, where, name=table.get("name", ""), **numbers))
         if thickness is not None:
             thicknesses.append(thickness)
             bottoms.append(table.get("bottom", "bonded"))
             scabs.append(scab)
-    return prefixed(Target, "", materials, thicknesses, bottoms, scabs, laws)
+    return prefixed(Target, "", materials, thicknesses, bottoms, scabs, laws, walls)
 
 
 def parse_projectile(table):
@@ -113,6 +114,8 @@ def target_table(target):
                      lam=float(material.lam), tau=float(material.tau))
         if target.plain_laws[i] is not None:  # absent keys are not written: the tables
             table["law_A"], table["law_B"] = target.plain_laws[i]  # and fingerprints stay
+        if target.tunnel_walls[i] != 1.0:  # the default is not written (fingerprints)
+            table["tunnel_wall"] = target.tunnel_walls[i]
         tables.append(table)
     return tables
 
