@@ -132,3 +132,23 @@ def test_added_turn_refinement_in_the_contact_ramp(default):
     assert np.all(steps < 0)  # monotone
     assert abs(steps[2]) < abs(steps[1]) < abs(steps[0])  # converging
     assert abs(added[0.003] / added[0.01] - 1.0) < 0.10
+
+
+@pytest.mark.parametrize("command", [["stress", "--velocity", "600", "--depth", "0.3"],
+                                     ["fem", "--velocity", "600", "--depth", "0.3"],
+                                     ["table", "--velocities", "0", "600", "--depths", "0.3"],
+                                     ["verify", "--quick"]])
+def test_bonded_only_commands_refuse_a_debonded_key(command, capsys, tmp_path):
+    """stress, fem, table and verify solve the bonded spherical problem: a debonded key is
+    refused (one line naming it, exit 2, nothing written), not silently ignored."""
+    config = tmp_path / "debonded.toml"
+    config.write_text(default_config_text().replace('name = "macadam"',
+                                                    'name = "macadam"\nbottom = "debonded"'))
+    out_dir = tmp_path / "out"
+    extra = (["--out", str(out_dir)] if command[0] == "verify"
+             else ["-o", str(out_dir / "t.nc")] if command[0] == "table" else [])
+    code = main([*command, "--config", str(config), *extra])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
+    assert "layers[1].bottom" in err and "debonded" in err
+    assert not out_dir.exists()
