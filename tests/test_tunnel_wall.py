@@ -152,3 +152,21 @@ def test_bonded_only_commands_refuse_a_debonded_key(command, capsys, tmp_path):
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, err
     assert "layers[1].bottom" in err and "debonded" in err
     assert not out_dir.exists()
+
+
+def test_low_pass_lateral_overload():
+    """The study's filtered lateral overload (the mean over the time to travel one nose
+    length): a constant is kept, and a signal switching between 0 and 2 every sample (the
+    shank's contact) averages to 1 within one sample's weight over the window (30 samples)."""
+    from cavex.verification.studies.oblique_study import low_pass
+
+    t = np.linspace(0.0, 1e-3, 601)
+    speed = np.full(t.size, 100.0)
+    length = 100.0 * 30 * (t[1] - t[0])  # 30 samples per window
+    constant = low_pass({"t_s": t, "lateral_g": np.full(t.size, 5.0), "speed_m_s": speed},
+                        length)
+    assert np.allclose(constant, 5.0, rtol=1e-13)
+    switching = np.where(np.arange(t.size) % 2 == 0, 0.0, 2.0)
+    mean = low_pass({"t_s": t, "lateral_g": switching, "speed_m_s": speed}, length)
+    inner = slice(20, -20)  # windows inside the record
+    assert np.all(np.abs(mean[inner] - 1.0) <= 2.0 / 30)

@@ -21,6 +21,7 @@ written with a rounding unit well above its own spread.
 
 import argparse
 import json
+import math
 import sys
 
 import numpy as np
@@ -331,6 +332,127 @@ def figures(results, folder, interfaces, runs):
     return [str(p) for p in written]
 
 
+def turn_after_interface(result, interface=1):
+    """Pitch at the end of the phase after the nose tip first crosses ``interface`` minus the
+    pitch at the crossing (deg); None when it does not cross."""
+    k = next((i for i, p in enumerate(result.phases) if p["end_reason"].startswith(
+        f"nose tip crossed interface {interface}")), None)
+    if k is None or k + 1 >= len(result.phases):
+        return None
+    return result.phases[k + 1]["end_pitch_deg"] - result.phases[k]["end_pitch_deg"]
+
+
+def low_pass(history, length):
+    """Lateral overload averaged over the time the body takes to travel ``length`` (the nose
+    length) around each sample (trapezoidal mean over ``[t - T/2, t + T/2]``, ``T = length /
+    speed``): the raw samples switch with the shank's contact."""
+    t, g, v = history["t_s"], history["lateral_g"], history["speed_m_s"]
+    out = np.empty_like(g)
+    for i in range(t.size):
+        half = 0.5 * length / max(v[i], 1e-9)
+        lo, hi = t[i] - half, t[i] + half
+        grid = np.concatenate([[max(lo, t[0])], t[(t > lo) & (t < hi)], [min(hi, t[-1])]])
+        values = np.interp(grid, t, g)
+        span = grid[-1] - grid[0]
+        area = float(np.sum(0.5 * (values[1:] + values[:-1]) * np.diff(grid)))
+        out[i] = area / span if span > 0 else g[i]
+    return out
+
+
+SHOT = Strike(600.0, obliquity=20.0)  # the paper's shot that reaches the first interface
+SCAB_CALIBRES = (1.5, 2.12, 2.5, 3.0, 3.5)
+WALL_FACTORS = (0.25, 0.5, 0.75, 1.0)
+
+
+def interface_figures(folder, target, projectile):
+    """Figures of the debonded study (issue 20): the 600 m/s, 20 deg shot's pitch and
+    overloads against nose-tip depth (bonded, debonded, concrete alone; the open zones
+    shaded), and the sensitivity of its added turn at the first interface to the rear-zone
+    depth, the crater depth and the tunnel-wall factor. Returns the files and the numbers."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from cavex.analytic.penetration.oblique import ObliqueModel
+    from cavex.analytic.penetration.stress_laws import make_law
+    from cavex.analytic.penetration.zones import open_zones
+    from cavex.materials import Target
+
+    bonded = target.with_interfaces("bonded")
+    debonded = target.with_interfaces("debonded")
+    runs = {"bonded": fly(bonded, projectile, SHOT), "debonded": fly(debonded, projectile, SHOT),
+            "concrete alone": fly(target.single(0), projectile, SHOT)}
+    nose_length = math.sqrt(2.0 * projectile.R * projectile.r - projectile.r ** 2)
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), layout="constrained")
+    for k, (label, result) in enumerate(runs.items()):
+        h, color = result.history, f"C{k}"
+        axes[0].plot(h["tip_z_m"], h["pitch_deg"], "--" if k == 2 else "-", color=color,
+                     label=label)
+        if label != "concrete alone":
+            axes[1].plot(h["tip_z_m"], h["axial_g"] / 1e3, color=color, label=label)
+            axes[2].plot(h["tip_z_m"], h["lateral_g"] / 1e3, lw=0.5, alpha=0.4, color=color,
+                         label=f"{label}, raw samples")
+            axes[2].plot(h["tip_z_m"], low_pass(h, nose_length) / 1e3, lw=1.6, color=color,
+                         label=f"{label}, mean over one nose length")
+    for a in axes:
+        for top, bottom in open_zones(debonded, projectile):
+            a.axvspan(top, bottom, color="0.85", lw=0)
+        for H in target.interface_depths:
+            a.axvline(H, color="0.5", lw=0.8, ls=":")
+        a.set_xlabel("nose-tip depth (m); shaded: open zones (debonded)")
+        a.set_xlim(0.0, max(r.end["nose_tip_m"][2] for r in runs.values()) + 0.02)
+        a.grid(alpha=0.3)
+        a.legend(fontsize=7)
+    axes[0].set_ylabel("pitch (deg)")
+    axes[1].set_ylabel("axial overload (thousands of g)")
+    axes[2].set_ylabel("lateral overload (thousands of g)")
+    fig.suptitle(f"{SHOT.speed:g} m/s at {SHOT.obliquity:g} deg: bonded and debonded "
+                 "interfaces, and the concrete alone", fontsize=10)
+    written = [save_figure(fig, folder / "interface_shot.png", dpi=120, bbox_inches="tight")]
+
+    def added(runway, *, crater="nose-base"):
+        turns = []
+        for t in (runway.with_interfaces("bonded"), runway):
+            model = ObliqueModel(t, projectile, make_law(t, projectile), crater=crater)
+            turns.append(turn_after_interface(model.run(SHOT)))
+        return None if None in turns else turns[1] - turns[0]
+
+    numbers = {"scab_calibres": {}, "tunnel_wall": {}, "crater": {}}
+    n = len(target.thicknesses)
+    for c in SCAB_CALIBRES:
+        scabbed = Target(target.layers, target.thicknesses, ("debonded",) * n,
+                         (c * 2.0 * projectile.r,) * n)
+        numbers["scab_calibres"][c] = added(scabbed)
+    for f in WALL_FACTORS:
+        numbers["tunnel_wall"][f] = added(debonded.with_tunnel_wall(f))
+    for crater in ("nose-tip", "nose-base"):
+        numbers["crater"][crater] = added(debonded, crater=crater)
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.0), layout="constrained")
+    for a, (key, label) in zip(axes, (("scab_calibres", "rear-zone depth (calibres)"),
+                                      ("tunnel_wall", "tunnel-wall factor"),
+                                      ("crater", "crater depth rule (4.5 r from ...)")),
+                               strict=True):
+        items = [(k, v) for k, v in numbers[key].items() if v is not None]
+        x = list(range(len(items))) if key == "crater" else [k for k, _ in items]
+        a.plot(x, [v for _, v in items], "o" if key == "crater" else "o-")
+        for xi, (_, v) in zip(x, items, strict=True):
+            a.annotate(f"{v:+.2f}", (xi, v), textcoords="offset points", xytext=(4, 4),
+                       fontsize=7)
+        if key == "crater":
+            a.set_xticks(x, [k for k, _ in items])
+            a.set_xlim(-0.5, len(items) - 0.5)
+        a.set_yscale("symlog", linthresh=1.0)  # a body that turns over: tens of degrees
+        a.set_xlabel(label)
+        a.grid(alpha=0.3)
+    axes[0].set_ylabel("added turn at interface 1 (deg; linear within +-1)")
+    fig.suptitle(f"Sensitivity of the added turn (debonded - bonded), {SHOT.speed:g} m/s at "
+                 f"{SHOT.obliquity:g} deg (uncalibrated settings)", fontsize=10)
+    written.append(save_figure(fig, folder / "interface_sensitivity.png", dpi=120,
+                               bbox_inches="tight"))
+    return [str(p) for p in written], numbers
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default=DEFAULT_DIR)
@@ -366,6 +488,9 @@ def main(argv=None):
     write_text_atomic(folder / "study.csv", table_csv(results))
     write_text_atomic(folder / "report.md", report_md(results, answers, interfaces))
     figures(results, folder, interfaces, runs)
+    if args.interfaces == "debonded":
+        _, numbers = interface_figures(folder, target, projectile)
+        print(json.dumps({"sensitivity_added_turn_deg": numbers}, indent=1))
     print(json.dumps({k: v for k, v in answers.items() if k != "added_change_deg"}, indent=1))
     return 0
 
