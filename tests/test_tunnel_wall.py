@@ -170,3 +170,52 @@ def test_low_pass_lateral_overload():
     mean = low_pass({"t_s": t, "lateral_g": switching, "speed_m_s": speed}, length)
     inner = slice(20, -20)  # windows inside the record
     assert np.all(np.abs(mean[inner] - 1.0) <= 2.0 / 30)
+
+
+def test_open_zones_are_merged_where_they_meet(default):
+    """The rear zone and the crater meet at the interface plane; a shank element straddling
+    it has no wall on either side (before the merge each zone's overlap was taken alone and
+    the element kept the larger partial load). ``zones.union`` merges touching and overlapping
+    zones; the kernel sums an element's overlaps with disjoint zones, so the zones given split
+    at the plane or merged load the body the same (bound 1e-12 of the total), and a shank
+    element centred on the plane carries nothing."""
+    from cavex.analytic.penetration.zones import union
+
+    assert union([(0.65, 0.766), (0.597, 0.65)]) == [(0.597, 0.766)]
+    assert union([(0.0, 1.0), (0.5, 2.0), (3.0, 4.0)]) == [(0.0, 2.0), (3.0, 4.0)]
+    assert union([]) == []
+    target, projectile = default
+    debonded = target.with_interfaces("debonded")
+    model, y = _state(default)  # the shank in its tunnel around the first interface
+    law = make_law(debonded, projectile)
+    deb = ObliqueModel(debonded, projectile, law)
+    H = debonded.interface_depths[0]
+    surface = list(deb._surface)
+    # a shank element loaded in the tunnel (no zones), moved with the body onto the plane z = H
+    from cavex.analytic.penetration.surface_force import rotation_matrix
+
+    def alone(state, k, zones):
+        one = list(surface)
+        one[2] = np.where(np.arange(deb.body.areas.size) == k, deb.body.areas, 0.0)
+        one[10] = zones
+        return np.concatenate([np.ravel(v) for v in surface_loads(state, *one)[:3]])
+
+    none = np.empty((0, 2))
+    shank = [k for k in np.flatnonzero(~deb.body.nose) if np.any(alone(y, k, none) != 0.0)]
+    assert shank
+    k = shank[0]
+    z = y[2] + (rotation_matrix(y[3:7]) @ deb.body.points[k])[2]
+    y = y.copy()
+    y[2] += H - z
+    split = np.array([[H - 0.053, H], [H, H + 0.116]])
+    merged = np.array([[H - 0.053, H + 0.116]])
+    loads = []
+    for zones in (split, merged):
+        surface[10] = zones
+        loads.append(np.concatenate([np.ravel(v) for v in surface_loads(y, *surface)[:3]]))
+    for part in (slice(0, 3), slice(3, 6), slice(6, 7)):
+        assert np.allclose(loads[0][part], loads[1][part], rtol=0,
+                           atol=1e-12 * np.abs(loads[1][part]).max())
+    # that element, centred on the plane: loaded without zones, unloaded with the two zones
+    assert np.any(alone(y, k, none) != 0.0)
+    assert np.all(alone(y, k, split) == 0.0)
