@@ -81,7 +81,10 @@ def shot_summary(result, approach_depth):
             "pitch_change_deg": result.end["pitch_deg"] - float(h["pitch_deg"][0]),
             "pitch_change_deep_deg": (result.end["pitch_deg"] - float(h["pitch_deg"][near[0]])
                                       if near.size else None),
-            **peaks(h), "overload_peaks": overload_peaks(h)}
+            **peaks(h), "overload_peaks": overload_peaks(h),
+            "crossing_speed_m_s": next((p["end_speed_m_s"] for p in result.phases
+                                        if p["end_reason"].startswith(
+                                            "nose tip crossed interface 1")), None)}
 
 
 def study_chunk(chunk):
@@ -513,6 +516,36 @@ def interface_figures(folder, target, projectile):
     return [str(p) for p in written], numbers
 
 
+def crossing_figure(results, folder):
+    """The added turn (layered - concrete, from the approach depth on, at the default ramp and
+    extrapolated to ramp -> 0) against the speed at which the nose tip crosses the first
+    interface, one line per obliquity (10-45 deg): does a slower crossing turn more?"""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    added, limits = _added(results, CONTACT_RAMP), extrapolated_added(results)
+    speed = {(o, v): lay["crossing_speed_m_s"] for o, v, lay, _ in _pairs(results)}
+    fig, ax = plt.subplots(figsize=(6.5, 4.2), layout="constrained")
+    for k, o in enumerate(sorted({o for o, _ in added if 0.0 < o <= 45.0})):
+        rows = sorted((speed[(q, v)], x, limits[(q, v)][0]) for (q, v), x in added.items()
+                      if q == o and speed[(q, v)] is not None)
+        if rows:
+            s_, x, lim = zip(*rows, strict=True)
+            ax.plot(s_, x, "o-", color=f"C{k}", label=f"{o:g} deg, ramp {CONTACT_RAMP:g} m/s")
+            ax.plot(s_, lim, "s--", color=f"C{k}", mfc="none", label=f"{o:g} deg, ramp -> 0")
+    ax.set_yscale("symlog", linthresh=1.0)
+    ax.set_xlabel("speed at the first interface (m/s)")
+    ax.set_ylabel("added turn, layered - concrete (deg; symlog, linear within +-1)")
+    ax.set_title(f"{results[0].get('interfaces', 'bonded')} interfaces: the turn from "
+                 f"{APPROACH:g} m above the first interface on", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    return str(save_figure(fig, folder / "added_turn_crossing.png", dpi=120,
+                           bbox_inches="tight"))
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default=DEFAULT_DIR)
@@ -549,6 +582,7 @@ def main(argv=None):
     write_text_atomic(folder / "report.md", report_md(results, answers, interfaces, faster))
     figures(results, folder, interfaces, runs)
     if args.interfaces == "debonded":
+        crossing_figure(results, folder)
         _, numbers = interface_figures(folder, target, projectile)
         print(json.dumps({"sensitivity_added_turn_deg": numbers}, indent=1))
     print(json.dumps({k: v for k, v in answers.items() if k != "added_change_deg"}, indent=1))
