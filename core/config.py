@@ -11,7 +11,10 @@ from cavex.input_files import in_file, read_toml
 from cavex.materials import Material, Projectile, Target
 
 LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c", "bottom",
-              "scab_depth", "law_A", "law_B", "tunnel_wall"}
+              "scab_depth", "tau_max", "tensile_strength", "law_A", "law_B", "tunnel_wall"}
+#: FE-only layer keys (docs/config.md), written back only when given: targets without them keep
+#: their tables and fingerprints
+OPTIONAL_LAYER_KEYS = ("tau_max", "tensile_strength")
 BOTTOM_KEYS = ("bottom", "scab_depth")  # how a layer's bottom face holds: not on the last layer
 PROJECTILE_KEYS = {"r", "l", "R", "crh", "m", "V0", "length", "inertia", "cg", "mu"}
 TOP_KEYS = {"projectile", "layers"}
@@ -112,6 +115,9 @@ def target_table(target):
                 table["scab_depth"] = float(target.scab_depths[i])
         table.update(E=float(material.E), nu=float(material.nu), rho=float(material.rho),
                      lam=float(material.lam), tau=float(material.tau))
+        for key in OPTIONAL_LAYER_KEYS:
+            if getattr(material, key) is not None:
+                table[key] = float(getattr(material, key))
         if target.plain_laws[i] is not None:  # absent keys are not written: the tables
             table["law_A"], table["law_B"] = target.plain_laws[i]  # and fingerprints stay
         if target.tunnel_walls[i] != 1.0:  # the default is not written (fingerprints)

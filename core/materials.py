@@ -47,6 +47,14 @@ class Material:
     name : str, optional
     sigma_c : float, optional
         Unconfined compressive strength (Pa), > 0, from which ``tau`` is derived.
+    tau_max : float, optional
+        Tresca cap (Pa) on the strength: ``sigma_r - sigma_theta <= min(lam sigma + tau,
+        tau_max)``; at least the uniaxial compressive strength ``3 tau/(3 - lam)``. None (the
+        default): no cap. Used by the FE only (docs/fem.md "Concrete").
+    tensile_strength : float, optional
+        Tension cut-off (Pa) on the least compressive principal stress, ``sigma_3 >=
+        -tensile_strength``, in (0, 3 tau/(3 - lam)]; None (the default): the FE's
+        ``tension_cutoff`` setting (through the cone's apex unless set). FE only.
     """
 
     E: float
@@ -56,6 +64,8 @@ class Material:
     tau: float | None = None
     name: str = ""
     sigma_c: float | None = field(default=None, compare=False)
+    tau_max: float | None = None
+    tensile_strength: float | None = None
 
     def __post_init__(self):
         require(isinstance(self.name, str), "name", "a string", self.name)
@@ -73,6 +83,24 @@ class Material:
                     self.tau)
             object.__setattr__(self, "tau", derived)
         _positive("tau", self.tau)
+        uniaxial = self.uniaxial_strength
+        if self.tau_max is not None:
+            _positive("tau_max", self.tau_max)
+            require(self.tau_max >= uniaxial * (1.0 - 1e-12), "tau_max",
+                    f">= the uniaxial compressive strength 3 tau/(3 - lam) = {uniaxial:.6g} Pa "
+                    "(a cap below it)", self.tau_max)
+        if self.tensile_strength is not None:
+            _positive("tensile_strength", self.tensile_strength)
+            require(self.tensile_strength <= uniaxial * (1.0 + 1e-12), "tensile_strength",
+                    f"<= the uniaxial compressive strength 3 tau/(3 - lam) = {uniaxial:.6g} Pa",
+                    self.tensile_strength)
+
+    @property
+    def uniaxial_strength(self):
+        """Unconfined compressive strength ``3 tau / (3 - lam)`` (Pa) of the Mohr-Coulomb
+        line (uniaxial compression: ``sigma_r - sigma_theta = sigma_c`` at ``sigma =
+        sigma_c/3``)."""
+        return 3.0 * self.tau / (3.0 - self.lam)
 
     @cached_property
     def alpha(self):
