@@ -14,6 +14,9 @@ RANGE_VELOCITY = 1200.0
 def run(args, target, projectile):
     """The comparison as text or JSON; ``--fields`` also writes the FE fields. A velocity
     beyond :data:`RANGE_VELOCITY` is computed, with one warning line on stderr."""
+    from cavex.verification.commands.options import refuse_debonded
+
+    refuse_debonded(target, "fem")
     document = summary(job(target, projectile, args.depth, args.velocity, nu=args.nu,
                            fields=args.fields))
     document["warnings"] += material_warnings(target)
