@@ -77,7 +77,7 @@ Public: :class:`ConcreteCavity` (the dimensionless material), :func:`solve` (one
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from functools import lru_cache
 
 import numpy as np
@@ -137,6 +137,12 @@ class ConcreteCavity:
     tensile: float = math.inf
     power_B: float = math.nan
     power_N: float = 1.0
+
+    def __repr__(self):
+        """The fields, the power law's only when it is used (no ``nan`` in a message)."""
+        names = [f.name for f in fields(self)
+                 if self.power_law or f.name not in ("power_B", "power_N")]
+        return f"ConcreteCavity({', '.join(f'{n}={getattr(self, n)!r}' for n in names)})"
 
     @property
     def power_law(self):
