@@ -4,7 +4,7 @@ The job runs :func:`cavex.analytic.penetration.oblique.fly` for the runway (and,
 ``compare_homogeneous``, for the first layer alone, as the paper does), writes the histories as
 CSV (9 significant digits) and the figures: side view to scale with the projectile outline at
 intervals, pitch against time, axial and lateral overload against time and depth with the
-interfaces marked, a 3-D view of the path in the layered block (pyvista, off-screen).
+interfaces marked, a 3-D view of the path in the layered block to scale (matplotlib's mplot3d).
 """
 
 import json
@@ -205,10 +205,8 @@ def figures(job, folder):
     matplotlib.use("Agg")
     written = [side_view(job, folder / "path_side.png"),
                pitch_time(job, folder / "pitch_time.png"),
-               overloads(job, folder / "overload.png")]
-    picture = view_3d(job, folder / "path_3d.png")
-    if picture:
-        written.append(picture)
+               overloads(job, folder / "overload.png"),
+               view_3d(job, folder / "path_3d.png")]
     return [str(path) for path in written]
 
 
@@ -225,6 +223,15 @@ def _interfaces(ax, target, vertical=True, deepest=math.inf):
 PITCH_ROUNDOFF_DEG = 1e-6
 LATERAL_ROUNDOFF = 1e-9
 SIDE_WIDTH_IN = 7.5  # side view: width (in); its height follows the picture's aspect
+
+
+def margins(fig, left, right, top, bottom, **space):
+    """Place the axes of ``fig`` with fixed margins (in) around them: no layout engine, so a
+    figure is drawn once when saved (a layout engine or ``bbox_inches="tight"`` draws it twice
+    and lays out its text each time: most of the figure time, benchmarks/commands.py)."""
+    width, height = fig.get_size_inches()
+    fig.subplots_adjust(left=left / width, right=1.0 - right / width, top=1.0 - top / height,
+                        bottom=bottom / height, **space)
 
 
 def _layer_names(ax, target):
@@ -289,8 +296,14 @@ def side_view(job, path):
         xs += [h["cg_x_m"], *(o[0] for o in outlines)]
         zs += [h["cg_z_m"], *(o[1] for o in outlines)]
     (x0, x1), (z0, z1) = side_limits(np.concatenate(xs), np.concatenate(zs), target)
-    height = min(max(SIDE_WIDTH_IN * (z1 - z0) / (x1 - x0), 2.2), 8.0)
-    fig, ax = plt.subplots(figsize=(SIDE_WIDTH_IN, height + 1.0), layout="constrained")
+    # the axes box to scale: 5.75 in wide, or narrower where 8 in high would not hold it (the
+    # figure then narrower too, at least 5.5 in for the title and the legend)
+    box_w = min(SIDE_WIDTH_IN - 1.75, 8.0 * (x1 - x0) / (z1 - z0))
+    box_h = box_w * (z1 - z0) / (x1 - x0)
+    rows = 2 * len(curves)  # legend rows: centre of mass and outline of each run
+    bottom, top = 0.6 + 0.2 * rows, 0.55
+    fig, ax = plt.subplots(figsize=(max(box_w + 1.75, 5.5), box_h + bottom + top))
+    margins(fig, left=0.75, right=1.0, top=top, bottom=bottom)
     for name, color, h, outlines in curves:
         ax.plot(h["cg_x_m"], h["cg_z_m"], color=color, lw=1, label=f"{name}: centre of mass")
         for k, (ox, oz) in enumerate(outlines):
@@ -307,10 +320,11 @@ def side_view(job, path):
     ax.set_xlabel("x (m, horizontal, plane of obliquity)")
     ax.set_ylabel("z (m, depth)")
     # the title (wrapped to the narrow figure) above the axes, the legend below: off the data
-    fig.suptitle(textwrap.fill(_title(job), 64), fontsize=9)
-    fig.legend(*ax.get_legend_handles_labels(), fontsize=8, loc="outside lower center",
-               ncol=2 if len(job["runs"]) > 1 else 1, frameon=False)
-    return save_figure(fig, path, dpi=120, bbox_inches="tight")
+    fig.suptitle(textwrap.fill(_title(job), 64), fontsize=9, va="top",
+                 y=1.0 - 0.05 / fig.get_size_inches()[1])
+    fig.legend(*ax.get_legend_handles_labels(), fontsize=8, loc="lower center",
+               bbox_to_anchor=(0.5, 0.0), frameon=False)
+    return save_figure(fig, path, dpi=120)
 
 
 def _title(job):
@@ -334,7 +348,8 @@ def pitch_time(job, path):
     pitch stays below :data:`PITCH_ROUNDOFF_DEG` (round-off)."""
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    margins(fig, left=0.8, right=1.6, top=0.75, bottom=0.55)
     runs = job["runs"].items()
     moving = [(k, name, result) for k, (name, result) in enumerate(runs)
               if np.max(np.abs(result.history["pitch_deg"])) >= PITCH_ROUNDOFF_DEG]
@@ -356,9 +371,10 @@ def pitch_time(job, path):
             ax.text(0.01, 0.02, note, transform=ax.transAxes, fontsize=8, color="0.25")
         else:
             _note(ax, note.replace(" (", "\n("))
-    ax.set_title(_title(job) + ("\ndotted: phase ends (nose tip crosses an interface, ...)"
-                                if moving else ""), fontsize=9)
-    return save_figure(fig, path, dpi=120, bbox_inches="tight")
+    ax.set_title(_title(job).replace("; ", "\n")
+                 + ("; dotted: phase ends (nose tip crosses an interface, ...)"
+                    if moving else ""), fontsize=9)
+    return save_figure(fig, path, dpi=120)
 
 
 def overloads(job, path):
@@ -368,6 +384,8 @@ def overloads(job, path):
     from matplotlib.ticker import MaxNLocator
 
     fig, axes = plt.subplots(2, 2, figsize=(10, 7))
+    margins(fig, left=0.75, right=0.2, top=0.55, bottom=0.55 + 0.25 * (len(job["runs"]) > 1),
+            hspace=0.3, wspace=0.22)
     runs = list(job["runs"].items())
     for row, key in enumerate(("axial_g", "lateral_g")):
         shown = 0
@@ -397,76 +415,117 @@ def overloads(job, path):
     fig.suptitle(_title(job), fontsize=10)
     if len(runs) > 1:
         fig.legend(handles, labels, loc="lower center", ncol=len(runs), fontsize=8,
-                   frameon=False, bbox_to_anchor=(0.5, -0.02))
-    return save_figure(fig, path, dpi=120, bbox_inches="tight")
+                   frameon=False, bbox_to_anchor=(0.5, 0.0))
+    return save_figure(fig, path, dpi=120)
 
 
-LAYER_COLOURS = ("#bbbbbb", "#a0785a", "#6b8e23", "#777777")  # the 3-D view's layers, top down
-LAYER_COLOUR_NAMES = ("grey", "brown", "green", "dark grey")
+LAYER_COLOURS = ("#bbbbbb", "#c8a27a", "#9cbf5a", "#8c8c8c")  # the 3-D view's layers, top down
+VIEW_3D_SIZE_IN = (7.5, 6.5)  # the 3-D view: width, height (in)
+
+
+def block_limits(result, target, min_ratio=0.4):
+    """``(x limits, y limits, depth limits)`` (m) of the 3-D view's block: around the path and
+    the body (tip and centre of mass) with a margin, from above the surface (the body at the
+    strike) to below the deepest interface and the path, so that every layer is in it; each
+    horizontal extent at least ``min_ratio`` of the largest extent (no hairline axis, room for
+    readable ticks); ``y`` covers the half ``y >= 0`` behind the plane of obliquity and any
+    lateral motion."""
+    h = result.history
+    x = np.concatenate([h["tip_x_m"], h["cg_x_m"]])
+    y = np.concatenate([h["tip_y_m"], h["cg_y_m"]])
+    z = np.concatenate([h["tip_z_m"], h["cg_z_m"]])
+    length = result.model.body.length
+    interfaces = target.interface_depths or (0.0,)
+    top = min(float(z.min()), 0.0) - 0.5 * length
+    deepest = max(float(z.max()), interfaces[-1])
+    span = max(float(np.ptp(x)), deepest - top, length)
+    margin = 0.1 * span
+    bottom = deepest + margin
+    x0, x1 = float(x.min()) - margin, float(x.max()) + margin
+    depth = bottom - top
+    if x1 - x0 < min_ratio * depth:
+        middle, half = 0.5 * (x0 + x1), 0.5 * min_ratio * depth
+        x0, x1 = middle - half, middle + half
+    y0 = min(float(y.min()), 0.0) - 0.5 * margin
+    y1 = max(float(y.max()), 0.0, y0 + min_ratio * max(depth, x1 - x0))
+    return (x0, x1), (y0, y1), (top, bottom)
+
+
+def body_outline_3d(result, y):
+    """Closed outline of the body in the plane of its axis and its e2 axis, as world points
+    ``(n, 3)`` (m; z depth) at state ``y``."""
+    body = result.model.body
+    ax, rad = body.outline[:, 0], body.outline[:, 1]
+    top = np.stack([ax, rad, np.zeros_like(ax)], -1)
+    bottom = np.stack([ax[::-1], -rad[::-1], np.zeros_like(ax)], -1)
+    pts = np.concatenate([top, bottom, top[:1]])
+    return y[0:3] + pts @ rotation(y[3:7]).T
 
 
 def view_3d(job, path):
-    """The path in the layered block (the half y <= 0, cut open along the plane of obliquity),
-    the body at 6 equal time intervals, with the block's bounds as scales in m, rendered
-    off-screen with pyvista; None if pyvista cannot render here (no OpenGL)."""
-    try:
-        import pyvista as pv
-        from vtkmodules.vtkCommonCore import vtkLogger
-    except ImportError:  # pragma: no cover
-        return None
-    # no display here: VTK falls back to off-screen rendering but first logs a coloured
-    # "bad X server connection" warning on stderr; the picture is the same
-    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
+    """The path in the layered block, drawn to scale (equal axes, ticks in m) with matplotlib's
+    mplot3d: the block is cut open along the plane of obliquity (its half ``y >= 0``, behind the
+    path as seen), each layer a coloured band on the block's back walls and floor, the surface
+    and the interfaces outlined, the centre of mass's path and the body's outline at 6 equal
+    time intervals drawn over them; the legend below the axes (off the data)."""
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch
+    from matplotlib.ticker import MaxNLocator
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
     target = job["target"]
     result = job["runs"]["runway"]
     h = result.history
-    x = np.concatenate([h["tip_x_m"], h["cg_x_m"]])
-    lo, hi = min(x.min(), -0.2) - 0.2, max(x.max(), 0.2) + 0.2
-    bottom = max(h["tip_z_m"].max() + 0.3, (target.interface_depths or (0.5,))[-1] + 0.3)
-    ylo = min(h["tip_y_m"].min(), 0.0) - 0.3
-    try:
-        plotter = pv.Plotter(off_screen=True, window_size=(900, 700))
-        tops = [0.0, *target.interface_depths, bottom]
-        colors = LAYER_COLOURS
-        for i in range(len(tops) - 1):
-            box = pv.Box(bounds=(lo, hi, ylo, 0.0, -tops[i + 1], -tops[i]))
-            plotter.add_mesh(box, color=colors[i % len(colors)], opacity=0.25,
-                             show_edges=True)
-        points = np.stack([h["cg_x_m"], h["cg_y_m"], -h["cg_z_m"]], -1)
-        plotter.add_mesh(pv.lines_from_points(points), color="red", line_width=4)
-        for t in np.linspace(0.0, h["t_s"][-1], 6):
-            y = result.state(t)
-            rot = rotation(y[3:7])
-            axis = rot[:, 0]
-            body = result.model.body
-            centre = y[0:3] + axis * (body.cg - body.length / 2.0)
-            cyl = pv.Cylinder(center=(centre[0], centre[1], -centre[2]),
-                              direction=(axis[0], axis[1], -axis[2]), radius=body.radius,
-                              height=body.length)
-            plotter.add_mesh(cyl, color="navy")
-        plotter.show_bounds(xtitle="x (m)", ytitle="y (m)", ztitle="height (m)",
-                            location="outer", font_size=10, color="black", n_xlabels=3,
-                            n_ylabels=2)
-        plotter.add_text(_title(job).replace("; ", "\n"), font_size=8, color="black",
-                         position="upper_left")
-        names = target.layer_names()
-        plotter.add_text("red: centre of mass; navy: the body at 6 equal time intervals\n"
-                         + ", ".join(f"{n} ({LAYER_COLOUR_NAMES[i % len(LAYER_COLOUR_NAMES)]})"
-                                     for i, n in enumerate(names)),
-                         font_size=7, color="black", position="lower_left")
-        plotter.set_background("white")
-        # the whole block in view: look from the front left, above, then fit every actor
-        plotter.camera_position = [(lo - 1.0, ylo - 2.5, 1.0), ((lo + hi) / 2, 0, -bottom / 2),
-                                   (0, 0, 1)]
-        plotter.reset_camera()
-        plotter.camera.zoom(0.85)
-        tmp = str(path) + ".tmp.png"
-        plotter.screenshot(tmp)
-        plotter.close()
-        Path(tmp).replace(path)
-    except Exception:  # noqa: BLE001 (no OpenGL context: the 3-D view is optional)
-        return None
-    return str(path)
+    (x0, x1), (y0, y1), (top, bottom) = block_limits(result, target)
+    fig = plt.figure(figsize=VIEW_3D_SIZE_IN)
+    # the drawing order is set here (walls, outlines, path, body): everything drawn is either
+    # on the block's back walls or in front of them, so no depth sorting is needed
+    ax = fig.add_axes((0.0, 0.13, 1.0, 0.79), projection="3d", computed_zorder=False)
+    ax.view_init(elev=22, azim=-58)
+    planes = [0.0, *target.interface_depths, bottom]
+    names = target.layer_names()
+    handles = []
+    for k in range(len(planes) - 1):
+        a, b = planes[k], planes[k + 1]
+        colour = LAYER_COLOURS[k % len(LAYER_COLOURS)]
+        walls = [[(x0, y1, a), (x1, y1, a), (x1, y1, b), (x0, y1, b)],  # back wall
+                 [(x0, y0, a), (x0, y1, a), (x0, y1, b), (x0, y0, b)]]  # left wall
+        if k == len(planes) - 2:  # the floor: under the last layer
+            walls.append([(x0, y0, b), (x1, y0, b), (x1, y1, b), (x0, y1, b)])
+        ax.add_collection3d(Poly3DCollection(walls, facecolor=colour, alpha=0.45,
+                                             edgecolor="none", zorder=1))
+        handles.append(Patch(facecolor=colour, alpha=0.6, label=names[k]))
+    for k, depth in enumerate(planes[:-1]):  # the surface (solid) and the interfaces (dashed)
+        ax.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], [depth] * 5, zorder=2,
+                color="k" if k == 0 else "0.35", lw=1.0 if k == 0 else 0.8,
+                ls="-" if k == 0 else "--")
+    path_line, = ax.plot(h["cg_x_m"], h["cg_y_m"], h["cg_z_m"], color="red", lw=1.2, zorder=5,
+                         label="centre of mass")
+    handles.insert(0, path_line)
+    for t in np.linspace(0.0, h["t_s"][-1], 6):
+        pts = body_outline_3d(result, result.state(t))
+        ax.add_collection3d(Poly3DCollection([pts], facecolor="navy", edgecolor="navy",
+                                             lw=0.6, zorder=4))
+    handles.insert(1, Patch(facecolor="navy", label="body at 6 equal time intervals"))
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_zlim(bottom, top)  # depth downward
+    ax.set_box_aspect((x1 - x0, y1 - y0, bottom - top), zoom=0.95)  # to scale
+    extents = (x1 - x0, y1 - y0, bottom - top)
+    for axis, extent in zip((ax.xaxis, ax.yaxis, ax.zaxis), extents, strict=True):
+        # ticks in proportion to the axis's drawn length: a short axis gets 2-3 (no crowding)
+        axis.set_major_locator(MaxNLocator(nbins=max(2, round(5 * extent / max(extents))),
+                                           steps=[1, 2, 2.5, 5, 10]))
+        axis.set_pane_color((1.0, 1.0, 1.0, 0.0))
+    ax.grid(False)
+    ax.tick_params(labelsize=8, pad=1)
+    ax.set_xlabel("x (m, plane of obliquity)", fontsize=8, labelpad=4)
+    ax.set_ylabel("y (m)", fontsize=8, labelpad=2)
+    ax.set_zlabel("z (m, depth)", fontsize=8, labelpad=4)
+    fig.suptitle(_title(job).replace("; ", "\n"), fontsize=9, y=0.98)
+    fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=min(len(handles), 3),
+               frameon=False, bbox_to_anchor=(0.5, 0.0))
+    return save_figure(fig, path, dpi=120)
 
 
 # --- the command -----------------------------------------------------------------------------
