@@ -11,9 +11,12 @@ that is not counted, so numba's cache is warm) of
 - ``cavex penetrate --no-figures`` and ``cavex penetrate``; ``cavex trajectory --no-figures``
   and ``cavex trajectory`` (default: normal incidence at V0);
 - in one process, after a warm-up: ``penetration_job`` (the runway and its first layer alone)
-  and ``trajectory_job`` (the default shot), the computations of those two commands;
+  and ``trajectory_job`` (the default shot), the computations of those two commands, and
+  ``trajectory.figures`` (the four figures of the default shot, matplotlib imported);
 
-and the overhead of each ``--no-figures`` command over its in-process computation.
+and the overhead of each ``--no-figures`` command over its in-process computation, and the
+time the figures add to each command (median with figures less median without: drawing,
+saving and importing matplotlib).
 
 Run as ``python benchmarks/commands.py [--runs N]`` from the repository root.
 """
@@ -68,7 +71,7 @@ def main():
     from cavex.analytic.penetration.oblique import Strike
     from cavex.config import load_config
     from cavex.verification.commands.penetrate import penetration_job
-    from cavex.verification.commands.trajectory import trajectory_job
+    from cavex.verification.commands.trajectory import figures, trajectory_job
 
     target, projectile = load_config()
     with tempfile.TemporaryDirectory() as folder:
@@ -93,11 +96,19 @@ def main():
                               in_process(lambda: penetration_job(target, projectile), runs)),
             "trajectory": line("in process: trajectory_job (default shot)", in_process(
                 lambda: trajectory_job(target, projectile, Strike(projectile.V0)), runs))}
+        job = trajectory_job(target, projectile, Strike(projectile.V0))
+        (out / "figures").mkdir()
+        line("in process: trajectory figures (default shot)",
+             in_process(lambda: figures(job, out / "figures"), runs))
     print()
     for command, seconds in computation.items():
         overhead = measured[command, "--no-figures"] - seconds
         print(f"cavex {command} --no-figures: {overhead:.3f} s over its in-process computation "
               f"(of which {floor:.3f} s: start-up and numba + scipy.integrate imports)")
+    for command in computation:
+        extra = measured[command, "--figures"] - measured[command, "--no-figures"]
+        print(f"cavex {command}: the figures add {extra:.3f} s (median with less median "
+              "without)")
 
 
 if __name__ == "__main__":

@@ -11,6 +11,8 @@ what does not move stays a straight line on it) is no hairline.
 """
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import matplotlib
@@ -32,10 +34,13 @@ class Drawn:
 
     def __init__(self):
         self.checked = {}
+        self.limits_3d = {}
 
     def wrap(self, original):
         def save(fig, path, **kwargs):
             self.checked[Path(path).name] = check_axes(fig)
+            self.limits_3d.update({Path(path).name: (ax.get_xlim(), ax.get_ylim(), ax.get_zlim())
+                                   for ax in fig.axes if ax.name == "3d"})
             return original(fig, path, **kwargs)
         return save
 
@@ -54,10 +59,43 @@ def data_lines(ax):
     return lines
 
 
+def check_axes_3d(ax):
+    """A 3-D view: drawn to scale (the box's sides in proportion to the axis ranges), every
+    line (path, surface, interfaces) inside the limits, at least two tick labels on each axis
+    (a scale), and no tick or axis label overlapping another (readable: the pyvista view once
+    crowded its y labels into one corner)."""
+    limits = [sorted(ax.get_xlim()), sorted(ax.get_ylim()), sorted(ax.get_zlim())]
+    ranges = np.array([hi - lo for lo, hi in limits])
+    assert (ranges > 0).all()
+    box = np.asarray(ax.get_box_aspect(), dtype=float)
+    np.testing.assert_allclose(box / box.max(), ranges / ranges.max(), rtol=1e-9)
+    lines = ax.get_lines()
+    assert lines
+    for line in lines:
+        for values, (lo, hi) in zip(line.get_data_3d(), limits, strict=True):
+            assert lo <= np.min(values) and np.max(values) <= hi, ("cut off", line.get_label())
+    ax.figure.canvas.draw()
+    renderer = ax.figure.canvas.get_renderer()
+    boxes = []
+    for axis, (lo, hi) in zip((ax.xaxis, ax.yaxis, ax.zaxis), limits, strict=True):
+        shown = [tick.label1 for tick in axis.get_major_ticks()
+                 if lo <= tick.get_loc() <= hi and tick.label1.get_visible()
+                 and tick.label1.get_text()]
+        assert len(shown) >= 2, ("no scale", axis.get_label_text())
+        boxes += [label.get_window_extent(renderer) for label in [*shown, axis.label]]
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1:]:
+            assert not a.overlaps(b), ("labels overlap", a, b)
+    return 1
+
+
 def check_axes(fig):
     """The checks of the module docstring on every visible axes; returns how many showed data."""
     shown = 0
     for ax in fig.axes:
+        if ax.name == "3d":
+            shown += check_axes_3d(ax)
+            continue
         lines = data_lines(ax)
         if not ax.get_visible() or not lines:
             continue
@@ -148,11 +186,41 @@ def test_trajectory_figures(capsys, tmp_path, drawn, case, argv, config):
     assert main(["trajectory", *argv, "--out", str(out), "--no-progress",
                  *_config(tmp_path, config)]) == 0
     capsys.readouterr()
-    assert {"path_side.png", "pitch_time.png", "overload.png"} <= set(drawn.checked)
+    assert set(drawn.checked) == {"path_side.png", "pitch_time.png", "overload.png",
+                                  "path_3d.png"}
     assert drawn.checked["path_side.png"] == 1 and drawn.checked["overload.png"] >= 2
-    for name in [*drawn.checked, "path_3d.png"]:
-        if (out / name).exists() or name != "path_3d.png":
-            not_blank(out / name)
+    assert drawn.checked["path_3d.png"] == 1
+    for name in drawn.checked:
+        not_blank(out / name)
+    # the whole target in the 3-D view: the surface and every interface inside the depth range
+    target, _ = load_config(tmp_path / "target.toml" if config else None)
+    (_, _, (bottom, top)) = drawn.limits_3d["path_3d.png"]  # depth downward
+    assert top < 0.0 <= max(target.interface_depths, default=0.0) < bottom
+
+
+@pytest.mark.parametrize(("case", "strike"), [
+    ("normal incidence", (1000.0, 0.0)), ("30 deg", (800.0, 30.0)),
+    ("70 deg ricochet", (1000.0, 70.0)), ("stops in the first layer", (150.0, 0.0))])
+def test_the_3d_block_holds_the_body(case, strike):
+    """The 3-D view's block (:func:`block_limits`) holds the body's outline at every drawn time
+    (the body is drawn as polygons, which the line check above does not see), with room for
+    readable ticks: each horizontal side at least 0.4 of the largest."""
+    from cavex.analytic.penetration.oblique import Strike
+    from cavex.verification.commands.trajectory import (
+        block_limits,
+        body_outline_3d,
+        trajectory_job,
+    )
+
+    target, projectile = load_config()
+    result = trajectory_job(target, projectile, Strike(*strike))["runs"]["runway"]
+    limits = block_limits(result, target)
+    times = np.linspace(0.0, result.history["t_s"][-1], 6)
+    points = np.concatenate([body_outline_3d(result, result.state(t)) for t in times])
+    for k, (lo, hi) in enumerate(limits):
+        assert lo < points[:, k].min() and points[:, k].max() < hi, (case, k, limits)
+    sides = np.array([hi - lo for lo, hi in limits])
+    assert sides[:2].min() >= 0.4 * sides.max() * (1.0 - 1e-12)
 
 
 def test_a_normal_shot_draws_notes_not_round_off(tmp_path, drawn, capsys):
@@ -183,3 +251,17 @@ def test_validation_figures(tmp_path, drawn, calibrated):
     for path in written:
         assert drawn.checked[Path(path).name] == expected[Path(path).name]
         not_blank(path)
+
+
+def test_trajectory_figures_import_neither_pyplot_nor_a_3d_engine(tmp_path):
+    """The figures are drawn on Agg canvases without pyplot, the 3-D view with mplot3d (the
+    figure time, issue 21: benchmarks/commands.py, docs/oblique.md "Speed")."""
+    probe = ("import sys; from cavex.verification.cli import main; "
+             f"code = main(['trajectory', '--velocity', '300', '--no-progress', '--out', "
+             f"{str(tmp_path / 't')!r}]); "
+             "print(code, sorted(m for m in ('matplotlib.pyplot', 'pyvista', 'vtk') "
+             "if m in sys.modules), 'matplotlib' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          timeout=300, check=True)
+    assert done.stdout.split("\n")[-2] == "0 [] True"
+    assert (tmp_path / "t" / "path_3d.png").exists()

@@ -13,7 +13,7 @@ import pytest
 from cavex.config import default_config_text, load_config
 from cavex.verification.cli import announce_compiling, build_parser, main
 
-HEAVY = ("numba", "scipy", "matplotlib", "skfem", "xarray", "dask", "pyvista")
+HEAVY = ("numba", "scipy", "matplotlib", "skfem", "xarray", "dask")
 
 
 def _run(capsys, *argv):

@@ -26,7 +26,13 @@ from cavex.analytic.penetration.oblique import (
 from cavex.analytic.penetration.surface_force import rotation_matrix as rotation
 from cavex.errors import is_finite_number, require
 from cavex.verification.fedata.runner import show_progress
-from cavex.verification.output.files import save_figure, write_columns_csv, write_text_atomic
+from cavex.verification.output.files import (
+    agg_figure,
+    collector_paused,
+    save_figure,
+    write_columns_csv,
+    write_text_atomic,
+)
 from cavex.verification.output.paths import check_output_dir, write_staged
 
 DEFAULT_DIR = "results/trajectory"
@@ -200,13 +206,13 @@ def write_outputs(job, out, draw=True):
 # --- figures ----------------------------------------------------------------------------------
 
 def figures(job, folder):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    written = [side_view(job, folder / "path_side.png"),
-               pitch_time(job, folder / "pitch_time.png"),
-               overloads(job, folder / "overload.png"),
-               view_3d(job, folder / "path_3d.png")]
+    """The four figures into ``folder``, drawn without pyplot and with the garbage collector
+    paused (:func:`collector_paused`); returns their paths."""
+    with collector_paused():
+        written = [side_view(job, folder / "path_side.png"),
+                   pitch_time(job, folder / "pitch_time.png"),
+                   overloads(job, folder / "overload.png"),
+                   view_3d(job, folder / "path_3d.png")]
     return [str(path) for path in written]
 
 
@@ -284,8 +290,6 @@ def side_view(job, path):
     """The path in the plane of obliquity to scale (equal axes) around what moves
     (:func:`side_limits`): the centre of mass and the outline at 9 equal time intervals, the
     surface, the interfaces in view and the layers named; the legend below the axes."""
-    import matplotlib.pyplot as plt
-
     target = job["target"]
     curves, xs, zs = [], [], []
     for k, (name, result) in enumerate(job["runs"].items()):
@@ -302,7 +306,8 @@ def side_view(job, path):
     box_h = box_w * (z1 - z0) / (x1 - x0)
     rows = 2 * len(curves)  # legend rows: centre of mass and outline of each run
     bottom, top = 0.6 + 0.2 * rows, 0.55
-    fig, ax = plt.subplots(figsize=(max(box_w + 1.75, 5.5), box_h + bottom + top))
+    fig = agg_figure(figsize=(max(box_w + 1.75, 5.5), box_h + bottom + top))
+    ax = fig.subplots()
     margins(fig, left=0.75, right=1.0, top=top, bottom=bottom)
     for name, color, h, outlines in curves:
         ax.plot(h["cg_x_m"], h["cg_z_m"], color=color, lw=1, label=f"{name}: centre of mass")
@@ -346,9 +351,8 @@ def _note(ax, text):
 def pitch_time(job, path):
     """Pitch against time with the phase ends dotted; a note instead of a curve where the
     pitch stays below :data:`PITCH_ROUNDOFF_DEG` (round-off)."""
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig = agg_figure(figsize=(8, 4.5))
+    ax = fig.subplots()
     margins(fig, left=0.8, right=1.6, top=0.75, bottom=0.55)
     runs = job["runs"].items()
     moving = [(k, name, result) for k, (name, result) in enumerate(runs)
@@ -380,10 +384,10 @@ def pitch_time(job, path):
 def overloads(job, path):
     """Axial and lateral overload against time and nose-tip depth; a note instead of the
     lateral curves where they stay below :data:`LATERAL_ROUNDOFF` of the axial peak."""
-    import matplotlib.pyplot as plt
     from matplotlib.ticker import MaxNLocator
 
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7))
+    fig = agg_figure(figsize=(10, 7))
+    axes = fig.subplots(2, 2)
     margins(fig, left=0.75, right=0.2, top=0.55, bottom=0.55 + 0.25 * (len(job["runs"]) > 1),
             hspace=0.3, wspace=0.22)
     runs = list(job["runs"].items())
@@ -468,7 +472,6 @@ def view_3d(job, path):
     path as seen), each layer a coloured band on the block's back walls and floor, the surface
     and the interfaces outlined, the centre of mass's path and the body's outline at 6 equal
     time intervals drawn over them; the legend below the axes (off the data)."""
-    import matplotlib.pyplot as plt
     from matplotlib.patches import Patch
     from matplotlib.ticker import MaxNLocator
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
@@ -477,10 +480,10 @@ def view_3d(job, path):
     result = job["runs"]["runway"]
     h = result.history
     (x0, x1), (y0, y1), (top, bottom) = block_limits(result, target)
-    fig = plt.figure(figsize=VIEW_3D_SIZE_IN)
+    fig = agg_figure(figsize=VIEW_3D_SIZE_IN)
     # the drawing order is set here (walls, outlines, path, body): everything drawn is either
     # on the block's back walls or in front of them, so no depth sorting is needed
-    ax = fig.add_axes((0.0, 0.13, 1.0, 0.79), projection="3d", computed_zorder=False)
+    ax = fig.add_axes((0.0, 0.12, 1.0, 0.78), projection="3d", computed_zorder=False)
     ax.view_init(elev=22, azim=-58)
     planes = [0.0, *target.interface_depths, bottom]
     names = target.layer_names()
@@ -519,10 +522,11 @@ def view_3d(job, path):
         axis.set_pane_color((1.0, 1.0, 1.0, 0.0))
     ax.grid(False)
     ax.tick_params(labelsize=8, pad=1)
-    ax.set_xlabel("x (m, plane of obliquity)", fontsize=8, labelpad=4)
-    ax.set_ylabel("y (m)", fontsize=8, labelpad=2)
-    ax.set_zlabel("z (m, depth)", fontsize=8, labelpad=4)
-    fig.suptitle(_title(job).replace("; ", "\n"), fontsize=9, y=0.98)
+    ax.set_xlabel("x (m)", fontsize=8, labelpad=6)
+    ax.set_ylabel("y (m)", fontsize=8, labelpad=4)
+    ax.set_zlabel("depth z (m)", fontsize=8, labelpad=6)
+    fig.suptitle(_title(job).replace("; ", "\n") + "\nx: horizontal in the plane of obliquity; "
+                 "the block cut open along it", fontsize=9, y=0.985)
     fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=min(len(handles), 3),
                frameon=False, bbox_to_anchor=(0.5, 0.0))
     return save_figure(fig, path, dpi=120)

@@ -2,8 +2,11 @@
 killed run never leaves a partial file: text, CSV columns of numbers, matplotlib figures, copies."""
 
 import csv
+import gc
 import io
 import os
+import sys
+from contextlib import contextmanager
 
 
 def write_text_atomic(path, text):
@@ -35,9 +38,8 @@ def write_columns_csv(path, columns):
 
 def save_figure(fig, path, **savefig):
     """Save a matplotlib figure atomically (a temporary file, then ``os.replace``: a killed run
-    never leaves a partial PNG) and close it; returns ``path``."""
-    import matplotlib.pyplot as plt
-
+    never leaves a partial PNG) and close it; returns ``path``. A figure made without pyplot
+    (:func:`agg_figure`) has nothing to close: pyplot is then not imported for it."""
     tmp = os.fspath(path) + f".{os.getpid()}.tmp.png"
     try:
         fig.savefig(tmp, **savefig)
@@ -45,8 +47,35 @@ def save_figure(fig, path, **savefig):
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)
-        plt.close(fig)
+        if "matplotlib.pyplot" in sys.modules:
+            sys.modules["matplotlib.pyplot"].close(fig)
     return path
+
+
+def agg_figure(**figure):
+    """A matplotlib ``Figure(**figure)`` on an Agg canvas, made without pyplot (its import and
+    figure manager cost a tenth of a second a command and nothing here shows a window)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(**figure)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+@contextmanager
+def collector_paused():
+    """Python's cyclic garbage collector off for the block, back on after. Drawing allocates
+    many small objects; in a process that holds numba's and scipy's (over 10^5 tracked
+    objects), each automatic full collection walks them all: a third of the figure time,
+    measured (benchmarks/commands.py). The figures' cycles are collected when it is back on."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
 
 
 def copy_atomic(source, path):
