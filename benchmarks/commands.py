@@ -71,7 +71,8 @@ def main():
     from cavex.analytic.penetration.oblique import Strike
     from cavex.config import load_config
     from cavex.verification.commands.penetrate import penetration_job
-    from cavex.verification.commands.trajectory import figures, trajectory_job
+    from cavex.verification.commands.trajectory import figures as trajectory_figures
+    from cavex.verification.commands.trajectory import trajectory_job
 
     target, projectile = load_config()
     with tempfile.TemporaryDirectory() as folder:
@@ -99,7 +100,7 @@ def main():
         job = trajectory_job(target, projectile, Strike(projectile.V0))
         (out / "figures").mkdir()
         line("in process: trajectory figures (default shot)",
-             in_process(lambda: figures(job, out / "figures"), runs))
+             in_process(lambda: trajectory_figures(job, out / "figures"), runs))
     print()
     for command, seconds in computation.items():
         overhead = measured[command, "--no-figures"] - seconds
