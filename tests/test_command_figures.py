@@ -265,3 +265,26 @@ def test_trajectory_figures_import_neither_pyplot_nor_a_3d_engine(tmp_path):
                           timeout=300, check=True)
     assert done.stdout.split("\n")[-2] == "0 [] True"
     assert (tmp_path / "t" / "path_3d.png").exists()
+
+
+def test_the_collector_pause_restores_the_collector():
+    """``collector_paused`` (the figures' pause of the cyclic garbage collector) leaves it as it
+    found it: on after the block, also when the block raises; off if it was off."""
+    import gc
+
+    from cavex.verification.output.files import collector_paused
+
+    assert gc.isenabled()
+    with collector_paused():
+        assert not gc.isenabled()
+    assert gc.isenabled()
+    with pytest.raises(KeyboardInterrupt), collector_paused():
+        raise KeyboardInterrupt
+    assert gc.isenabled()
+    gc.disable()
+    try:
+        with collector_paused():
+            pass
+        assert not gc.isenabled()
+    finally:
+        gc.enable()
