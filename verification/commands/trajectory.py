@@ -353,7 +353,6 @@ def pitch_time(job, path):
     pitch stays below :data:`PITCH_ROUNDOFF_DEG` (round-off)."""
     fig = agg_figure(figsize=(8, 4.5))
     ax = fig.subplots()
-    margins(fig, left=0.8, right=1.6, top=0.75, bottom=0.55)
     runs = job["runs"].items()
     moving = [(k, name, result) for k, (name, result) in enumerate(runs)
               if np.max(np.abs(result.history["pitch_deg"])) >= PITCH_ROUNDOFF_DEG]
@@ -362,6 +361,8 @@ def pitch_time(job, path):
         ax.plot(h["t_s"] * 1e3, h["pitch_deg"], color=f"C{k}", label=name)
         for ph in result.phases[:-1]:
             ax.axvline(ph["end_time_s"] * 1e3, color=f"C{k}", lw=0.6, ls=":")
+    # room on the right for the legend (off the data) only where there are curves
+    margins(fig, left=0.8, right=1.6 if moving else 0.8, top=0.75, bottom=0.55)
     if moving:
         ax.set_xlabel("t (ms)")
         ax.set_ylabel("pitch (deg, axis from +z toward +x)")
