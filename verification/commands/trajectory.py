@@ -45,7 +45,7 @@ MAX_STEPS = 100_000
 def trajectory_job(target, projectile, strike, resistance="derived", *, boundary="dynamic",
                    epsilon="quasi-static", free_surface=True, table=None, law_A=None,
                    law_B=None, compare_homogeneous=False, contact_ramp=None, progress=False,
-                   tangency_psi=0.0):
+                   tangency_psi=0.0, entry_crater=False):
     """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``;
     ``progress``: a tqdm bar per run on stderr (steps, simulated time, speed)."""
     contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
@@ -58,7 +58,7 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
             "of the V_r -> 0 limit)", contact_ramp)
     options = {"boundary": boundary, "epsilon": epsilon, "free_surface": free_surface,
                "table": table, "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp,
-               "tangency_psi": tangency_psi}
+               "tangency_psi": tangency_psi, "entry_crater": entry_crater}
     if table is not None:
         from cavex.analytic.penetration.tabulated import load_table
         options["table"] = load_table(table)
@@ -87,6 +87,8 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
         settings["tunnel_walls"] = list(target.tunnel_walls)
     if tangency_psi:
         settings["tangency_psi_deg"] = tangency_psi
+    if entry_crater:  # the runway's entry crater [top, bottom] (m); the default's settings
+        settings["entry_crater_m"] = list(runs["runway"].model.zones[0])  # are unchanged
     if resistance == "law":
         settings["law"] = ({"A_Pa": law_A, "B_kg_m3": law_B} if law_A is not None else
                            [{"law_A": A, "law_B": B} for A, B in target.plain_laws])
@@ -526,6 +528,7 @@ def run(args, target, projectile):
                                  compare_homogeneous=args.compare_homogeneous,
                                  contact_ramp=args.contact_ramp,
                                  tangency_psi=args.tangency_psi,
+                                 entry_crater=args.entry_crater,
                                  progress=show_progress(args.progress))
     except FloatingPointError as exc:
         raise CavexNumericalError(f"the trajectory overflowed ({exc}): forces far beyond the "
