@@ -187,7 +187,7 @@ def test_entry_crater_work_is_the_kinetic_energy_lost(default):
 
 def test_trajectory_entry_crater_option(capsys, tmp_path, default):
     """``--entry-crater`` names its zone in the settings; without it the settings are as
-    before (no key)."""
+    before (no key); ``--crater`` sets the crater depth and goes with a zone."""
     _, projectile = default
     base = ["trajectory", "--velocity", "600", "--obliquity", "20", "--no-figures", "--json"]
     assert main([*base, "--entry-crater", "--out", str(tmp_path / "on")]) == 0
@@ -200,3 +200,13 @@ def test_trajectory_entry_crater_option(capsys, tmp_path, default):
     assert main([*base, "--entry-crater=yes", "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err
     assert "--entry-crater" in err and len(err.strip().splitlines()) == 1
+    # the crater depth from the nose tip (zones.crater_depth "nose-tip": 4.5 r)
+    assert main([*base, "--entry-crater", "--crater", "nose-tip", "--out",
+                 str(tmp_path / "tip")]) == 0
+    tip = json.loads(capsys.readouterr().out)
+    assert tip["settings"]["entry_crater_m"] == [0.0, crater_depth(projectile, "nose-tip")]
+    assert tip["settings"]["crater"] == "nose-tip"
+    for bad in (["--crater", "nose-tip"], ["--entry-crater", "--crater", "tail"]):
+        assert main([*base, *bad, "--out", str(tmp_path / "x")]) == 2
+        err = capsys.readouterr().err
+        assert "--crater" in err and len(err.strip().splitlines()) == 1

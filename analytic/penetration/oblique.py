@@ -482,10 +482,12 @@ class ObliqueModel:
 
 def fly(target, projectile, strike=None, resistance="derived", *, body=None, bottom=None,
         rtol=RTOL, atol=ATOL, method=METHOD, contact_ramp=None, progress=None,
-        tangency_psi=0.0, entry_crater=False, **law_options):
+        tangency_psi=0.0, entry_crater=False, crater="nose-base", **law_options):
     """One trajectory: :class:`Result` of ``strike`` (default: normal incidence at ``V0``);
     ``progress(t, y)`` is called after every integrator step; ``entry_crater``: the shank
-    carries no load in the entry crater ``[0, L_c]`` (zones.open_zones; docs/oblique.md)."""
+    carries no load in the entry crater ``[0, L_c]`` (zones.open_zones; docs/oblique.md);
+    ``crater``: where ``L_c`` of the entry and interface craters is measured from
+    (zones.crater_depth)."""
     strike = strike or Strike(projectile.V0)
     require(resistance == "derived" or not target.debonded, "interfaces",
             "'bonded' unless the resistance is 'derived' (a debonded interface needs its "
@@ -493,7 +495,8 @@ def fly(target, projectile, strike=None, resistance="derived", *, body=None, bot
     law = make_law(target, projectile, resistance, bottom=bottom, **law_options)
     model = ObliqueModel(target, projectile, law, body=body, bottom=bottom, rtol=rtol,
                          atol=atol, method=method, contact_ramp=contact_ramp,
-                         tangency_psi=tangency_psi, entry_crater=entry_crater)
+                         tangency_psi=tangency_psi, entry_crater=entry_crater,
+                         crater=crater)
     return model.run(strike, progress=progress)
 
 
