@@ -323,7 +323,9 @@ def _title(job):
     law = s["resistance"] + (f"-{s['boundary']}" if s["resistance"] == "derived" else "")
     return (f"V0 = {s['speed_m_s']:g} m/s, obliquity {s['obliquity_deg']:g} deg, attack "
             f"{s['attack_deg']:g} deg; resistance {law}, contact ramp "
-            f"{s['contact_ramp_m_s']:g} m/s")
+            f"{s['contact_ramp_m_s']:g} m/s"
+            + (f"; entry crater to {s['entry_crater_m'][1]:.3g} m" if "entry_crater_m" in s
+               else ""))
 
 
 def _note(ax, text):
