@@ -7,9 +7,9 @@ call of :func:`cavex.fem.newton.newton`, so cases whose cut-backs differ stay in
 case gives the same bits alone and inside any stack. The policy for a failing step, the same for
 every case:
 
-1. a step whose Newton iteration fails (no convergence, folded element, non-finite value,
-   singular tangent) is retried as two half steps (the load interpolated linearly), recursively,
-   up to ``max_cutbacks`` times;
+1. a step whose Newton iteration fails (a stall or no convergence, folded element,
+   non-finite value, singular tangent) is retried as two half steps (the load interpolated
+   linearly), recursively, up to ``max_cutbacks`` times;
 2. a step that still fails at the deepest cut-back is tried once more with an energy line search
    (:func:`cavex.fem.newton.newton_line_search`), which cures the two-cycle of plain Newton at
    the Mohr-Coulomb apex (docs/fem.md); steps that plain Newton solves never reach it;
@@ -219,9 +219,10 @@ class RadialSolver:
         if self.dynamic:
             dt_d = w.dt[stack.dof_case]
             v = w.v0 + dt_d * ((1.0 - p.gamma) * w.a0 + p.gamma * a)
-            mid = stack.mass @ ((1.0 - p.alpha_m) * a + p.alpha_m * w.a0)
-            mid_force = (mid + (1.0 - p.alpha_f) * f + p.alpha_f * w.f0)[stack.wall]
-            end_force = f[stack.wall] + (stack.mass @ a)[stack.wall]
+            wall_mass = stack.wall_mass  # the wall rows of the mass matrix: the wall forces
+            mid = wall_mass @ ((1.0 - p.alpha_m) * a + p.alpha_m * w.a0)
+            mid_force = mid + ((1.0 - p.alpha_f) * f + p.alpha_f * w.f0)[stack.wall]
+            end_force = f[stack.wall] + wall_mass @ a
         else:
             v = np.zeros_like(u)
             mid_force = 0.5 * (f[stack.wall] + w.f0[stack.wall])

@@ -10,6 +10,7 @@ import pytest
 
 from cavex import load_config
 from cavex.fem import expand_cavities, expand_cavity, newton
+from cavex.fem import stack as newton_stack
 from cavex.fem.estimate import richardson_error, richardson_error_from_finer
 from cavex.fem.newton import StepFailure, line_search_newton
 
@@ -104,3 +105,52 @@ def test_the_rescue_is_the_same_inside_a_stack(line_searches):
     assert np.array_equal(b.u, alone.u)
     assert b.stats["newton_iterations"] == alone.stats["newton_iterations"]
     assert b.stats["cutbacks"] == alone.stats["cutbacks"]
+
+
+# --- the stall rule: a failing attempt ends early -----------------------------------------------
+
+def stall_iteration(residuals):
+    """Iteration (1-based) at which :func:`cavex.fem.newton._stalls` fails a single case whose
+    relative residuals are ``residuals`` (the first is the predictor's), or None."""
+    best, stalled, done = np.full(1, np.inf), np.zeros(1, dtype=int), np.zeros(1, dtype=bool)
+    for iteration, r in enumerate(residuals[1:], start=2):
+        if newton._stalls(np.array([r]), best, stalled, done)[0]:
+            return iteration
+    return None
+
+
+# relative residuals of two attempts measured on the issue grid (V = 200 m/s, L = 0.8 m): one
+# that ended in a two-cycle and used to run its 30 iterations, one that converged after
+# climbing twice
+CYCLING = [6.8e-2, 3.4e-1, 3.8e-1, 3.5e-1, 2.2e-1, 1.7e-1, 6.2e-2, 1.1e-2] + [5.9e-2, 1.1e-2] * 11
+CONVERGING = [8.6e-2, 3.8e-1, 4.3e-1, 4.0e-1, 2.7e-1, 3.9e-1, 5.4e-6, 1.0e-14]
+
+
+def test_stall_rule_on_measured_residuals():
+    assert newton.STALL_ITERATIONS == 4
+    assert stall_iteration(CYCLING) == 12  # 4 iterations after the last new low (iteration 8)
+    assert stall_iteration(CONVERGING) is None  # the predictor's residual is not a low to beat
+    assert stall_iteration([1.0, 0.5] + [0.6] * 3) is None
+    assert stall_iteration([1.0, 0.5] + [0.6] * 4) == 6
+
+
+def test_stall_rule_saves_work_and_keeps_the_answer(monkeypatch):
+    """Quasi-static soil at the default resolution: its failing attempts cycle; ending them at
+    the stall instead of after 30 iterations halves the residual evaluations (measured 973
+    against 1767) and leaves the wall stress within its error estimate (measured: unchanged)."""
+    evaluations = []
+    assemble = newton_stack.Stack.assemble
+
+    def counted(self, u, theta_p, gamma_p, skip=None, out=None):
+        evaluations.append(self.n_cases - (0 if skip is None else int(skip.sum())))
+        return assemble(self, u, theta_p, gamma_p, skip, out)
+
+    monkeypatch.setattr(newton_stack.Stack, "assemble", counted)
+    with_rule = expand_cavity(*ARGS)
+    n_rule = sum(evaluations)
+    monkeypatch.setattr(newton, "STALL_ITERATIONS", newton.MAX_ITERATIONS)
+    evaluations.clear()
+    without = expand_cavity(*ARGS)
+    assert n_rule < 0.7 * sum(evaluations)
+    change = abs(with_rule.cavity_stress / without.cavity_stress - 1.0)
+    assert change <= without.error_estimate
