@@ -50,6 +50,20 @@ def failure_message(depth, t, wall_radius, load, dt, plain, line_searched):
             f"{line_searched}")
 
 
+def _store(state, names, rows, ok, new):
+    """``state[name][rows][ok] = new[name][ok]`` for every name; ``rows`` is ``slice(None)``
+    (the working stack is the whole stack: written in place, no index arrays) or an index
+    array (a subset)."""
+    if isinstance(rows, slice):
+        for name in names:
+            np.copyto(state[name], new[name], where=ok if state[name].ndim == 1
+                      else ok[:, None])
+        return
+    where = rows[ok]
+    for name in names:
+        state[name][where] = new[name][ok]
+
+
 class RadialSolver:
     """State and stepping of a stack of radial models.
 
@@ -130,7 +144,7 @@ class RadialSolver:
         plain_reason = [None] * k               # why its plain Newton attempt failed
         t, load = self.cases["t"], self.cases["load"]
         stack, cases = root, np.arange(k)
-        dofs, elements = np.arange(root.ndof), np.arange(root.el_count.sum())
+        dofs = elements = slice(None)  # the working stack's rows of the state: all of it
         while True:
             for c in np.flatnonzero(~finished):
                 if pending[c]:
@@ -235,14 +249,12 @@ class RadialSolver:
                                        - (2.0 / 3.0) * Q * (resp.gamma_p - w.gamma_p))
         ok_dofs, ok_elements = ok[stack.dof_case], ok[stack.element_case]
         new = {"u": u, "v": v, "a": a, "f": f, "du_prev": u - w.u0}
-        for name in DOF_STATE:
-            self.dofs[name][dofs[ok_dofs]] = new[name][ok_dofs]
+        _store(self.dofs, DOF_STATE, dofs, ok_dofs, new)
         eq_p = (self.points["eq_p"][elements]
                 + np.abs(resp.gamma_p - w.gamma_p) * (2.0 / 3.0))
         new = {"eq_p": eq_p, **{name: getattr(resp, name) for name in POINT_STATE
                                 if name != "eq_p"}}
-        for name in POINT_STATE:
-            self.points[name][elements[ok_elements]] = new[name][ok_elements]
+        _store(self.points, POINT_STATE, elements, ok_elements, new)
         done = cases[ok]
         self.cases["wall_force"][done] = end_force[ok]
         self.cases["work"][done] += work[ok]
