@@ -40,7 +40,8 @@ from cavex.fem.stack import Stack
 DOF_STATE = ("u", "v", "a", "f", "du_prev")
 POINT_STATE = ("theta_p", "gamma_p", "eq_p", "plastic", "yield_ratio", "tau_r", "tau_t")
 CASE_STATE = ("t", "load", "dt_old", "wall_force", "work", "dissipated")
-COUNTERS = ("steps", "newton_iterations", "cutbacks", "line_search_steps")
+COUNTERS = ("steps", "newton_iterations", "cutbacks", "line_search_steps",
+            "residual_evaluations")
 
 
 def failure_message(depth, t, wall_radius, load, dt, plain, line_searched):
@@ -172,8 +173,9 @@ class RadialSolver:
                           load=task_load[cases], dt=task_dt[cases],
                           dt_old=self.cases["dt_old"][cases], has_prev=self.has_prev[cases],
                           active=active & ~task_search[cases])
-            trial, ok, iterations, reasons = self._attempt(stack, w, active,
-                                                           task_search[cases])
+            trial, ok, iterations, reasons, evaluations = self._attempt(stack, w, active,
+                                                                        task_search[cases])
+            self.counters["residual_evaluations"][cases] += evaluations
             self._commit(stack, cases, dofs, elements, ok, w, trial)
             done = cases[ok]
             self.cases["dt_old"][done] = task_dt[done]
@@ -208,9 +210,10 @@ class RadialSolver:
 
     def _attempt(self, stack, w, active, search):
         """One Newton attempt of the active cases (the line-searched ones case by case).
-        Returns ``((u, a, f, response), ok, iterations, reasons)`` on the working stack."""
-        u, a, f, resp, iterations, reasons = newton(stack, w, self.params, self.dynamic,
-                                                    self.newton_tol)
+        Returns ``((u, a, f, response), ok, iterations, reasons, evaluations)`` on the working
+        stack (``evaluations``: plain Newton's residual evaluations per case)."""
+        u, a, f, resp, iterations, reasons, evaluations = newton(
+            stack, w, self.params, self.dynamic, self.newton_tol)
         if search.any():
             u, a, f = u.copy(), a.copy(), f.copy()
             resp = copy_response(resp)
@@ -223,7 +226,7 @@ class RadialSolver:
                     u[sdofs], a[sdofs], f[sdofs] = su, sa, sf
                     replace_points(resp, selements, sresp)
         ok = active & np.array([r is None for r in reasons])
-        return (u, a, f, resp), ok, iterations, reasons
+        return (u, a, f, resp), ok, iterations, reasons, evaluations
 
     def _commit(self, stack, cases, dofs, elements, ok, w, trial):
         """Accept the converged cases ``ok`` of the working ``stack``: velocities, plastic
