@@ -27,7 +27,8 @@ Run: ``python benchmarks/table.py [--repeats 3] [--workers N] [--grids issue 120
 
 Measured (issue 21, branch fem-speed against main, issue grid, 7 pairs, a 2-core machine
 shared with other jobs, load average ~5 during the runs, so absolute times are ~2-3x a quiet
-machine's): wall 9.6 s against 12.7 s (median ratio 0.71), CPU 5.9 s against 8.0 s (0.69);
+machine's): wall 8.3 s against 13.2 s (median ratio 0.68), CPU 4.9 s against 7.4 s (0.66);
+default grid, 3 pairs: wall 29.8 s against 54.6 s (0.59), CPU 20.6 s against 30.8 s (0.67);
 see docs/fem.md, "Throughput".
 """
 
