@@ -77,7 +77,7 @@ Public: :class:`ConcreteCavity` (the dimensionless material), :func:`solve` (one
 """
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from functools import lru_cache
 
 import numpy as np
@@ -92,8 +92,8 @@ STRUCTURES = {ELASTIC_PLASTIC: "elastic-comminuted", CRACKED: "elastic-cracked-c
               SUPERSEISMIC: "comminuted shock into undisturbed concrete"}
 DEFAULT_STEPS = 256  # RK4 steps across the comminuted zone (see the convergence test)
 # columns of the parameter vector of the compiled functions
-(E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, LOCKED, TENSILE, W, WB, PHI) = range(12)
-NPAR = 12
+(E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, LOCKED, TENSILE, W, WB, PHI, POWER_B, POWER_N) = range(14)
+NPAR = 14
 
 
 @dataclass(frozen=True)
@@ -119,6 +119,12 @@ class ConcreteCavity:
         Modulus ``K_l / f_c`` past the locking strain (> 0; ``inf``: rigid).
     tensile : float
         Tensile strength ``f_t / f_c`` (> 0; ``inf``: no cracking).
+    power_B, power_N : float
+        The comminuted (fully damaged) strength as a power law of the pressure,
+        ``D = min(B p^N, tau_max)`` (Holmquist, Johnson and Cook 1993: ``B = 1.6``,
+        ``N = 0.61``), ``B > 0``, ``N`` in ``(0, 1]``. Default ``power_B = nan``: the straight
+        line ``tau_0 + lam p``. The intact material ahead of the comminution front yields on the
+        straight line in either case.
     """
 
     modulus: float
@@ -129,6 +135,19 @@ class ConcreteCavity:
     eta_lock: float = 0.0
     bulk_locked: float = math.inf
     tensile: float = math.inf
+    power_B: float = math.nan
+    power_N: float = 1.0
+
+    def __repr__(self):
+        """The fields, the power law's only when it is used (no ``nan`` in a message)."""
+        names = [f.name for f in fields(self)
+                 if self.power_law or f.name not in ("power_B", "power_N")]
+        return f"ConcreteCavity({', '.join(f'{n}={getattr(self, n)!r}' for n in names)})"
+
+    @property
+    def power_law(self):
+        """True when the comminuted strength is ``B p^N`` (:attr:`power_B` given)."""
+        return not math.isnan(self.power_B)
 
     def __post_init__(self):
         for name in ("modulus", "nu", "lam", "eta_lock"):
@@ -143,6 +162,11 @@ class ConcreteCavity:
                 self.bulk_locked)
         require(0.0 <= self.eta_lock <= 0.9, "eta_lock", "in [0, 0.9]", self.eta_lock)
         require(self.tensile > 0.0, "tensile", "f_t/f_c > 0 (inf: no cracking)", self.tensile)
+        if self.power_law:
+            require(is_finite_number(self.power_B) and self.power_B > 0.0, "power_B",
+                    "a finite number > 0 (nan: the straight line)", self.power_B)
+            require(is_finite_number(self.power_N) and 0.0 < self.power_N <= 1.0, "power_N",
+                    "in (0, 1]", self.power_N)
 
     @property
     def shear(self):
@@ -164,6 +188,7 @@ class ConcreteCavity:
         p[TAU0], p[TAU_MAX], p[BULK] = 1.0 - self.lam / 3.0, self.tau_max, self.bulk
         p[ETA], p[LOCKED], p[TENSILE] = self.eta_lock, self.bulk_locked, self.tensile
         p[W], p[WB], p[PHI] = w, wb, phi
+        p[POWER_B], p[POWER_N] = self.power_B, self.power_N
         return p
 
 
@@ -247,24 +272,61 @@ def crack_amplitude(p, x):
 
 
 @njit(cache=True, error_model="numpy")
+def power_pressure(p, s):
+    """Pressure ``q >= 0`` with ``q + (2/3) B q^N = s`` (comminuted power law below the cap) and
+    ``dq/ds``. The left side is increasing and concave in ``q``: Newton from ``q = s`` lands below
+    the root once, then climbs to it monotonically; kept inside the bracket ``[0, s]``."""
+    if not s > 0.0:
+        return s, 1.0
+    B, N = p[POWER_B], p[POWER_N]
+    lo, hi = 0.0, s
+    q = s
+    for _ in range(100):
+        g = q + 2.0 * B * q ** N / 3.0 - s
+        if g > 0.0:
+            hi = q
+        else:
+            lo = q
+        slope = 1.0 + 2.0 * B * N * q ** (N - 1.0) / 3.0 if q > 0.0 else np.inf
+        step = g / slope
+        q_new = q - step
+        if not lo <= q_new <= hi:
+            q_new = 0.5 * (lo + hi)
+        done = abs(q_new - q) <= 1e-13 * s
+        q = q_new
+        if done:
+            break
+    slope = 1.0 + 2.0 * B * N * q ** (N - 1.0) / 3.0 if q > 0.0 else np.inf
+    return q, 1.0 / slope
+
+
+@njit(cache=True, error_model="numpy")
+def strength(p, s, capped):
+    """``(D, pressure, dpressure/ds)`` of the comminuted zone at radial stress ``s``, on the
+    cap (``capped``) or below it: the straight line ``tau_0 + lam p`` or the power law
+    ``B p^N`` (:attr:`ConcreteCavity.power_B`)."""
+    cap = p[TAU_MAX]
+    if capped:
+        return cap, s - 2.0 * cap / 3.0, 1.0
+    if math.isnan(p[POWER_B]):
+        lam, tau0 = p[LAM], p[TAU0]
+        scale = 1.0 / (1.0 + 2.0 * lam / 3.0)
+        pressure = (s - 2.0 * tau0 / 3.0) * scale
+        return tau0 + lam * pressure, pressure, scale
+    pressure, dp = power_pressure(p, s)
+    return p[POWER_B] * max(pressure, 0.0) ** p[POWER_N], pressure, dp
+
+
+@njit(cache=True, error_model="numpy")
 def constitutive(p, s, branch=np.nan):
     """``(D, R, dR/ds)`` of the comminuted zone at radial stress ``s``; ``R = nan`` if the
     hydrostat is past full compaction. The pieces of the law (below or above the cap and the
     locking pressure) are chosen at ``branch`` (default ``s``), so that a step ending or
     starting at a kink stays on one side of it."""
-    lam, tau0, cap = p[LAM], p[TAU0], p[TAU_MAX]
     b = s if math.isnan(branch) else branch
-    scale = 1.0 / (1.0 + 2.0 * lam / 3.0)
-    capped = tau0 + lam * (b - 2.0 * tau0 / 3.0) * scale > cap
-    if capped:
-        D = cap
-        pressure = s - 2.0 * cap / 3.0
-        dp = 1.0
-    else:
-        pressure = (s - 2.0 * tau0 / 3.0) * scale
-        D = tau0 + lam * pressure
-        dp = scale
-    b_pressure = b - 2.0 * cap / 3.0 if capped else (b - 2.0 * tau0 / 3.0) * scale
+    capped = b > kink_stresses(p)[0]
+    D, pressure, dp = strength(p, s, capped)
+    b_pressure = strength(p, b, capped)[1]
     eta, compliance = hydrostat(p, pressure, b_pressure)
     if eta >= 1.0:
         return D, np.nan, np.nan
@@ -317,16 +379,24 @@ def _rk4(p, t, s, U, h, floor=-np.inf, ceiling=np.inf):
 
 @njit(cache=True, error_model="numpy")
 def kink_stresses(p):
-    """Radial stresses of the comminuted zone's kinks: where ``tau_0 + lam p`` reaches
-    ``tau_max`` and where the hydrostat locks (inf: none)."""
+    """Radial stresses of the comminuted zone's kinks: where the strength below the cap
+    (``tau_0 + lam p`` or ``B p^N``) reaches ``tau_max`` and where the hydrostat locks (inf:
+    none)."""
     lam, cap = p[LAM], p[TAU_MAX]
     s_cap = np.inf
-    if lam > 0.0 and math.isfinite(cap):
-        s_cap = (cap - p[TAU0]) / lam + 2.0 * cap / 3.0
+    if math.isfinite(cap):
+        if not math.isnan(p[POWER_B]):
+            s_cap = (cap / p[POWER_B]) ** (1.0 / p[POWER_N]) + 2.0 * cap / 3.0
+        elif lam > 0.0:
+            s_cap = (cap - p[TAU0]) / lam + 2.0 * cap / 3.0
     p_lock = lock_pressure(p)
     s_lock = np.inf
     if p_lock > 0.0 and math.isfinite(p_lock):
-        s_lock = p_lock + 2.0 * min(p[TAU0] + lam * p_lock, cap) / 3.0
+        if math.isnan(p[POWER_B]):
+            below = p[TAU0] + lam * p_lock
+        else:
+            below = p[POWER_B] * p_lock ** p[POWER_N]
+        s_lock = p_lock + 2.0 * min(below, cap) / 3.0
     return s_cap, s_lock
 
 

@@ -11,7 +11,10 @@ from cavex.input_files import in_file, read_toml
 from cavex.materials import Material, Projectile, Target
 
 LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c", "bottom",
-              "scab_depth"}
+              "scab_depth", "tau_max", "tensile_strength", "law_A", "law_B", "tunnel_wall"}
+#: FE-only layer keys (docs/config.md), written back only when given: targets without them keep
+#: their tables and fingerprints
+OPTIONAL_LAYER_KEYS = ("tau_max", "tensile_strength")
 BOTTOM_KEYS = ("bottom", "scab_depth")  # how a layer's bottom face holds: not on the last layer
 PROJECTILE_KEYS = {"r", "l", "R", "crh", "m", "V0", "length", "inertia", "cg", "mu"}
 TOP_KEYS = {"projectile", "layers"}
@@ -51,7 +54,7 @@ def parse_config(data):
 def parse_target(layers):
     """Build a :class:`Target` from a list of ``[[layers]]`` tables."""
     require(isinstance(layers, list) and layers, "layers", "a non-empty array of tables", layers)
-    materials, thicknesses, bottoms, scabs = [], [], [], []
+    materials, thicknesses, bottoms, scabs, laws, walls = [], [], [], [], [], []
     for i, table in enumerate(layers):
         where = f"layers[{i}]."
         require(isinstance(table, dict), f"layers[{i}]", "a table", table)
@@ -69,12 +72,19 @@ def parse_target(layers):
                    if k not in ("name", "bottom")}
         thickness = numbers.pop("thickness", None)
         scab = numbers.pop("scab_depth", None)
+        law = numbers.pop("law_A", None), numbers.pop("law_B", None)
+        if (law[0] is None) != (law[1] is None):
+            missing = "law_B" if law[1] is None else "law_A"
+            raise CavexInputError("must be given with law_A and law_B both (the plain law "
+                                  "S = A + B rho V^2 / tau)", f"{where}{missing}")
+        laws.append(None if law[0] is None else law)
+        walls.append(numbers.pop("tunnel_wall", 1.0))
         materials.append(prefixed(Material, where, name=table.get("name", ""), **numbers))
         if thickness is not None:
             thicknesses.append(thickness)
             bottoms.append(table.get("bottom", "bonded"))
             scabs.append(scab)
-    return prefixed(Target, "", materials, thicknesses, bottoms, scabs)
+    return prefixed(Target, "", materials, thicknesses, bottoms, scabs, laws, walls)
 
 
 def parse_projectile(table):
@@ -105,6 +115,13 @@ def target_table(target):
                 table["scab_depth"] = float(target.scab_depths[i])
         table.update(E=float(material.E), nu=float(material.nu), rho=float(material.rho),
                      lam=float(material.lam), tau=float(material.tau))
+        for key in OPTIONAL_LAYER_KEYS:
+            if getattr(material, key) is not None:
+                table[key] = float(getattr(material, key))
+        if target.plain_laws[i] is not None:  # absent keys are not written: the tables
+            table["law_A"], table["law_B"] = target.plain_laws[i]  # and fingerprints stay
+        if target.tunnel_walls[i] != 1.0:  # the default is not written (fingerprints)
+            table["tunnel_wall"] = target.tunnel_walls[i]
         tables.append(table)
     return tables
 

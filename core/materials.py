@@ -47,6 +47,14 @@ class Material:
     name : str, optional
     sigma_c : float, optional
         Unconfined compressive strength (Pa), > 0, from which ``tau`` is derived.
+    tau_max : float, optional
+        Tresca cap (Pa) on the strength: ``sigma_r - sigma_theta <= min(lam sigma + tau,
+        tau_max)``; at least the uniaxial compressive strength ``3 tau/(3 - lam)``. None (the
+        default): no cap. Used by the FE only (docs/fem.md "Concrete").
+    tensile_strength : float, optional
+        Tension cut-off (Pa) on the least compressive principal stress, ``sigma_3 >=
+        -tensile_strength``, in (0, 3 tau/(3 - lam)]; None (the default): the FE's
+        ``tension_cutoff`` setting (through the cone's apex unless set). FE only.
     """
 
     E: float
@@ -56,6 +64,8 @@ class Material:
     tau: float | None = None
     name: str = ""
     sigma_c: float | None = field(default=None, compare=False)
+    tau_max: float | None = None
+    tensile_strength: float | None = None
 
     def __post_init__(self):
         require(isinstance(self.name, str), "name", "a string", self.name)
@@ -73,6 +83,24 @@ class Material:
                     self.tau)
             object.__setattr__(self, "tau", derived)
         _positive("tau", self.tau)
+        uniaxial = self.uniaxial_strength
+        if self.tau_max is not None:
+            _positive("tau_max", self.tau_max)
+            require(self.tau_max >= uniaxial * (1.0 - 1e-12), "tau_max",
+                    f">= the uniaxial compressive strength 3 tau/(3 - lam) = {uniaxial:.6g} Pa "
+                    "(a cap below it)", self.tau_max)
+        if self.tensile_strength is not None:
+            _positive("tensile_strength", self.tensile_strength)
+            require(self.tensile_strength <= uniaxial * (1.0 + 1e-12), "tensile_strength",
+                    f"<= the uniaxial compressive strength 3 tau/(3 - lam) = {uniaxial:.6g} Pa",
+                    self.tensile_strength)
+
+    @property
+    def uniaxial_strength(self):
+        """Unconfined compressive strength ``3 tau / (3 - lam)`` (Pa) of the Mohr-Coulomb
+        line (uniaxial compression: ``sigma_r - sigma_theta = sigma_c`` at ``sigma =
+        sigma_c/3``)."""
+        return 3.0 * self.tau / (3.0 - self.lam)
 
     @cached_property
     def alpha(self):
@@ -105,6 +133,11 @@ class Material:
 #: (the interface opens: a traction-free rear face, a rear zone, a crater in the next layer;
 #: docs/analytic.md "Debonded interfaces").
 BONDINGS = ("bonded", "debonded")
+#: ranges of a layer's plain-law constants ``law_A``, ``law_B`` (``S = A + B rho V^2 / tau``):
+#: wide of published numbers (Forrestal's concrete S ~ 4-20 in units of f_c, i.e. A ~ 5-30 in
+#: units of tau; B ~ 1; soils B ~ 1-3) and bounded where the stresses stay finite
+LAW_A_RANGE = (0.0, 1e3)
+LAW_B_RANGE = (0.0, 100.0)
 
 
 @dataclass(frozen=True)
@@ -114,12 +147,19 @@ class Target:
     ``bottoms[i]`` (one of :data:`BONDINGS`, default all "bonded") is how the bottom face of
     layer ``i`` (interface ``i + 1``) holds; ``scab_depths[i]`` (m, > 0, less than the layer's
     thickness; None: the rule of :func:`cavex.analytic.penetration.zones.scab_depth`) is the
-    depth of the rear zone above a debonded interface."""
+    depth of the rear zone above a debonded interface. ``plain_laws[i]`` (None: not given) is
+    layer ``i``'s plain law ``(A, B)`` (``law_A``, ``law_B`` of a layer, dimensionless,
+    :data:`LAW_A_RANGE`, :data:`LAW_B_RANGE`): ``S = A + B rho V^2 / tau``, i.e. the wall
+    stress ``tau (A + B rho V^2 / tau)``, used by ``cavex trajectory --resistance law``.
+    ``tunnel_walls[i]`` (in [0, 1], default 1) scales the load of the 3-D model's shank in
+    layer ``i``: a sensitivity setting, uncalibrated (docs/oblique.md "Tunnel wall")."""
 
     layers: tuple
     thicknesses: tuple
     bottoms: tuple = ()
     scab_depths: tuple = ()
+    plain_laws: tuple = ()
+    tunnel_walls: tuple = ()
 
     def __post_init__(self):
         object.__setattr__(self, "layers", tuple(self.layers))
@@ -141,6 +181,25 @@ class Target:
                 require(is_finite_number(scab) and 0.0 < scab < self.thicknesses[i],
                         f"layers[{i}].scab_depth", f"in (0, {self.thicknesses[i]:g}) m (within "
                         "the layer)", scab)
+        laws = tuple(self.plain_laws) or (None,) * len(self.layers)
+        require(len(laws) == len(self.layers), "law_A", "given per layer (None: no plain law)",
+                len(laws))
+        for i, law in enumerate(laws):
+            if law is None:
+                continue
+            require(len(law) == 2, f"layers[{i}].law_A", "given with law_B", law)
+            for name, value, (lo, hi) in (("law_A", law[0], LAW_A_RANGE),
+                                          ("law_B", law[1], LAW_B_RANGE)):
+                require(is_finite_number(value) and lo <= value <= hi, f"layers[{i}].{name}",
+                        f"in [{lo:g}, {hi:g}] (dimensionless)", value)
+        object.__setattr__(self, "plain_laws", tuple(
+            None if law is None else (float(law[0]), float(law[1])) for law in laws))
+        walls = tuple(self.tunnel_walls) or (1.0,) * len(self.layers)
+        require(len(walls) == len(self.layers), "tunnel_wall", "given per layer", len(walls))
+        for i, wall in enumerate(walls):
+            require(is_finite_number(wall) and 0.0 <= wall <= 1.0, f"layers[{i}].tunnel_wall",
+                    "in [0, 1]", wall)
+        object.__setattr__(self, "tunnel_walls", tuple(float(w) for w in walls))
         object.__setattr__(self, "bottoms", bottoms)
         object.__setattr__(self, "scab_depths", tuple(None if s is None else float(s)
                                                       for s in scabs))
@@ -169,7 +228,15 @@ class Target:
             return self
         require(bonding in BONDINGS, "interfaces", "one of " + ", ".join(BONDINGS), bonding)
         return Target(self.layers, self.thicknesses, (bonding,) * len(self.thicknesses),
-                      self.scab_depths)
+                      self.scab_depths, self.plain_laws, self.tunnel_walls)
+
+    def with_tunnel_wall(self, factor):
+        """This target with every layer's tunnel-wall factor ``factor`` (None: unchanged):
+        what ``--tunnel-wall`` does to the file's ``tunnel_wall`` keys."""
+        if factor is None:
+            return self
+        return Target(self.layers, self.thicknesses, self.bottoms, self.scab_depths,
+                      self.plain_laws, (factor,) * len(self.layers))
 
     def layer_at(self, depth):
         """Index of the layer containing ``depth`` (interfaces belong to the deeper layer)."""
@@ -177,7 +244,8 @@ class Target:
 
     def single(self, index):
         """The semi-infinite target made of layer ``index`` alone."""
-        return Target((self.layers[index],), ())
+        return Target((self.layers[index],), (), plain_laws=(self.plain_laws[index],),
+                      tunnel_walls=(self.tunnel_walls[index],))
 
     def layer_name(self, index):
         """Display name of layer ``index`` (from 0, top down): its ``name``, else

@@ -1,4 +1,4 @@
-r"""Hencky elasticity with Mohr-Coulomb perfect plasticity and a tension cut-off.
+r"""Hencky elasticity with Mohr-Coulomb perfect plasticity, a Tresca cap and a tension cut-off.
 
 Spherical symmetry keeps the principal axes fixed (``r``, ``theta = phi``), so the finite-strain
 return map is exact in principal logarithmic strains. Per quadrature point the total log strains
@@ -21,7 +21,13 @@ Kirchhoff stress with the intercepts scaled by ``J``. With ``s = sign(Q)``:
   ``f_MC = c_s |Q| - lam P - tau J`` with ``c_+ = 1``, ``c_- = (3 + lam)/3``;
 - tension cut-off on the least compressive principal stress ``sigma_3 >= -T``:
   ``f_TC = -sigma_3 - T J`` with ``sigma_3 = P - Q/3`` (``s > 0``) or ``P + 2Q/3`` (``s < 0``).
-  The default ``T = tau/lam`` puts it through the cone's apex (no cut-off for Tresca).
+  The default ``T = tau/lam`` puts it through the cone's apex (no cut-off for Tresca);
+  a layer's ``tensile_strength`` (concrete's ``f_t``) replaces it in that layer;
+- Tresca cap (concrete, Forrestal and Tzou 1997) on the principal stress difference,
+  ``f_cap = |Q| - tau_max J`` (``c = 1`` on both sides), associated (``g_cap = (0, -3/2 s)``:
+  volume-preserving, along ``Q`` at fixed ``P``), so that the strength is
+  ``|sigma_r - sigma_theta| <= min(lam sigma + tau, tau_max)``; ``tau_max = inf`` (the default)
+  is no cap.
 
 Flow: Mohr-Coulomb is non-associated with plastic potential ``g = c_s(psi)|Q| - lam_psi P``
 (``lam_psi = 6 sin psi / (3 - sin psi)`` from the dilatancy angle ``psi``; zero by default, i.e.
@@ -42,7 +48,12 @@ linear, so solved in closed form; the consistent tangent is its exact derivative
 Implementation: one compiled (numba) kernel per point, :func:`return_point`, used by the element
 loop of :mod:`cavex.fem.element` for every case. It tries the Mohr-Coulomb-only return first (one
 multiplier, the common case) and falls back, for that point only, to the multi-surface return
-when the trial state or the Mohr-Coulomb-returned one violates the tension cut-off.
+when the trial state or the Mohr-Coulomb-returned one violates the tension cut-off. With a
+finite cap, a point whose trial or returned deviator exceeds ``tau_max J`` is returned again
+from its trial state by the three-surface return :func:`_capped_point` (the active set, one
+surface or a corner of two, the first of MC, cap, TC, MC+cap, MC+TC, cap+TC with positive
+multipliers that violates no other surface; the same closed-form solve and tangent). Without a
+cap (``inf``) those tests are false and every point takes the code path above, bit for bit.
 An independent numpy implementation of the same equations is kept in ``tests/oracles.py`` and
 compared with this kernel point by point (``tests/test_fem_kernels.py``).
 """
@@ -70,13 +81,20 @@ class PointMaterial:
     tau: np.ndarray
     lam_psi: np.ndarray
     tension: np.ndarray
+    cap: np.ndarray | None = None  # Tresca cap tau_max (Pa); None: inf everywhere (no cap)
+
+    def __post_init__(self):
+        if self.cap is None:
+            self.cap = np.full(np.shape(self.K), np.inf)
 
     @classmethod
     def from_layers(cls, layers, layer_of_point, dilatancy_deg=0.0, tension_cutoff=None):
         """Constants at points whose layer index is ``layer_of_point`` (int array).
 
         ``tension_cutoff`` is ``None`` (through the apex, ``tau/lam``), a number (Pa) applied to
-        every layer, or a sequence with one value per layer.
+        every layer, or a sequence with one value per layer. A layer's own ``tensile_strength``
+        (:class:`cavex.materials.Material`, when given) takes the place of ``tension_cutoff``
+        in that layer; its ``tau_max`` (None: no cap) is the Tresca cap.
         """
         pick = np.asarray(layer_of_point)
 
@@ -89,6 +107,9 @@ class PointMaterial:
             cut = [float(tension_cutoff)] * len(layers)
         else:
             cut = list(tension_cutoff)
+        cut = [cut[i] if getattr(m, "tensile_strength", None) is None else m.tensile_strength
+               for i, m in enumerate(layers)]
+        caps = [np.inf if getattr(m, "tau_max", None) is None else m.tau_max for m in layers]
         sin_psi = np.sin(np.radians(dilatancy_deg))
         lam_psi = 6.0 * sin_psi / (3.0 - sin_psi)
         return cls(K=per_layer([m.bulk_modulus for m in layers]),
@@ -96,7 +117,7 @@ class PointMaterial:
                    lam=per_layer([m.lam for m in layers]),
                    tau=per_layer([m.tau for m in layers]),
                    lam_psi=np.full(pick.shape, lam_psi),
-                   tension=per_layer(cut))
+                   tension=per_layer(cut), cap=per_layer(caps))
 
 
 
@@ -218,9 +239,102 @@ def _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_
 
 
 @njit(cache=True, error_model="numpy")
-def return_point(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, out):
+def _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap,
+                  out):
+    """Three-surface return (Mohr-Coulomb, Tresca cap, tension cut-off; one surface or a
+    corner of two) from the trial state; returns ``plastic``.
+
+    The active set is the first of MC, cap, TC, MC+cap, MC+TC, cap+TC (single surfaces only
+    where the trial state violates them) whose multipliers are positive and whose returned
+    state violates no other surface (within ``1e-12 tau J``); if round-off leaves none
+    admissible, the one with the smallest violation.
+    """
+    P_tr = -K * (theta - theta_p)
+    Q_tr = -2.0 * G * (gamma - gamma_p)
+    pos = Q_tr >= 0.0
+    sign = 1.0 if pos else -1.0
+    c_mc = 1.0 if pos else (3.0 + lam) / 3.0
+    c_psi = 1.0 if pos else (3.0 + lam_psi) / 3.0
+    # surfaces k = 0 (MC), 1 (cap), 2 (TC): f_k = a0[k] P + a1[k] Q - k_k J, flow g_k
+    a0 = (-lam, 0.0, -1.0)
+    a1 = (c_mc * sign, sign, 1.0 / 3.0 if pos else -2.0 / 3.0)
+    kJ = (tau * J, cap * J, tension * J)
+    g0 = (lam_psi, 0.0, 1.0)
+    g1 = (-1.5 * c_psi * sign, -1.5 * sign, -0.5 if pos else 1.0)
+    d0 = (-K * g0[0], -K * g0[1], -K * g0[2])
+    d1 = (-2.0 * G * g1[0], -2.0 * G * g1[1], -2.0 * G * g1[2])
+    f = (a0[0] * P_tr + a1[0] * Q_tr - kJ[0], a0[1] * P_tr + a1[1] * Q_tr - kJ[1],
+         a0[2] * P_tr + a1[2] * Q_tr - kJ[2])
+    tol = 1e-12 * tau * J
+    E00, E11 = -K, -2.0 * G
+    T00, T01, T10, T11 = E00, 0.0, 0.0, E11
+    m = (0.0, 0.0, 0.0)
+    elastic = f[0] <= tol and f[1] <= tol and f[2] <= tol
+    if not elastic:
+        best = np.inf
+        for s in range(6):
+            i = s if s < 3 else (0 if s < 5 else 1)
+            j = -1 if s < 3 else (1 if s == 3 else 2)
+            if j < 0 and not f[i] > tol:
+                continue
+            Gii = a0[i] * d0[i] + a1[i] * d1[i]
+            if j < 0:
+                li, lj = f[i] / Gii, 0.0
+                j = i  # no second surface: its multiplier is zero
+            else:
+                Gij = a0[i] * d0[j] + a1[i] * d1[j]
+                Gji = a0[j] * d0[i] + a1[j] * d1[i]
+                Gjj = a0[j] * d0[j] + a1[j] * d1[j]
+                det = Gii * Gjj - Gij * Gji
+                li = (Gjj * f[i] - Gij * f[j]) / det
+                lj = (Gii * f[j] - Gji * f[i]) / det
+            dP = li * d0[i] + lj * d0[j] if j != i else li * d0[i]
+            dQ = li * d1[i] + lj * d1[j] if j != i else li * d1[i]
+            P = P_tr - dP
+            Q = Q_tr - dQ
+            worst = max(-li, -lj)
+            for k in range(3):
+                worst = max(worst, a0[k] * P + a1[k] * Q - kJ[k])
+            if not worst < best:          # NaN (a singular corner) or no better
+                continue
+            best = worst
+            second = lj if j != i else 0.0
+            m = ((li if i == 0 else 0.0) + (second if j == 0 else 0.0),
+                 (li if i == 1 else 0.0) + (second if j == 1 else 0.0),
+                 (li if i == 2 else 0.0) + (second if j == 2 else 0.0))
+            # tangent T = E - D G^-1 (A E - k J e_theta^T) over the active set
+            r_i0, r_i1 = a0[i] * E00 - kJ[i], a1[i] * E11
+            if j == i:
+                T00 = E00 - d0[i] * r_i0 / Gii
+                T01 = -d0[i] * r_i1 / Gii
+                T10 = -d1[i] * r_i0 / Gii
+                T11 = E11 - d1[i] * r_i1 / Gii
+            else:
+                r_j0, r_j1 = a0[j] * E00 - kJ[j], a1[j] * E11
+                i00, i01, i10, i11 = Gjj / det, -Gij / det, -Gji / det, Gii / det
+                x0, x1 = i00 * r_i0 + i01 * r_j0, i00 * r_i1 + i01 * r_j1
+                y0, y1 = i10 * r_i0 + i11 * r_j0, i10 * r_i1 + i11 * r_j1
+                T00 = E00 - (d0[i] * x0 + d0[j] * y0)
+                T01 = -(d0[i] * x1 + d0[j] * y1)
+                T10 = -(d1[i] * x0 + d1[j] * y0)
+                T11 = E11 - (d1[i] * x1 + d1[j] * y1)
+            if worst <= tol:
+                break
+    out[7] = theta_p + m[0] * g0[0] + m[1] * g0[1] + m[2] * g0[2]
+    out[8] = gamma_p + m[0] * g1[0] + m[1] * g1[1] + m[2] * g1[2]
+    _finish_point(P_tr - m[0] * d0[0] - m[1] * d0[1] - m[2] * d0[2],
+                  Q_tr - m[0] * d1[0] - m[1] * d1[1] - m[2] * d1[2], T00, T01, T10, T11,
+                  lam, tau, J, out)
+    return not elastic
+
+
+@njit(cache=True, error_model="numpy")
+def return_point(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap, out):
     """Return map of one point from its total log strains; writes :data:`OUTPUTS` into
-    ``out`` (length 9) and returns whether the point is plastic in this step."""
+    ``out`` (length 9) and returns whether the point is plastic in this step.
+
+    ``cap`` is the Tresca cap ``tau_max`` (Pa) on ``|sigma_r - sigma_theta|``; ``inf`` (no
+    cap) takes exactly the Mohr-Coulomb/tension code path (the cap tests are false)."""
     theta = eps_r + 2.0 * eps_t
     gamma = eps_r - eps_t
     J = math.exp(theta)
@@ -229,5 +343,12 @@ def return_point(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tensio
     if multi:
         plastic = _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
                                        lam_psi, tension, out)
+    if cap < np.inf:
+        capJ = cap * J
+        tol = 1e-12 * tau * J
+        trial_deviator = 2.0 * G * abs(gamma - gamma_p)
+        if trial_deviator - capJ > tol or abs(out[1] - out[0]) - capJ > tol:
+            plastic = _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
+                                    lam_psi, tension, cap, out)
+        out[6] = max(out[6], abs(out[1] - out[0]) / capJ)
     return plastic
-

@@ -40,8 +40,8 @@ from cavex.fem.constitutive import return_point
 
 @njit(cache=True, error_model="numpy")
 def assemble_cases(u, Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_weights, K, G,
-                   lam, tau, lam_psi, tension, theta_p, gamma_p, el_start, el_count, skip, p, f,
-                   band, tau_r, tau_t, th_p_new, ga_p_new, plastic, yield_ratio, folded,
+                   lam, tau, lam_psi, tension, cap, theta_p, gamma_p, el_start, el_count, skip, p,
+                   f, band, tau_r, tau_t, th_p_new, ga_p_new, plastic, yield_ratio, folded,
                    force_scale):
     """Response, internal force and banded tangent at the radial dofs ``u`` of every case ``c``
     with ``not skip[c]``.
@@ -85,7 +85,7 @@ def assemble_cases(u, Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_we
                 plastic[e, q] = return_point(math.log1p(Gr[e, q]), math.log1p(Gt[e, q]),
                                              theta_p[e, q], gamma_p[e, q], K[e, q], G[e, q],
                                              lam[e, q], tau[e, q], lam_psi[e, q],
-                                             tension[e, q], out)
+                                             tension[e, q], cap[e, q], out)
                 tau_r[e, q] = out[0]
                 tau_t[e, q] = out[1]
                 for i in range(4):

@@ -144,7 +144,7 @@ class Stack:
             self._gradients = (np.zeros(self.R_points.shape), np.zeros(self.R_points.shape))
         assemble_cases(u, *self._gradients, self.element_dofs, self.dNdR, self.N, self.R_points,
                        self.weights, self.force_weights, m.K, m.G, m.lam, m.tau, m.lam_psi,
-                       m.tension, theta_p, gamma_p, self.el_start, self.el_count, skip,
+                       m.tension, m.cap, theta_p, gamma_p, self.el_start, self.el_count, skip,
                        self.degree, f, band, resp.tau_r, resp.tau_t, resp.theta_p,
                        resp.gamma_p, resp.plastic, resp.yield_ratio, folded, scale)
         return out

@@ -23,10 +23,17 @@ cavex validate --shots examples/shots_forrestal1994.csv --calibration \
   results/validation/calibration_derived-quasi-static.toml results/validation/calibration_paper.toml \
   results/validation/calibration_table.toml results/validation/calibration_derived-dynamic.toml \
   --out results/validation --no-progress > /dev/null
+cavex validate --shots examples/shots_compilation_dev.csv --out results/validation/compilation_dev \
+  --no-progress > /dev/null
 cavex verify --no-progress > /dev/null
 python -m cavex.verification.studies.oblique_study --no-progress > /dev/null
+# the same study with debonded interfaces: on another CPU the rows its report.md lists under
+# "Reproducibility" (one_ulp_stable = no in study.csv) may read differently
+python -m cavex.verification.studies.oblique_study --interfaces debonded --no-progress \
+  --out results/oblique/debonded > /dev/null
 shot=$(mktemp -d)  # the command's own figures of the paper's 20 deg, 600 m/s shot (PNGs only)
 cavex trajectory --obliquity 20 --velocity 600 --compare-homogeneous --out "$shot" > /dev/null
 cp "$shot"/*.png results/oblique/shot_20deg_600/ && rm -r "$shot"
 python -m cavex.verification.studies.concrete_validation --workers 2 > /dev/null
+python -m cavex.verification.studies.concrete_fe > /dev/null
 git status --short results

@@ -17,12 +17,12 @@ from cavex.fem.constitutive import OUTPUTS, PointMaterial, return_point
 
 
 @njit(cache=True, error_model="numpy")
-def _return_points(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, out,
+def _return_points(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap, out,
                    plastic):
     row = np.empty(9)
     for i in range(eps_r.size):
         plastic[i] = return_point(eps_r[i], eps_t[i], theta_p[i], gamma_p[i], K[i], G[i],
-                                  lam[i], tau[i], lam_psi[i], tension[i], row)
+                                  lam[i], tau[i], lam_psi[i], tension[i], cap[i], row)
         out[:, i] = row
 
 
@@ -38,7 +38,7 @@ def return_map(eps_r, eps_t, theta_p, gamma_p, material):
             for x in (eps_r, eps_t, theta_p, gamma_p)]
     props = [np.ascontiguousarray(np.broadcast_to(getattr(material, name), shape),
                                   dtype=float).ravel()
-             for name in ("K", "G", "lam", "tau", "lam_psi", "tension")]
+             for name in ("K", "G", "lam", "tau", "lam_psi", "tension", "cap")]
     out = np.empty((len(OUTPUTS), flat[0].size))
     plastic = np.empty(flat[0].size, dtype=np.bool_)
     _return_points(*flat, *props, out, plastic)

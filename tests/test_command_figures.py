@@ -166,7 +166,8 @@ def test_a_normal_shot_draws_notes_not_round_off(tmp_path, drawn, capsys):
 
 @pytest.mark.parametrize("calibrated", [True, False])
 def test_validation_figures(tmp_path, drawn, calibrated):
-    from cavex.verification.commands.validate import write_figures
+    from cavex.verification.commands.validate import FIGURES, REGIME_FIGURES, write_figures
+    from cavex.verification.validation.regimes import REGIMES
 
     result = json.loads((ROOT / "results" / "validation" / "validation.json").read_text())
     if not calibrated:
@@ -174,6 +175,11 @@ def test_validation_figures(tmp_path, drawn, calibrated):
                   "models": [m for m in result["models"] if m.count(" ") == 0]}
     written = write_figures(result, tmp_path)
     panels = 1 + sum(m.count(" ") > 0 for m in result["models"])
+    regimes = [name for name, member in REGIMES.items() if name != "all" and any(
+        member(r["fc_Pa"], r["V0_m_s"], r.get("flag")) for r in result["shots"])]
+    expected = {name: panels for name in FIGURES} | {REGIME_FIGURES[0]: len(regimes),
+                                                     REGIME_FIGURES[1]: 2}
+    assert sorted(Path(p).name for p in written) == sorted(expected)
     for path in written:
-        assert drawn.checked[Path(path).name] == panels
+        assert drawn.checked[Path(path).name] == expected[Path(path).name]
         not_blank(path)

@@ -8,7 +8,15 @@ import pytest
 
 from cavex.verification.cli import main
 from cavex.verification.fedata import table as fe_table
-from cavex.verification.fedata.table_cache import CACHE_ENV, cache_dir, entry_path, load_entry
+from cavex.verification.fedata.table_cache import (
+    CACHE_ENV,
+    SIZE_ENV,
+    cache_dir,
+    entry_path,
+    load_entry,
+    max_bytes,
+    prune,
+)
 from cavex.verification.validation.concrete import shot_target
 from cavex.verification.validation.predict import TableCache, table_velocities
 from cavex.verification.validation.shots import read_shots, shot_projectile
@@ -132,3 +140,34 @@ def test_entry_of_other_solver_settings_or_version_is_not_trusted(tmp_path, tabl
     other.attrs["solver_settings"] = "{}"
     fe_table.write_table(other, entry)
     assert load_entry(entry, target, projectile, velocities) is None
+
+
+def test_prune_deletes_the_least_recently_used_entries_first(tmp_path):
+    """Five 1000-byte entries, modified at t = 1 ... 5, limit 2500 bytes: the three oldest go
+    except the one just stored (t = 1 here), which is kept even though it is the oldest."""
+    import os
+
+    paths = []
+    for k in range(1, 6):
+        path = tmp_path / f"table_{k:016x}.nc"
+        path.write_bytes(b"x" * 1000)
+        os.utime(path, (k, k))
+        paths.append(path)
+    (tmp_path / "other.txt").write_bytes(b"y" * 5000)  # not a table: never counted or deleted
+    deleted = prune(tmp_path, paths[0], 2500)
+    assert deleted == [paths[1], paths[2], paths[3]]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [paths[0].name, paths[4].name, "other.txt"])
+    assert prune(tmp_path, paths[0], 2500) == []
+
+
+def test_size_limit_from_the_environment(capsys, tmp_path, monkeypatch):
+    assert max_bytes({}) == 500e6
+    assert max_bytes({SIZE_ENV: "0.25"}) == 0.25e6
+    for bad in ("0", "-3", "inf", "nan", "lots"):
+        monkeypatch.setenv(SIZE_ENV, bad)
+        code = main(["validate", "--shots", str(SHOTS), "--models", "table", "--out",
+                     str(tmp_path / "v")])
+        out, err = capsys.readouterr()
+        assert (code, out) == (2, "") and err.count("\n") == 1 and f"'{SIZE_ENV}'" in err
+        assert not (tmp_path / "v").exists()

@@ -146,3 +146,35 @@ def test_progress_is_called_once_per_step():
     assert len(seen) == steps
     assert np.array_equal(seen, np.concatenate([s.t[1:] for s in result.solutions]))
     assert seen[-1] == result.end["time_s"]  # the last step ends on the final event
+
+
+def test_debonded_study_marks_rows_that_move_one_ulp_faster():
+    """The debonded study flies every runway shot again one ulp faster (study_cases) and marks
+    each runway row ``one_ulp_stable`` yes/no by whether it reads the same; the report names
+    the rows that move. Constructed: two shots, one whose pitch moves by 0.002 deg."""
+    from cavex.verification.studies.oblique_study import report_md, split_ulp, study_cases
+
+    cases = study_cases((20.0,), (600.0,), interfaces="debonded")
+    assert sum(1 for c in cases if c.get("ulp")) == len(RAMPS)  # runway shots only
+    assert all(c["target"] == "runway" for c in cases if c.get("ulp"))
+    assert not any(c.get("ulp") for c in study_cases((20.0,), (600.0,)))  # bonded: none
+    results = []
+    for v, moved in ((600.0, 0.0), (800.0, 0.002)):
+        for ramp in RAMPS:
+            results.append(_shot(20.0, v, "runway", 1.0, 0.1, [(0.6, 1e4)], 0.8, ramp))
+            results.append(_shot(20.0, v, "first layer only", 1.0, 0.1, [(0.04, 2e4)], 0.7,
+                                 ramp))
+            faster = _shot(20.0, v, "runway", 1.0 + moved, 0.1, [(0.6, 1e4)], 0.8, ramp)
+            results.append({**faster, "ulp": True})
+    nominal, faster = split_ulp(results)
+    assert len(nominal) == 8 and len(faster) == 4
+    lines = table_csv(nominal, faster).splitlines()
+    assert lines[0].endswith(",one_ulp_stable")
+    flags = {(line.split(",")[1], line.split(",")[3]): line.split(",")[-1] for line in lines[1:]}
+    assert flags[("600", "runway")] == "yes" and flags[("800", "runway")] == "no"
+    assert flags[("600", "first layer only")] == ""
+    answers = findings(nominal, [0.65, 1.1])
+    report = report_md(nominal, answers, [0.65, 1.1], faster)
+    assert "## Reproducibility" in report and "20 deg 800 m/s" in report
+    assert "20 deg 600 m/s (ramp" not in report.split("## Reproducibility")[1]
+    assert "one_ulp_stable" not in table_csv(nominal)  # bonded: the columns as before

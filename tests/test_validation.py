@@ -377,7 +377,7 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
         final, rel=DIGITS_6)
     # the JSON of the issue, and the statistics recomputed from it
     assert set(result["summary"]) == {"derived-quasi-static", "derived-dynamic", "paper",
-                                      "table", "concrete", "forrestal-1994",
+                                      "table", "concrete", "li-chen-2003", "forrestal-1994",
                                       "derived-quasi-static calibrated"}
     for model, stats in result["summary"].items():
         ratios = [row["predicted_m"][model] / row["measured_m"] for row in result["shots"]]
@@ -433,13 +433,57 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
         assert row["predicted_m"]["forrestal-1994"] == pytest.approx(
             empirical.shot_depth(shot), rel=DIGITS_6)
     header = (out_dir / "predictions.csv").read_text().splitlines()[0].split(",")
-    assert header[5:] == ["concrete_m", "forrestal_1994_m", "concrete_ratio",
+    assert header[5:] == ["flag", "concrete_m", "forrestal_1994_m", "concrete_ratio",
                           "forrestal_1994_ratio"]
     report = (out_dir / "report.md").read_text()
     sentence = recommendation("concrete", result["summary"])
     assert sentence.startswith("Recommended model: `concrete`") and sentence in report
     assert "--models concrete forrestal-1994" in report
     assert "| derived-dynamic |" not in report and "| table |" not in report
+
+
+def test_validate_reports_by_regime(capsys, tmp_path):
+    """Every regime's statistics recomputed here from the per-shot JSON (the regime of a shot
+    from its f_c, V0 and flag written beside it), Li and Chen's column equal to
+    :func:`concrete_model.li_chen_depth`, the flag equal to :func:`concrete_model.rigid_flag`,
+    the regime table in the report and both regime figures written."""
+    from cavex.verification.validation import concrete_model
+
+    out_dir = tmp_path / "val"
+    code, out, err = run(capsys, "validate", "--shots", SHOTS, "--models", "concrete",
+                         "li-chen-2003", "--json", "--out", str(out_dir))
+    assert code == 0
+    result = json.loads(out)
+    shots = read_shots(SHOTS).shots
+    for row, shot in zip(result["shots"], shots, strict=True):
+        assert row["predicted_m"]["li-chen-2003"] == pytest.approx(
+            concrete_model.li_chen_depth(shot), rel=DIGITS_6)
+        assert row["flag"] == concrete_model.rigid_flag(
+            shot, concrete_model.TableResistance(shot))
+    members = {"all": lambda r: True,
+               "normal strength, V0 <= 1000 m/s": lambda r: r["fc_Pa"] <= 100e6
+               and r["V0_m_s"] <= 1000.0,
+               "V0 > 1000 m/s": lambda r: r["V0_m_s"] > 1000.0,
+               "f_c > 100 MPa": lambda r: r["fc_Pa"] > 100e6,
+               "not flagged non-rigid": lambda r: r["flag"] == ""}
+    expected = {name: [r for r in result["shots"] if member(r)]
+                for name, member in members.items()}
+    assert set(result["regimes"]) == {name for name, rows in expected.items() if rows}
+    for name, stats in result["regimes"].items():
+        for model in ("concrete", "li-chen-2003"):
+            logs = np.log([r["predicted_m"][model] / r["measured_m"] for r in expected[name]])
+            assert stats[model]["n"] == len(logs)
+            assert stats[model]["mean_abs_log_ratio"] == pytest.approx(np.abs(logs).mean(),
+                                                                       rel=DIGITS_6)
+            assert stats[model]["mean_log_ratio"] == pytest.approx(logs.mean(), rel=DIGITS_6)
+    report = (out_dir / "report.md").read_text()
+    assert "## By regime" in report
+    regime_table = report.split("## By regime")[1]
+    line = next(x for x in regime_table.splitlines() if x.startswith("| li-chen-2003 | "))
+    stats = result["regimes"]["all"]["li-chen-2003"]
+    assert f"{stats['mean_abs_log_ratio']:.3f} / {stats['mean_log_ratio']:+.3f}" in line
+    for png in ("by_regime.png", "residuals.png"):
+        assert (out_dir / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_validate_refuses_an_unknown_model_in_one_line(capsys, tmp_path):
@@ -449,7 +493,7 @@ def test_validate_refuses_an_unknown_model_in_one_line(capsys, tmp_path):
     assert (code, out) == (2, "") and err.count("\n") == 1
     assert "'models'" in err and "'li-chen'" in err
     for label in ("derived-quasi-static", "derived-dynamic", "paper", "table", "concrete",
-                  "forrestal-1994"):
+                  "li-chen-2003", "forrestal-1994"):
         assert f"'{label}'" in err
     assert not out_dir.exists()
 
@@ -497,6 +541,33 @@ def test_committed_validation_report_is_consistent():
             empirical.shot_depth(shot), rel=DIGITS_6)
     sentence = verdict(result["held_out_summary"], result["calibrations"])
     assert sentence in (folder / "report.md").read_text()
+
+
+def test_committed_development_validation_is_consistent():
+    """results/validation/compilation_dev/ (the development compilation): every regime's
+    statistics equal the ones recomputed from the per-shot depths and flags written beside
+    them, and the regime table of docs/validation.md is the committed one."""
+    from pathlib import Path
+
+    from cavex.verification.validation.regimes import REGIMES
+
+    folder = Path("results/validation/compilation_dev")
+    result = json.loads((folder / "validation.json").read_text())
+    assert result["shots_file"]["n"] == 286 and result["recommended_model"] == "concrete"
+    for name, models in result["regimes"].items():
+        rows = [r for r in result["shots"] if REGIMES[name](r["fc_Pa"], r["V0_m_s"], r["flag"])]
+        for model, stats in models.items():
+            logs = np.log([r["predicted_m"][model] / r["measured_m"] for r in rows
+                           if r["predicted_m"][model] is not None])
+            assert stats["n"] == len(logs)
+            assert stats["mean_abs_log_ratio"] == pytest.approx(np.abs(logs).mean(),
+                                                                rel=DIGITS_6)
+            assert stats["mean_log_ratio"] == pytest.approx(logs.mean(), rel=DIGITS_6)
+    docs = Path("docs/validation.md").read_text()
+    for model in ("concrete", "li-chen-2003", "forrestal-1994"):
+        cells = [f"{s['mean_abs_log_ratio']:.3f} / {s['mean_log_ratio']:+.3f}"
+                 for s in (result["regimes"][name][model] for name in REGIMES)]
+        assert f"| {model} | " + " | ".join(cells) + " |" in docs
 
 
 def test_a_shot_id_of_any_characters_is_one_markdown_table_cell():

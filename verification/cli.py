@@ -146,9 +146,18 @@ def build_parser():
                             help="contact regularisation: the stress rises linearly over "
                             "0 < V_n < this (m/s; default 0.01; docs/oblique.md)")
     trajectory.add_argument("--law-A", dest="law_A", type=float, help="A of sigma_n = A + B "
-                            "V_n^2 (Pa; required with --resistance law, default: none)")
-    trajectory.add_argument("--law-B", dest="law_B", type=float, help="B (kg/m^3; required "
-                            "with --resistance law, default: none)")
+                            "V_n^2 everywhere (Pa; with --resistance law; default: none, each "
+                            "layer's law_A, law_B keys)")
+    trajectory.add_argument("--law-B", dest="law_B", type=float, help="B (kg/m^3; with "
+                            "--law-A; default: none)")
+    trajectory.add_argument("--tunnel-wall", dest="tunnel_wall", type=float, default=None,
+                            help="factor in [0, 1] on the shank's load in every layer (a "
+                            "sensitivity setting, uncalibrated; default: each layer's "
+                            "tunnel_wall key, else 1; docs/oblique.md)")
+    trajectory.add_argument("--tangency-psi", dest="tangency_psi", type=float, default=0.0,
+                            help="OFPM's attenuation: an element's load falls linearly within "
+                            "this angle of tangency to its velocity (deg in [0, 30]; default "
+                            "0: none; docs/oblique.md)")
     trajectory.add_argument("--no-free-surface", action="store_true",
                             help="no free-surface reduction of the derived law")
     trajectory.add_argument("--compare-homogeneous", action="store_true",

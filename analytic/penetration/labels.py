@@ -16,13 +16,14 @@ RESISTANCES = (*MODELS, "table")
 MODEL_LABELS = ("derived-quasi-static", "derived-dynamic", "paper", "table")
 #: The labels of the models that are not a cavex resistance (no ``--resistance`` choice), which
 #: ``cavex validate`` also predicts with: the concrete cavity-expansion model
-#: (:mod:`cavex.verification.validation.concrete_model`) and Forrestal et al.'s (1994) empirical
-#: formula (:mod:`cavex.verification.validation.empirical`).
+#: (:mod:`cavex.verification.validation.concrete_model`) and the empirical formulas of Li and
+#: Chen (2003) and Forrestal et al. (1994) (:mod:`cavex.verification.validation.empirical`).
 CONCRETE_LABEL = "concrete"
+LI_CHEN_LABEL = "li-chen-2003"  # Li and Chen's (2003) empirical formula
 EMPIRICAL_LABEL = "forrestal-1994"
 #: Every model ``cavex validate`` predicts with (``--models`` choices), in the order of its
 #: columns.
-VALIDATION_LABELS = (*MODEL_LABELS, CONCRETE_LABEL, EMPIRICAL_LABEL)
+VALIDATION_LABELS = (*MODEL_LABELS, CONCRETE_LABEL, LI_CHEN_LABEL, EMPIRICAL_LABEL)
 #: Earlier spellings of a model label (validation's columns, ``calibrate --model``), each with
 #: the label that replaced it; refused with a line that names the new one.
 OLD_LABELS = {"derived quasi-static": "derived-quasi-static",

@@ -39,7 +39,7 @@ from cavex.analytic.penetration.surface_force import (
     rotation_matrix,
     surface_loads,
 )
-from cavex.analytic.penetration.zones import open_zones
+from cavex.analytic.penetration.zones import open_zones, union
 from cavex.errors import CavexNumericalError, is_finite_number, require
 from cavex.materials import MAX_VELOCITY
 
@@ -189,7 +189,8 @@ class ObliqueModel:
     """
 
     def __init__(self, target, projectile, law, *, body=None, bottom=None, rtol=RTOL,
-                 atol=ATOL, method=METHOD, contact_ramp=None, crater="nose-base"):
+                 atol=ATOL, method=METHOD, contact_ramp=None, crater="nose-base",
+                 tangency_psi=0.0):
         self.target, self.projectile, self.law = target, projectile, law
         self.body = body or build_body(projectile)
         self.bottom = bottom
@@ -199,6 +200,15 @@ class ObliqueModel:
                 "contact_ramp", "in [0, 100] m/s", contact_ramp)
         self.contact_ramp = float(contact_ramp)
         self.mu = float(projectile.mu)
+        require(is_finite_number(tangency_psi) and 0.0 <= tangency_psi <= 30.0,
+                "tangency_psi", "in [0, 30] degrees", tangency_psi)
+        # OFPM's attenuation within psi of tangency (docs/oblique.md "Tunnel wall"; 0: none)
+        self.tangency = math.sin(math.radians(tangency_psi)) if tangency_psi > 0.0 else 0.0
+        # the tunnel-wall factors of the layers (Target.tunnel_walls): none when all are 1, so
+        # that the default arithmetic is the same to the bit
+        walls = np.asarray(target.tunnel_walls, dtype=float)
+        self._walls = walls if np.any(walls != 1.0) else np.empty(0)
+        self._wall_depths = np.asarray(target.interface_depths, dtype=float)
         b = self.body
         self._p = b.points
         self._inertia = b.inertia
@@ -218,9 +228,11 @@ class ObliqueModel:
         b = self.body
         self.opened = np.array([z for z in self.zones if z[0] < depth or (
             z[0] == depth and depth > 0.0)], dtype=float).reshape(-1, 2)
+        walls = np.array(union(self.opened.tolist()), dtype=float).reshape(-1, 2)
         self._surface = (b.points, b.normals, b.areas, b.sizes, b.partners, b.length, self.mu,
                          self.contact_ramp, np.inf if self.bottom is None else float(self.bottom),
-                         b.nose, self.opened, *self.law.data)
+                         b.nose, walls, self._walls, self._wall_depths, self.tangency,
+                         *self.law.data)
 
     # -- forces ---------------------------------------------------------------------------
     def loads(self, y, surface=None):
@@ -333,7 +345,8 @@ class ObliqueModel:
                 if interface is not None:  # the layer the tip has just entered
                     label = self.target.layer_name(interface + 1 if directions[which] > 0
                                                    else interface)
-                if directions[which] > 0 and self.zones:  # deeper: zones open at this top
+                if directions[which] > 0 and self.zones and which < args[2].size:
+                    # a depth event, deeper: zones open at this top
                     self._open_zones(float(args[2][which]))
                 directions[which] = -directions[which]
             else:
@@ -464,7 +477,7 @@ class ObliqueModel:
 
 def fly(target, projectile, strike=None, resistance="derived", *, body=None, bottom=None,
         rtol=RTOL, atol=ATOL, method=METHOD, contact_ramp=None, progress=None,
-        **law_options):
+        tangency_psi=0.0, **law_options):
     """One trajectory: :class:`Result` of ``strike`` (default: normal incidence at ``V0``);
     ``progress(t, y)`` is called after every integrator step."""
     strike = strike or Strike(projectile.V0)
@@ -473,7 +486,8 @@ def fly(target, projectile, strike=None, resistance="derived", *, body=None, bot
             "traction-free sphere)", "debonded")
     law = make_law(target, projectile, resistance, bottom=bottom, **law_options)
     model = ObliqueModel(target, projectile, law, body=body, bottom=bottom, rtol=rtol,
-                         atol=atol, method=method, contact_ramp=contact_ramp)
+                         atol=atol, method=method, contact_ramp=contact_ramp,
+                         tangency_psi=tangency_psi)
     return model.run(strike, progress=progress)
 
 

@@ -26,6 +26,9 @@ Every law is one compiled function of the element's depth ``z``, the vertical co
   interpolant, then bilinear; depths outside the table take its end rows; normal velocities
   beyond its largest velocity are refused.
 - :class:`PlainLaw` (``DEPTH_QUADRATIC`` on one depth): ``sigma_n = A + B V_n^2`` everywhere.
+- :class:`LayerPlainLaw` (``LAYER_QUADRATIC``): each layer's own plain law (its ``law_A``,
+  ``law_B`` keys), ``sigma_n = tau_k (A_k + B_k rho_k V_n^2 / tau_k)`` in the element's layer
+  ``k`` (the layer holding its depth ``z``).
 """
 
 
@@ -44,7 +47,7 @@ from cavex.problem import BOUNDARIES
 
 HORIZONTAL = 1e-12  # |n_z| below which a normal counts as horizontal
 FAR = 1e6  # m: interface radius standing for "never met"
-DEPTH_QUADRATIC, TABLE, DERIVED = range(3)
+DEPTH_QUADRATIC, TABLE, DERIVED, LAYER_QUADRATIC = range(4)
 OK, WALK_FAILED, BEYOND_TABLE, NOT_FINITE = range(4)
 RESISTANCES = ("derived", "paper", "table", "law")
 _EMPTY1 = np.empty(0)
@@ -107,13 +110,17 @@ def element_stress(kind, scalars, values, tables, counts, depths, z, nz, vn, rad
     (``sigma_n`` NaN); ``BEYOND_TABLE`` (``sigma_n`` at the table's largest velocity).
     ``scalars`` per kind: ``DEPTH_QUADRATIC`` ``(offset, L_0, dL)`` with ``values[:, 0:2] =
     (s_0, s_2)``; ``TABLE`` ``(offset, L_0, dL, dV2)`` with ``values[i, j]`` at
-    ``(L_0 + i dL, j dV2)``; ``DERIVED`` ``(a, free surface, bottom, dynamic)`` with the
+    ``(L_0 + i dL, j dV2)``; ``LAYER_QUADRATIC`` ``values[k, 0:2] = (s_0, s_2)`` of layer
+    ``k`` (interfaces ``depths``); ``DERIVED`` ``(a, free surface, bottom, dynamic)`` with the
     material tables of every (own layer, direction) group and ``values`` the traction-free
     faces ``(2, n)`` below and above each layer (``inf`` / ``-inf``: none). ``radii``
     ``(1, >= n - 1)`` and
     ``zones`` ``(0, 1, 2)`` are scratch."""
     if kind == DERIVED:
         return _derived(scalars, values, tables, counts, depths, z, nz, vn, radii, zones)
+    if kind == LAYER_QUADRATIC:  # the element's own layer's (s_0, s_2)
+        k = np.searchsorted(depths, z, side="right")
+        return values[k, 0] + values[k, 1] * vn * vn, OK
     depth = z + scalars[0]
     if kind == DEPTH_QUADRATIC:
         return (_lerp(depth, scalars[1], scalars[2], 0, values)
@@ -273,6 +280,25 @@ class PlainLaw(_Law):
                      _EMPTY3, _NO_COUNTS, _EMPTY1)
 
 
+class LayerPlainLaw(_Law):
+    """Each layer's plain law ``S_k = A_k + B_k rho_k V_n^2 / tau_k`` (the target's
+    ``plain_laws``, the layers' ``law_A``, ``law_B`` keys): ``sigma_n = tau_k S_k`` in the
+    element's own layer (module docstring)."""
+
+    name = "law"
+
+    def __init__(self, target):
+        for i, law in enumerate(target.plain_laws):
+            if law is None:
+                raise CavexInputError("must be given on every layer for --resistance law "
+                                      "without --law-A/--law-B (the plain law S = A + B rho "
+                                      "V^2 / tau of each layer)", f"layers[{i}].law_A")
+        values = np.array([[m.tau * A, B * m.rho] for m, (A, B)
+                           in zip(target.layers, target.plain_laws, strict=True)])
+        self.data = (LAYER_QUADRATIC, np.zeros(1), values, _EMPTY3, _NO_COUNTS,
+                     np.asarray(target.interface_depths, dtype=float))
+
+
 def make_law(target, projectile, resistance="derived", *, boundary="dynamic",
              free_surface=True, table=None, law_A=None, law_B=None, epsilon="quasi-static",
              bottom=None):
@@ -287,6 +313,8 @@ def make_law(target, projectile, resistance="derived", *, boundary="dynamic",
         require(table is not None, "table", "given for --resistance table", None)
         from cavex.analytic.penetration.tabulated import TabulatedResistance
         return TableLaw(TabulatedResistance(table, target, projectile))
+    if law_A is None and law_B is None:  # each layer's own law_A, law_B
+        return LayerPlainLaw(target)
     require(law_A is not None and law_B is not None, "law_A", "given with law_B for "
             "--resistance law", law_A)
     return PlainLaw(law_A, law_B)

@@ -14,9 +14,12 @@ embedded fraction ``w = clip(1/2 + z/h_i, 0, 1)`` (and ``clip(1/2 + (z_b - z)/h_
 a finite bottom ``z_b``; for a shank element and each open zone ``[z_t, z_b]``
 (:func:`cavex.analytic.penetration.zones.open_zones`, opened by the integrator's events) at
 most ``1 - |[z - h_i/2, z + h_i/2] ∩ [z_t, z_b]| / h_i``: no tunnel wall in a crater or a
-scabbed rear zone). A wetted element (``w > 0`` and ``V_n > 10^-9 (|v| + L |omega|)``,
+scabbed rear zone; times the tunnel-wall factor ``walls[k]`` of its layer ``k``, none: 1).
+A wetted element (``w > 0`` and ``V_n > 10^-9 (|v| + L |omega|)``,
 the round-off guard) carries the load ``P = A_i w sigma_n(z, n_3, V_n) min(V_n / V_r, 1)``
-(contact regularisation over ``0 < V_n < V_r``, ``V_r`` = ``contact_ramp``; 0: none), force
+(contact regularisation over ``0 < V_n < V_r``, ``V_r`` = ``contact_ramp``; 0: none; with
+OFPM's tangency attenuation ``tangency = sin psi`` > 0, ``V_r = max(contact_ramp, |u| sin psi)``:
+the load falls linearly within ``psi`` of tangency), force
 
 .. math:: \mathbf f = -P (\mathbf n + \mu \mathbf t), \quad
           \mathbf t = \mathbf u_t / |\mathbf u_t|, \quad
@@ -114,8 +117,8 @@ def mirror_state(y):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, contact_ramp, bottom,
-                  nose, open_zones, kind, scalars, values, tables, counts, depths, radii, zones,
-                  out, damping):
+                  nose, open_zones, walls, wall_depths, tangency, kind, scalars, values, tables,
+                  counts, depths, radii, zones, out, damping):
     """Force, moment about the centre of mass (target frame) and power of element ``i``
     into ``out[0:7]``, its contact damping ``kappa b a^T`` (module docstring, target frame)
     into ``damping``; returns ``(status, V_n)``."""
@@ -128,12 +131,18 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
     frac = min(max(0.5 + z / sizes[i], 0.0), 1.0)
     if bottom < np.inf:
         frac = min(frac, min(max(0.5 + (bottom - z) / sizes[i], 0.0), 1.0))
-    if not nose[i]:  # the shank carries no load in an open zone (crater, scabbed rear zone)
+    if not nose[i] and open_zones.shape[0] > 0:  # the shank carries no load in an open
+        # zone (crater, scabbed rear zone); the zones are disjoint (merged where they touch),
+        # so the element's length inside their union is the sum of its overlaps
+        half = 0.5 * sizes[i]
+        inside = 0.0
         for k in range(open_zones.shape[0]):
-            half = 0.5 * sizes[i]
-            inside = min(z + half, open_zones[k, 1]) - max(z - half, open_zones[k, 0])
-            if inside > 0.0:
-                frac = min(frac, max(1.0 - inside / sizes[i], 0.0))
+            inside += max(min(z + half, open_zones[k, 1]) - max(z - half, open_zones[k, 0]),
+                          0.0)
+        if inside > 0.0:
+            frac = min(frac, max(1.0 - inside / sizes[i], 0.0))
+    if not nose[i] and walls.shape[0] > 0:  # the tunnel-wall factor of the element's layer
+        frac *= walls[np.searchsorted(wall_depths, z, side="right")]
     if frac <= 0.0:
         return OK, 0.0
     n0 = rot[0, 0] * normals[i, 0] + rot[0, 1] * normals[i, 1] + rot[0, 2] * normals[i, 2]
@@ -150,8 +159,11 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
     if status == WALK_FAILED:
         return status, vn
     load = sigma * areas[i] * frac
-    if contact_ramp > 0.0:
-        load *= min(vn / contact_ramp, 1.0)
+    ramp = contact_ramp
+    if tangency > 0.0:  # OFPM's attenuation: load x angle / psi within psi of tangency
+        ramp = max(ramp, tangency * math.sqrt(u0 * u0 + u1 * u1 + u2 * u2))
+    if ramp > 0.0:
+        load *= min(vn / ramp, 1.0)
     f0, f1, f2 = -load * n0, -load * n1, -load * n2
     if mu > 0.0:
         t0, t1, t2 = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
@@ -164,7 +176,7 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
     out[4] = p2 * f0 - p0 * f2
     out[5] = p0 * f1 - p1 * f0
     out[6] = f0 * u0 + f1 * u1 + f2 * u2
-    if contact_ramp > 0.0 and vn < contact_ramp and load > 0.0:
+    if ramp > 0.0 and vn < ramp and load > 0.0:
         kappa = load / vn  # = A_i w sigma_n / V_r on the ramp
         a = (n0, n1, n2, p1 * n2 - p2 * n1, p2 * n0 - p0 * n2, p0 * n1 - p1 * n0)
         b = (-f0 / load, -f1 / load, -f2 / load, -out[3] / load, -out[4] / load,
@@ -178,7 +190,8 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
 
 @njit(cache=True, error_model="numpy")
 def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
-                  nose, open_zones, kind, scalars, values, tables, counts, depths):
+                  nose, open_zones, walls, wall_depths, tangency, kind, scalars, values, tables,
+                  counts, depths):
     """``(F (3, target frame), M (3, body frame), power, status, V_n of a failed element,
     C)`` of the surface forces in state ``y`` (module docstring; the law arrays are
     ``law.data``; ``C = diag(1, R^T) (sum kappa b a^T) diag(1, R)``, the contact damping
@@ -208,8 +221,8 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contac
         for second in range(2 if j != i else 1):
             status, vn = _element_load(j if second else i, y, rot, omega, scale, points,
                                        normals, areas, sizes, mu, contact_ramp, bottom, nose,
-                                       open_zones, kind, scalars, values, tables, counts,
-                                       depths, radii, zones,
+                                       open_zones, walls, wall_depths, tangency, kind,
+                                       scalars, values, tables, counts, depths, radii, zones,
                                        other if second else one,
                                        other_damping if second else one_damping)
             if status == BEYOND_TABLE:
@@ -241,12 +254,14 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contac
 
 @njit(cache=True, error_model="numpy")
 def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length, mu, contact_ramp,
-               bottom, nose, open_zones, kind, scalars, values, tables, counts, depths):
+               bottom, nose, open_zones, walls, wall_depths, tangency, kind, scalars, values,
+               tables, counts, depths):
     """``(dy/dt, D, status, V_n of a failed element)`` (module docstring; ``D`` the 6 x 6
     contact damping block of the Jacobian)."""
     force, moment, power, status, vn, damping = surface_loads(
         y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
-        nose, open_zones, kind, scalars, values, tables, counts, depths)
+        nose, open_zones, walls, wall_depths, tangency, kind, scalars, values, tables, counts,
+        depths)
     dy = np.empty(14)
     q0, q1, q2, q3 = y[3], y[4], y[5], y[6]
     w0, w1, w2 = y[10], y[11], y[12]

@@ -68,3 +68,17 @@ def open_zones(target, projectile, crater="nose-base", entry=False):
         zones.append((H - scab_depth(target, projectile, j), H))
         zones.append((H, min(H + crater_depth(projectile, crater), below)))
     return zones
+
+
+def union(zones):
+    """The zones ``[(top, bottom), ...]`` as disjoint intervals sorted by depth (touching or
+    overlapping zones merged): a shank element's length without tunnel wall is its overlap
+    with their union, which these intervals give as a sum (a rear zone and the crater below
+    it meet at the interface; an element straddling the plane has no wall on either side)."""
+    merged = []
+    for top, bottom in sorted(zones):
+        if merged and top <= merged[-1][1]:
+            merged[-1] = (merged[-1][0], max(merged[-1][1], bottom))
+        else:
+            merged.append((top, bottom))
+    return merged

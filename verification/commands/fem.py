@@ -14,8 +14,12 @@ RANGE_VELOCITY = 1200.0
 def run(args, target, projectile):
     """The comparison as text or JSON; ``--fields`` also writes the FE fields. A velocity
     beyond :data:`RANGE_VELOCITY` is computed, with one warning line on stderr."""
+    from cavex.verification.commands.options import refuse_debonded
+
+    refuse_debonded(target, "fem")
     document = summary(job(target, projectile, args.depth, args.velocity, nu=args.nu,
                            fields=args.fields))
+    document["warnings"] += material_warnings(target)
     for warning in document["warnings"]:
         print(f"cavex fem: warning: {warning}", file=sys.stderr)
     return json.dumps(document, indent=2) if args.json else text(document)
@@ -30,6 +34,20 @@ def range_warnings(velocity, wall_stress):
             f"incompressible rigid-projectile regime, docs/fem.md 'Range'): a real projectile "
             f"deforms, and the wall stress ({wall_stress / 1e9:.3g} GPa) is beyond the "
             "constitutive law"]
+
+
+def material_warnings(target):
+    """A sentence if a layer has FE-only keys (``tau_max``, ``tensile_strength``): the closed
+    forms ignore them, so the comparison is between different materials."""
+    named = []
+    for i, material in enumerate(target.layers):
+        keys = [k for k in ("tau_max", "tensile_strength") if getattr(material, k) is not None]
+        if keys:
+            named.append(f"{target.layer_name(i)} ({', '.join(keys)})")
+    if not named:
+        return []
+    return ["FE-only keys in " + "; ".join(named) + ": the closed forms ignore them, so "
+            "FE/analytic - 1 compares different materials (docs/fem.md 'Concrete')"]
 
 
 def job(target, projectile, depth, velocity, *, nu=None, fields=None):

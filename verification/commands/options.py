@@ -120,3 +120,14 @@ def interface_target(args, target, resistance):
                               f"\"debonded\") goes with --resistance derived (got "
                               f"--resistance {resistance})")
     return target
+
+
+def refuse_debonded(target, command):
+    """Refuse a target with a debonded interface in a command that solves the bonded spherical
+    problem only (``stress``, ``fem``, ``table``, ``verify``): its answer would silently ignore
+    the key."""
+    if target.debonded:
+        j = target.debonded[0]
+        raise CavexInputError(f"is \"debonded\", which `cavex {command}` does not model (the "
+                              "spherical problem is one bonded continuum): remove the key, or "
+                              "use penetrate or trajectory", f"layers[{j}].bottom")

@@ -12,8 +12,13 @@ from cavex.materials import MAX_VELOCITY
 
 def run(args, target, projectile):
     """The closed form's wall stress as text or JSON (a table is no closed form: refused)."""
-    from cavex.verification.commands.options import CLOSED_FORMS, resistance_settings
+    from cavex.verification.commands.options import (
+        CLOSED_FORMS,
+        refuse_debonded,
+        resistance_settings,
+    )
 
+    refuse_debonded(target, "stress")
     settings = resistance_settings(args, CLOSED_FORMS)
     document = summary(stress_at_depth(target, projectile, args.depth, args.velocity,
                                        resistance=settings["resistance"],

@@ -18,6 +18,9 @@ STORE_SUFFIX = ".cases"  # the resumable case store: <out>.cases/ until the tabl
 
 def run(args, target, projectile):
     """Build, write and summarise the table; return the text or JSON to print."""
+    from cavex.verification.commands.options import refuse_debonded
+
+    refuse_debonded(target, "table")
     result = job(target, projectile, args.velocities, args.depths, args.out, nu=args.nu,
                  workers=args.workers, scheduler=args.scheduler, progress=args.progress)
     document = summary(result, write_outputs(result))

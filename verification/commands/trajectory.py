@@ -44,7 +44,8 @@ MAX_STEPS = 100_000
 
 def trajectory_job(target, projectile, strike, resistance="derived", *, boundary="dynamic",
                    epsilon="quasi-static", free_surface=True, table=None, law_A=None,
-                   law_B=None, compare_homogeneous=False, contact_ramp=None, progress=False):
+                   law_B=None, compare_homogeneous=False, contact_ramp=None, progress=False,
+                   tangency_psi=0.0):
     """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``;
     ``progress``: a tqdm bar per run on stderr (steps, simulated time, speed)."""
     contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
@@ -56,7 +57,8 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
             f"in [{MIN_CONTACT_RAMP:g}, {MAX_CONTACT_RAMP:g}] m/s (final depth within 0.1 % "
             "of the V_r -> 0 limit)", contact_ramp)
     options = {"boundary": boundary, "epsilon": epsilon, "free_surface": free_surface,
-               "table": table, "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp}
+               "table": table, "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp,
+               "tangency_psi": tangency_psi}
     if table is not None:
         from cavex.analytic.penetration.tabulated import load_table
         options["table"] = load_table(table)
@@ -81,6 +83,13 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
                 "contact_ramp_m_s": contact_ramp}
     if target.debonded:  # a bonded target's settings (and committed results) are unchanged
         settings["interfaces"] = list(target.bottoms)
+    if any(w != 1.0 for w in target.tunnel_walls):  # the default's settings are unchanged
+        settings["tunnel_walls"] = list(target.tunnel_walls)
+    if tangency_psi:
+        settings["tangency_psi_deg"] = tangency_psi
+    if resistance == "law":
+        settings["law"] = ({"A_Pa": law_A, "B_kg_m3": law_B} if law_A is not None else
+                           [{"law_A": A, "law_B": B} for A, B in target.plain_laws])
     return {"runs": runs, "settings": settings, "target": target}
 
 
@@ -471,10 +480,24 @@ def run(args, target, projectile):
 
     settings = resistance_settings(args, (*RESISTANCES, "law"))
     target = interface_target(args, target, settings["resistance"])
+    if args.tunnel_wall is not None:
+        require(is_finite_number(args.tunnel_wall) and 0.0 <= args.tunnel_wall <= 1.0,
+                "tunnel-wall", "in [0, 1]", args.tunnel_wall)
+        target = target.with_tunnel_wall(args.tunnel_wall)
+    require(is_finite_number(args.tangency_psi) and 0.0 <= args.tangency_psi <= 30.0,
+            "tangency-psi", "in [0, 30] degrees", args.tangency_psi)
     law = [args.law_A is not None, args.law_B is not None]
-    if not all(law) if args.resistance == "law" else any(law):
+    if any(law) and not (all(law) and args.resistance == "law"):
         raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
-                              "'--resistance law' (all or none)")
+                              "'--resistance law' (both, or neither: each layer's law_A, "
+                              "law_B keys)")
+    if args.resistance == "law" and not any(law):
+        missing = next((i for i, plain in enumerate(target.plain_laws) if plain is None), None)
+        if missing is not None:
+            raise CavexInputError("must be given on every layer for '--resistance law' without "
+                                  "'--law-A PA --law-B KG_PER_M3' (the layer's plain law "
+                                  "S = A + B rho V^2 / tau; docs/config.md)",
+                                  f"layers[{missing}].law_A")
     if args.resistance == "law" and args.boundary is not None:
         raise CavexInputError("option '--boundary' goes with '--resistance derived' (or table); "
                               "'--resistance law' has no boundary convention")
@@ -502,6 +525,7 @@ def run(args, target, projectile):
                                  table=settings["table"], law_A=args.law_A, law_B=args.law_B,
                                  compare_homogeneous=args.compare_homogeneous,
                                  contact_ramp=args.contact_ramp,
+                                 tangency_psi=args.tangency_psi,
                                  progress=show_progress(args.progress))
     except FloatingPointError as exc:
         raise CavexNumericalError(f"the trajectory overflowed ({exc}): forces far beyond the "

@@ -14,6 +14,7 @@ and no wall time is written, so a rerun gives the same files.
 import csv
 import io
 import json
+import math
 import os
 import shlex
 import sys
@@ -29,13 +30,14 @@ from cavex.verification.validation.predict import (
     CONCRETE,
     EMPIRICAL,
     FE_MODEL,
+    LI_CHEN,
     MODELS,
     TableCache,
-    flag_outliers,
+    add_statistics,
     predictions,
-    summaries,
     validate,
 )
+from cavex.verification.validation.regimes import NON_RIGID, REGIMES
 from cavex.verification.validation.shots import read_shots
 
 DEFAULT_OUT = "results/validation"
@@ -121,12 +123,8 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
                 depth / row["measured_m"]
         result["failures"].update(failures)
         result["compressibility_column"] = COMPRESSIBILITY_COLUMN
-        result["summary"] = summaries(result["shots"], list(result["summary"]) +
-                                      [COMPRESSIBILITY_COLUMN])
-        held = [r for r in result["shots"] if r["id"] in result["held_out"]]
-        result["held_out_summary"] = summaries(held, list(result["summary"]))
         result["models"].append(COMPRESSIBILITY_COLUMN)
-        flag_outliers(result)
+        add_statistics(result)
     result["shots_file"] = {"path": shot_file.path, "comments": list(shot_file.comments),
                             "n": len(shot_file.shots)}
     result["tables"] = {"built": tables.built, "reused": tables.reused}
@@ -165,11 +163,11 @@ def predictions_csv(result):
     text = io.StringIO(newline="")
     writer = csv.writer(text, lineterminator="\n")
     models = result["models"]
-    writer.writerow(["id", "V0_m_s", "fc_Pa", "rho_kg_m3", "measured_m"]
+    writer.writerow(["id", "V0_m_s", "fc_Pa", "rho_kg_m3", "measured_m", "flag"]
                     + [f"{slug(m)}_m" for m in models] + [f"{slug(m)}_ratio" for m in models])
     for row in result["shots"]:
         writer.writerow([row["id"], _g(row["V0_m_s"]), _g(row["fc_Pa"]), _g(row["rho_kg_m3"]),
-                         _g(row["measured_m"])]
+                         _g(row["measured_m"]), row.get("flag") or ""]
                         + [_g(row["predicted_m"][m]) for m in models]
                         + [_g(row["ratio"][m]) for m in models])
     return text.getvalue()
@@ -265,6 +263,8 @@ def report_markdown(result, figures=True):
               "Mohr-Coulomb capped at 7 f_c, radial cracking, compaction to lock-up, every "
               "constant published (none fitted to shots), its own crater (Li and Chen 2003); "
               "it does not use the mapping below;",
+              f"- `{LI_CHEN}`: S = 72 f_c^-0.5 (f_c in MPa), crater 0.707 + h/d calibres "
+              "(Li and Chen 2003, fitted by them to published shots);",
               f"- `{EMPIRICAL}`: S = 82.6 f_c^-0.544 (f_c in MPa), crater of two calibres "
               "(Forrestal et al. 1994). Forrestal et al. fitted S to their own shots, so on "
               "their data it is not an out-of-sample prediction;",
@@ -298,6 +298,7 @@ def report_markdown(result, figures=True):
         lines += [sentence, ""]
     lines += ["Ratio = predicted / measured depth; std is the sample standard deviation; "
               "mean abs ln ratio is the mean of |ln(predicted/measured)|.", ""]
+    lines += _regime_section(result)
     lines += _outlier_section(result)
     lines += ["## Compressibility: the FE table against the incompressible closed forms", ""]
     for column, what in ((FE_MODEL, "uncalibrated mapping"),
@@ -321,7 +322,11 @@ def report_markdown(result, figures=True):
     lines += ["", "![predicted against measured (small multiples: the uncalibrated models and "
               "the empirical formula, then each calibrated model with its fitted shots filled "
               "and its held-out shots open)](predicted_vs_measured.png)", "",
-              "![ratio against striking velocity](ratio_vs_velocity.png)", ""] if figures \
+              "![ratio against striking velocity](ratio_vs_velocity.png)", "",
+              "![the recommended model and the empirical formulas, predicted against measured "
+              "by regime (open: flagged non-rigid)](by_regime.png)", "",
+              "![ln(predicted/measured) against striking velocity and f_c](residuals.png)",
+              ""] if figures \
         else ["", "(figures not drawn: `--no-figures`)", ""]
     if result["failures"]:
         lines += ["## Failures", ""]
@@ -329,6 +334,36 @@ def report_markdown(result, figures=True):
             lines += [f"- {model}, shot {i}: {reason}" for i, reason in items.items()]
         lines.append("")
     return "\n".join(lines)
+
+
+def _regime_section(result):
+    """Mean |ln ratio| / bias per regime (docs/validation.md, "Regimes")."""
+    regimes = result.get("regimes", {})
+    if not regimes:
+        return []
+    flags = [row.get("flag") for row in result["shots"]]
+    names = list(regimes)
+    first = result["models"][0]
+    lines = ["## By regime", "",
+             "Mean |ln(predicted/measured)| / bias (mean ln ratio; positive: too deep), n shots "
+             "per regime. A shot's regime follows from its inputs "
+             "(`cavex.verification.validation.regimes`).", "",
+             "| model | " + " | ".join(f"{n} ({regimes[n][first]['n']})" for n in names) + " |",
+             "|---|" + "---:|" * len(names)]
+    for m in result["models"]:
+        cells = []
+        for n in names:
+            s = regimes[n][m]
+            cells.append("n/a" if s["mean_abs_log_ratio"] is None else
+                         f"{s['mean_abs_log_ratio']:.3f} / {s['mean_log_ratio']:+.3f}"
+                         + (f" ({s['n']})" if s["n"] != regimes[n][first]["n"] else ""))
+        lines.append(f"| {m} | " + " | ".join(cells) + " |")
+    flagged = sum(1 for f in flags if f == NON_RIGID)
+    if any(f is not None for f in flags):
+        lines += ["", f"Flagged non-rigid: {flagged} of {len(flags)} shots (the concrete model's "
+                  "mean nose pressure at impact above the projectile's listed yield strength; "
+                  "kept in every table)."]
+    return lines + [""]
 
 
 def table_cell(text):
@@ -360,6 +395,7 @@ def _outlier_section(result):
 
 
 FIGURES = ("predicted_vs_measured.png", "ratio_vs_velocity.png")
+REGIME_FIGURES = ("by_regime.png", "residuals.png")
 
 
 def write_figures(result, out):
@@ -382,7 +418,7 @@ def write_figures(result, out):
                                      "Ratio predicted / measured against striking velocity"),
                            strict=True):
         predicted = name.startswith("predicted")
-        fig, axes = plt.subplots(rows, columns, figsize=(4.6 * columns, 4.2 * rows + 1.2),
+        fig, axes = plt.subplots(rows, columns, figsize=(max(4.6 * columns, 8.0), 4.2 * rows + 1.2),
                                  squeeze=False, sharex=True, sharey=True)
         for ax, (heading, models) in zip(axes.flat, panels, strict=False):
             for model in models:
@@ -399,7 +435,104 @@ def write_figures(result, out):
         fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
         fig.tight_layout(rect=(0, 0.1 if rows == 1 else 0.06, 1, 0.97))
         written.append(save_figure(fig, out / name, dpi=110))
+    return written + write_regime_figures(result, out, plt)
+
+
+def regime_models(result):
+    """The models of the regime figures: the recommended one and the empirical formulas (those
+    that ran)."""
+    return [m for m in (result["recommended_model"], LI_CHEN, EMPIRICAL) if m in result["models"]]
+
+
+def write_regime_figures(result, out, plt):
+    """``by_regime.png``: predicted against measured (log-log, 1:1, +-20 %) for the
+    :func:`regime_models`, one panel per regime other than ``all``, shots flagged non-rigid
+    open; ``residuals.png``: ``ln(predicted/measured)`` against ``V0`` and ``f_c``. One legend
+    below the panels."""
+    models = regime_models(result)
+    rows = result["shots"]
+    if not models or not rows:
+        return []
+    measured = np.array([row["measured_m"] for row in rows])
+    velocity = np.array([row["V0_m_s"] for row in rows])
+    strength = np.array([row["fc_Pa"] for row in rows]) / 1e6
+    flagged = np.array([row.get("flag") == NON_RIGID for row in rows])
+    names = [n for n in REGIMES if n != "all"]
+    member = {n: np.array([REGIMES[n](r["fc_Pa"], r["V0_m_s"], r.get("flag")) for r in rows])
+              for n in names}
+    names = [n for n in names if member[n].any()]
+
+    def depths(model):
+        return np.array([np.nan if row["predicted_m"][model] is None
+                         else row["predicted_m"][model] for row in rows])
+
+    written = []
+    fig, axes = plt.subplots(1, len(names), figsize=(4.4 * len(names), 5.0), squeeze=False)
+    for ax, name in zip(axes.flat, names, strict=True):
+        chosen = member[name]
+        for model in models:
+            _scatter(ax, measured[chosen] * 1e3, depths(model)[chosen] * 1e3, flagged[chosen],
+                     model)
+        _frame(ax, measured[chosen], True)
+        ax.set_title(f"{name} ({int(chosen.sum())} shots)", fontsize=9)
+    _legend_below(fig, axes.flat[0], flagged.any())
+    fig.suptitle("Predicted against measured depth, by regime", fontsize=11)
+    fig.tight_layout(rect=(0, 0.12, 1, 0.95))
+    written.append(save_figure(fig, out / REGIME_FIGURES[0], dpi=110))
+
+    fig, axes = plt.subplots(1, 2, figsize=(10.0, 4.8), sharey=True)
+    for ax, x, label, scale in ((axes[0], velocity, "striking velocity V0 (m/s)", "linear"),
+                                (axes[1], strength, "f_c (MPa)", "log")):
+        for model in models:
+            _scatter(ax, x, np.log(depths(model) / measured), flagged, model)
+        ax.axhline(0.0, color="k", linewidth=1)
+        ax.axhspan(math.log(1 - BAND), math.log(1 + BAND), color="grey", alpha=0.2,
+                   label="+-20 %")
+        ax.set(xlabel=label, xscale=scale)
+        ax.autoscale_view()
+        if scale == "log":
+            _plain_log_ticks(ax.xaxis)
+        ax.grid(alpha=0.3, which="both")
+    axes[0].set_ylabel("ln(predicted / measured)")
+    _legend_below(fig, axes[0], flagged.any())
+    fig.suptitle("Residuals against striking velocity and concrete strength", fontsize=11)
+    fig.tight_layout(rect=(0, 0.12, 1, 0.95))
+    written.append(save_figure(fig, out / REGIME_FIGURES[1], dpi=110))
     return written
+
+
+def _plain_log_ticks(axis):
+    """Ticks of a log axis written as plain numbers: decades (1, 10, 100), and 2 and 5 times
+    them where the axis spans less than two decades; minor ticks unlabelled (their default
+    labels overprint)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    lo, hi = sorted(axis.get_view_interval())
+    if lo > 0.0 and hi / lo < 100.0:
+        axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+    axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    axis.set_minor_formatter(NullFormatter())
+
+
+def _scatter(ax, x, y, flagged, model):
+    """One model's points, the shots flagged non-rigid open."""
+    base = next(b for b in MODELS if model.startswith(b))
+    style = {"marker": MARKERS[base], "color": COLOURS[base], "linestyle": "none",
+             "markersize": 5, "alpha": 0.8}
+    ax.plot(x[~flagged], y[~flagged], label=model, **style)
+    ax.plot(x[flagged], y[flagged], markerfacecolor="white", **style)
+
+
+def _legend_below(fig, ax, flagged):
+    handles, labels = ax.get_legend_handles_labels()
+    if flagged:
+        from matplotlib.lines import Line2D
+
+        handles.append(Line2D([], [], marker="o", color="0.3", markerfacecolor="white",
+                              linestyle="none"))
+        labels.append("open: flagged non-rigid")
+    fig.legend(handles, labels, loc="lower center", ncol=min(6, len(labels)), fontsize=8,
+               frameon=False)
 
 
 def _fitted_keys():
@@ -430,9 +563,9 @@ def fitted_ids(result, model):
     return set()
 
 
-MARKERS = dict(zip(MODELS, ["o", "s", "^", "D", "v", "*"], strict=True))
+MARKERS = dict(zip(MODELS, ["o", "s", "^", "D", "v", "X", "*"], strict=True))
 COLOURS = dict(zip(MODELS, ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple",
-                            "black"], strict=True))
+                            "tab:brown", "black"], strict=True))
 
 
 def _draw_model(ax, result, model, measured, velocity):
@@ -465,6 +598,8 @@ def _frame(ax, measured, predicted):
                         label="+-20 %")
         ax.set(xscale="log", yscale="log", xlim=(lo, hi), ylim=(lo / 2, hi * 1.5),
                xlabel="measured depth (mm)", ylabel="predicted depth (mm)")
+        _plain_log_ticks(ax.xaxis)
+        _plain_log_ticks(ax.yaxis)
     else:
         ax.axhline(1.0, color="k", linewidth=1)
         ax.axhspan(1 - BAND, 1 + BAND, color="grey", alpha=0.2, label="+-20 %")

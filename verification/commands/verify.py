@@ -13,6 +13,9 @@ DEFAULT_OUT = "results/verification"
 
 def run(args, target, projectile):
     """Write the report; return its summary as text or JSON."""
+    from cavex.verification.commands.options import refuse_debonded
+
+    refuse_debonded(target, "verify")
     document = summary(job(target, projectile, config_path=args.config, quick=args.quick,
                            out_dir=args.out, scheduler=args.scheduler, workers=args.workers,
                            progress=args.progress))

@@ -40,9 +40,10 @@ SECTIONS = ("sweep", "target", "grid", "numerics", "materials")
 SWEEP_KEYS = ("name", "scheduler", "workers")
 TARGET_KEYS = ("config", "layers", "projectile")
 GRID_KEYS = ("velocities", "depths", "nu")
-MATERIAL_PROPERTIES = ("thickness", "E", "nu", "rho", "lam", "tau", "sigma_c")
+MATERIAL_PROPERTIES = ("thickness", "E", "nu", "rho", "lam", "tau", "sigma_c", "tau_max",
+                       "tensile_strength")
 PROPERTY_UNITS = {"thickness": "m", "E": "Pa", "nu": "1", "rho": "kg m-3", "lam": "1",
-                  "tau": "Pa", "sigma_c": "Pa"}
+                  "tau": "Pa", "sigma_c": "Pa", "tau_max": "Pa", "tensile_strength": "Pa"}
 NUMERICS_UNITS = {"seed_radius": "m", "tension_cutoff": "Pa", "dilatancy_deg": "degree"}
 SWEEP_FILE, STORE_DIR, RESULTS_FILE = "sweep.json", "cases", "results.nc"
 

@@ -356,11 +356,17 @@ def _pool_context():
     return multiprocessing.get_context("forkserver" if "forkserver" in methods else "spawn")
 
 
+def process_pool(workers):
+    """A local pool of ``workers`` processes (:func:`_pool_context`), each ending with its
+    parent (:func:`_die_with_parent`)."""
+    return ProcessPoolExecutor(max_workers=workers, mp_context=_pool_context(),
+                               initializer=_die_with_parent)
+
+
 def _run_pool(function, todo, workers, finished):
     """Local processes; at most ``2 * workers`` chunks in flight."""
     pending = iter(todo)
-    with ProcessPoolExecutor(max_workers=workers, mp_context=_pool_context(),
-                             initializer=_die_with_parent) as pool:
+    with process_pool(workers) as pool:
         try:
             running = {}
             _top_up(running, pending, 2 * workers,

@@ -12,6 +12,10 @@ The folder is ``$CAVEX_CACHE_DIR``, else ``$XDG_CACHE_HOME/cavex/tables``, else
 ``~/.cache/cavex/tables``. An entry is never trusted: one that cannot be read, was built for
 another target, has another velocity grid or another solver setting, or was made by another
 cavex version is rebuilt and replaced.
+
+Size: the folder is kept under ``$CAVEX_CACHE_MAX_MB`` megabytes (default 500; a number > 0):
+after each store the least recently used entries (oldest modification time; a reused entry is
+touched) are deleted until the rest fit, never the entry just stored.
 """
 
 import hashlib
@@ -24,6 +28,52 @@ import numpy as np
 from cavex.errors import CavexInputError
 
 CACHE_ENV = "CAVEX_CACHE_DIR"
+SIZE_ENV = "CAVEX_CACHE_MAX_MB"
+DEFAULT_MAX_MB = 500.0
+
+
+def max_bytes(environ=None):
+    """The cache's size limit in bytes: ``$CAVEX_CACHE_MAX_MB`` megabytes (a finite number
+    > 0), default :data:`DEFAULT_MAX_MB`."""
+    environ = os.environ if environ is None else environ
+    text = environ.get(SIZE_ENV, "")
+    if not text:
+        return DEFAULT_MAX_MB * 1e6
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value > 0.0 and value != float("inf")):
+        raise CavexInputError(f"parameter '{SIZE_ENV}' (environment) must be a finite number "
+                              f"of megabytes > 0, got {text!r}", SIZE_ENV)
+    return value * 1e6
+
+
+def prune(directory, keep, limit):
+    """Delete the least recently used ``table_*.nc`` of ``directory`` (oldest modification
+    time first) until the folder's tables take at most ``limit`` bytes; ``keep`` (a path) is
+    never deleted. Returns the deleted paths."""
+    entries = []
+    for path in Path(directory).glob("table_*.nc"):
+        try:
+            status = path.stat()
+        except OSError:  # removed by a concurrent run
+            continue
+        entries.append((status.st_mtime, path, status.st_size))
+    total = sum(size for _, _, size in entries)
+    deleted = []
+    for _, path, size in sorted(entries):
+        if total <= limit:
+            break
+        if Path(path) == Path(keep):
+            continue
+        try:
+            path.unlink()
+        except OSError:
+            continue
+        total -= size
+        deleted.append(path)
+    return deleted
 
 
 def cache_dir(environ=None):
@@ -71,6 +121,10 @@ def load_entry(path, target, projectile, velocities, numerics=None):
         return None
     if json.loads(table.attrs.get("versions", "{}")).get("cavex") != _cavex_version():
         return None
+    try:
+        os.utime(path)  # used now: the last to go when the cache is pruned
+    except OSError:
+        pass
     return table
 
 
@@ -80,6 +134,7 @@ def store(table, path):
     from cavex.verification.fedata.table import write_table
 
     write_table(table, path)
+    prune(Path(path).parent, path, max_bytes())
     return load_table(path)
 
 

@@ -71,6 +71,8 @@ class Constants:
     locked_modulus: float = 85e9
     confinement: float = 4.1
     nu: float = DEFAULT_NU
+    power_B: float = math.nan
+    power_N: float = 1.0
 
     def with_values(self, names, values):
         return replace(self, **{n: float(v) for n, v in zip(names, values, strict=True)})
@@ -95,7 +97,8 @@ def concrete_cavity(fc, rho, constants=None):
     return ConcreteCavity(modulus=aci_modulus(fc, rho) / fc, nu=c.nu,
                           lam=mohr_coulomb_lambda(c.confinement), tau_max=c.cap,
                           bulk=c.lock_pressure / eta_lock / fc, eta_lock=eta_lock,
-                          bulk_locked=c.locked_modulus / fc, tensile=tensile_strength(fc) / fc)
+                          bulk_locked=c.locked_modulus / fc, tensile=tensile_strength(fc) / fc,
+                          power_B=c.power_B, power_N=c.power_N)
 
 
 def crater_calibres(crh):

@@ -16,6 +16,9 @@ projectile the shot's (:func:`~cavex.verification.validation.shots.shot_projecti
   (:mod:`cavex.verification.validation.concrete_model`, published constants, none fitted to the
   shots; its own crater and material, not the mapping), the recommended model
   (:data:`RECOMMENDED_MODEL`);
+- ``li-chen-2003``: Li and Chen's (2003) empirical formula (Forrestal's form with
+  ``S = 72 f_c^-0.5`` and the crater ``0.707 + h/d`` calibres,
+  :func:`cavex.verification.validation.concrete_model.li_chen_depth`);
 - ``forrestal-1994``: the empirical model (:mod:`cavex.verification.validation.empirical`).
 
 cavex's models run the penetration integrator
@@ -29,13 +32,19 @@ the fitted mapping parameters, named ``"<model> calibrated"``.
 """
 
 import math
+import os
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from cavex.analytic.penetration.integrator import penetrate
-from cavex.analytic.penetration.labels import CONCRETE_LABEL, EMPIRICAL_LABEL, VALIDATION_LABELS
+from cavex.analytic.penetration.labels import (
+    CONCRETE_LABEL,
+    EMPIRICAL_LABEL,
+    LI_CHEN_LABEL,
+    VALIDATION_LABELS,
+)
 from cavex.analytic.penetration.nose import nose_rule
 from cavex.analytic.penetration.resistance import MODEL_LABELS, make_resistance, parse_model_label
 from cavex.analytic.penetration.resistance import MODELS as CLOSED_FORMS
@@ -43,11 +52,13 @@ from cavex.errors import CavexInputError, CavexNumericalError, require_choice
 from cavex.verification.output.number_format import FE_DIGITS, round_significant
 from cavex.verification.validation import concrete_model, empirical
 from cavex.verification.validation.concrete import Mapping, shot_target
+from cavex.verification.validation.regimes import regime_statistics
 from cavex.verification.validation.shots import shot_projectile
 
 FE_MODEL = "table"
 EMPIRICAL = EMPIRICAL_LABEL
 CONCRETE = CONCRETE_LABEL
+LI_CHEN = LI_CHEN_LABEL
 CAVEX_MODELS = MODEL_LABELS  # the closed forms and the FE table: what a calibration can fit
 MODELS = VALIDATION_LABELS  # the cavex models, the concrete model, the empirical formula
 #: The model ``cavex validate`` recommends: the uncalibrated one with no constant fitted to any
@@ -60,9 +71,13 @@ TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on dep
 # 95 FE tables of 25 velocities and 2 depths in ~90 s; a prediction 1.4-2.6 ms with a closed
 # form, 29 ms with an FE table (5000 shots: 12 min on a machine loaded ~2x)
 TABLE_CASES_PER_SECOND_PER_WORKER = 45.0
-PREDICTION_SECONDS = {"closed form": 2.5e-3, FE_MODEL: 3e-2,
-                      # docs/concrete.md: 286 development shots (96 cavity tables) in ~17 s
-                      CONCRETE: 6e-2}
+PREDICTION_SECONDS = {"closed form": 2.5e-3, FE_MODEL: 3e-2, LI_CHEN: 0.0,
+                      # docs/concrete.md: the integrator 6.3 ms a shot, besides its table
+                      CONCRETE: 6.3e-3}
+# one concrete's cavity table (33 self-similar solutions): docs/concrete.md measured 15 s for
+# the 96 tables of the development shots (0.16 s each); benchmarks/validate_scale.py measured
+# about 0.56 CPU s each for 1000 concretes on a machine loaded ~2.5x
+CONCRETE_TABLE_SECONDS = 0.2
 # a shot every model misses by more than this factor (either way) is flagged as an outlier:
 # 21 of the 286 development shots (C133: 1.2 mm measured at 86 m/s, every model ~25 mm), none
 # of Forrestal's 17
@@ -101,6 +116,8 @@ def predict(shot, model, mapping=None, tables=None):
         return empirical.shot_depth(shot)
     if model == CONCRETE:
         return concrete_model.model_depth(shot)
+    if model == LI_CHEN:
+        return concrete_model.li_chen_depth(shot)
     resistance, boundary = parse_model_label(model)
     if resistance == "table":
         tables = tables or TableCache()
@@ -139,8 +156,9 @@ class TableCache:
 
     def __init__(self, directory=None, numerics=None, workers=None, scheduler=None,
                  progress=False, cache=None):
-        from cavex.verification.fedata.table_cache import cache_dir
+        from cavex.verification.fedata.table_cache import cache_dir, max_bytes
 
+        max_bytes()  # a bad size limit is refused before any work
         self.directory = None if directory is None else Path(directory)
         self.cache = cache_dir() if cache is None else Path(cache)
         self.numerics, self.workers, self.scheduler = numerics, workers, scheduler
@@ -232,8 +250,10 @@ def run_estimate(shots, models, tables, workers):
     cases = build * len(tables._velocities) * len(TABLE_DEPTHS)
     per_shot = sum(PREDICTION_SECONDS.get(model, PREDICTION_SECONDS["closed form"])
                    for model, _ in models.values() if model != EMPIRICAL)
+    concretes = len({(s.fc, s.rho) for s in shots}) if any(
+        model == CONCRETE for model, _ in models.values()) else 0
     seconds = (cases / (TABLE_CASES_PER_SECOND_PER_WORKER * max(1, workers))
-               + len(shots) * per_shot)
+               + len(shots) * per_shot + concretes * CONCRETE_TABLE_SECONDS / max(1, workers))
     when = ("under a minute" if seconds < 60.0 else f"about {seconds / 60.0:.0f} min"
             if seconds < 3600.0 else f"about {seconds / 3600.0:.1f} h")
     return (f"{len(shots)} shots x {len(models)} models = {len(shots) * len(models)} "
@@ -331,26 +351,96 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     columns = validation_columns(calibrations, mapping, models)
     tables = tables or TableCache()
     tables.velocities_for(shots)
-    depths, failures = predictions(shots, columns, tables, progress)
+    concrete = [name for name, (model, _) in columns.items() if model == CONCRETE]
+    depths, failures = predictions(
+        shots, {k: v for k, v in columns.items() if k not in concrete}, tables, progress)
+    flags = [None] * len(shots)
+    if concrete:
+        concrete_depths, flags, concrete_failures = concrete_predictions(shots, tables.workers,
+                                                                         progress)
+        for name in concrete:
+            depths[name] = concrete_depths
+            if concrete_failures:
+                failures[name] = concrete_failures
+    depths = {name: depths[name] for name in columns}
     rows = []
     for i, shot in enumerate(shots):
         predicted = {name: depths[name][i] for name in columns}
         ratio = {name: None if d is None else d / shot.depth for name, d in predicted.items()}
         rows.append({"id": shot.id, "V0_m_s": shot.V0, "fc_Pa": shot.fc,
                      "rho_kg_m3": shot.rho, "measured_m": shot.depth, "predicted_m": predicted,
-                     "ratio": ratio})
+                     "ratio": ratio, "flag": flags[i]})
     fitted = {i for c in calibrations for i in c.shots}
-    held_out = [row["id"] for row in rows if row["id"] not in fitted]
     result = {"models": list(columns), "recommended_model": RECOMMENDED_MODEL,
               "mapping": mapping.as_dict(),
               "calibrations": [c.describe() for c in calibrations], "shots": rows,
-              "summary": summaries(rows, columns), "failures": failures}
+              "failures": failures}
     if calibrations:
-        result["held_out"] = held_out
-        result["held_out_summary"] = summaries(
-            [row for row in rows if row["id"] in held_out], columns)
-    flag_outliers(result)
-    return result
+        result["held_out"] = [row["id"] for row in rows if row["id"] not in fitted]
+    return add_statistics(result)
+
+
+def concrete_predictions(shots, workers=None, progress=None):
+    """The concrete model's ``(depths, flags, failures)`` for ``shots``: per shot the depth
+    (rounded like every depth, None if it failed), the rigid-regime flag
+    (:func:`~cavex.verification.validation.concrete_model.rigid_flag`, None if it failed) and
+    ``{shot id: reason}``. The shots of one concrete (``f_c``, ``rho``) go to one task, so its
+    cavity table is built once; tasks run on ``workers`` local processes (default: the CPUs).
+    """
+    from cavex.verification.fedata.runner import Progress, process_pool, show_progress
+
+    groups = {}
+    for i, shot in enumerate(shots):
+        groups.setdefault((shot.fc, shot.rho), []).append(i)
+    tasks = [[shots[i] for i in group] for group in groups.values()]
+    workers = min(workers or os.cpu_count() or 1, len(tasks))
+    bar = Progress(len(shots), 0, show_progress(progress), unit="prediction")
+    results = []
+    if workers > 1:
+        with process_pool(workers) as pool:
+            for task, answers in zip(tasks, pool.map(concrete_group, tasks), strict=True):
+                results.append(answers)
+                bar.update(len(task))
+    else:
+        for task in tasks:
+            results.append(concrete_group(task))
+            bar.update(len(task))
+    bar.close()
+    depths, flags, failures = [None] * len(shots), [None] * len(shots), {}
+    for group, answers in zip(groups.values(), results, strict=True):
+        for i, (depth, flag, reason) in zip(group, answers, strict=True):
+            depths[i], flags[i] = depth, flag
+            if reason is not None:
+                failures[shots[i].id] = reason
+    return depths, flags, failures
+
+
+def concrete_group(shots):
+    """``[(depth, flag, reason)]`` of the concrete model for ``shots`` (one concrete)."""
+    out = []
+    for shot in shots:
+        try:
+            resistance = concrete_model.TableResistance(shot)
+            depth = round_significant(concrete_model.table_depth(shot, resistance),
+                                      DEPTH_DIGITS)
+            out.append((depth, concrete_model.rigid_flag(shot, resistance), None))
+        except (CavexInputError, CavexNumericalError) as exc:
+            out.append((None, None, str(exc).splitlines()[0]))
+    return out
+
+
+def add_statistics(result):
+    """Set ``result``'s statistics from its ``shots`` and ``models``: ``summary`` (all shots),
+    ``held_out_summary`` (when it has ``held_out``), ``regimes``
+    (:func:`cavex.verification.validation.regimes.regime_statistics`), ``outliers`` and
+    ``summary_without_outliers`` (:func:`flag_outliers`)."""
+    rows, columns = result["shots"], result["models"]
+    result["summary"] = summaries(rows, columns)
+    if "held_out" in result:
+        held = set(result["held_out"])
+        result["held_out_summary"] = summaries([r for r in rows if r["id"] in held], columns)
+    result["regimes"] = regime_statistics(rows, columns, DEPTH_DIGITS)
+    return flag_outliers(result)
 
 
 def is_outlier(ratios, factor=OUTLIER_FACTOR):

@@ -1,0 +1,56 @@
+r"""The regimes a validation is reported by, and each model's statistics in them.
+
+A shot's regime follows from its inputs only (never from a measured depth):
+
+- ``all``;
+- ``normal strength, V0 <= 1000 m/s``: ``f_c <= 100`` MPa and ``V0 <= 1000`` m/s (where the
+  empirical formulas were fitted and rigid projectiles are the rule);
+- ``V0 > 1000 m/s``;
+- ``f_c > 100 MPa`` (high- and ultra-high-strength concrete);
+- ``not flagged non-rigid``: the shots the rigid-regime rule keeps
+  (:func:`cavex.verification.validation.concrete_model.rigid_flag`: the concrete model's mean
+  nose pressure at impact at most the projectile's listed yield strength, or no yield listed).
+
+Per regime and model: ``n``, the mean ``|ln(predicted/measured)|`` and the bias, the mean
+``ln(predicted/measured)`` (positive: too deep), rounded like every statistic of a validation.
+"""
+
+import math
+
+import numpy as np
+
+from cavex.verification.output.number_format import round_significant
+
+NORMAL_STRENGTH = 100e6  # Pa
+FAST = 1000.0  # m/s
+NON_RIGID = "non-rigid"
+REGIMES = {
+    "all": lambda fc, V0, flag: True,
+    "normal strength, V0 <= 1000 m/s": lambda fc, V0, flag: fc <= NORMAL_STRENGTH and V0 <= FAST,
+    "V0 > 1000 m/s": lambda fc, V0, flag: V0 > FAST,
+    "f_c > 100 MPa": lambda fc, V0, flag: fc > NORMAL_STRENGTH,
+    "not flagged non-rigid": lambda fc, V0, flag: flag is not None and flag != NON_RIGID,
+}
+
+
+def log_statistics(ratios, digits):
+    """``{n, mean_abs_log_ratio, mean_log_ratio}`` of the positive finite ``ratios`` (None
+    where there are none), rounded to ``digits`` significant digits."""
+    logs = np.log([r for r in ratios if r is not None and math.isfinite(r) and r > 0.0])
+    if not logs.size:
+        return {"n": 0, "mean_abs_log_ratio": None, "mean_log_ratio": None}
+    return {"n": int(logs.size),
+            "mean_abs_log_ratio": round_significant(float(np.abs(logs).mean()), digits),
+            "mean_log_ratio": round_significant(float(logs.mean()), digits)}
+
+
+def regime_statistics(rows, columns, digits):
+    """``{regime: {column: log_statistics}}`` over ``rows`` (dicts with ``fc_Pa``, ``V0_m_s``,
+    ``flag`` and ``ratio``); a regime with no shot is left out."""
+    out = {}
+    for name, member in REGIMES.items():
+        chosen = [row for row in rows if member(row["fc_Pa"], row["V0_m_s"], row.get("flag"))]
+        if chosen:
+            out[name] = {c: log_statistics([row["ratio"][c] for row in chosen], digits)
+                         for c in columns}
+    return out
