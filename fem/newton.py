@@ -153,7 +153,7 @@ def newton(stack, w, params, dynamic, tol):
     iterate(u, w.u0, w.v0, w.a0, w.f0, w.theta_p, w.gamma_p, w.load, w.dt, tol,
             MAX_ITERATIONS, STALL_ITERATIONS, stack.element_dofs, stack.dNdR, stack.N,
             stack.R_points, stack.weights, stack.force_weights, m.K, m.G, m.lam, m.tau,
-            m.lam_psi, m.tension, stack.el_start, stack.el_count, stack.degree,
+            m.lam_psi, m.tension, m.cap, stack.el_start, stack.el_count, stack.degree,
             stack.mass_band, stack.dof_start, stack.dof_count, stack.free, stack.R_dofs,
             stack.fixed_entries, stack.fixed_diagonal, p.alpha_m, p.alpha_f, p.beta, dynamic,
             stack.pressure_control, stack.outer_fixed, *gradients, f, band, resp.tau_r,
@@ -180,7 +180,7 @@ def stalls(relative, best, stalled, c, limit):
 @njit(cache=True, error_model="numpy")
 def iterate(u, u0, v0, a0, f0, theta_p, gamma_p, load, dt, tol, max_iterations,
             stall_iterations, element_dofs, dNdR, N, R_points, weights, force_weights, K, G,
-            lam, tau, lam_psi, tension, el_start, el_count, p, mass_band, dof_start,
+            lam, tau, lam_psi, tension, cap, el_start, el_count, p, mass_band, dof_start,
             dof_count, free, R_dofs, fixed_entries, fixed_diagonal, alpha_m, alpha_f, beta,
             dynamic, pressure, outer_fixed, Gr, Gt, f, band, tau_r, tau_t, th_p_new, ga_p_new,
             plastic, yield_ratio, folded, force_scale, a, r_free, jac, scale, r_max, du,
@@ -208,7 +208,7 @@ def iterate(u, u0, v0, a0, f0, theta_p, gamma_p, load, dt, tol, max_iterations,
                 f[s0:s0 + m] = 0.0
                 band[:, s0:s0 + m] = 0.0
         assemble_cases(u, Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_weights,
-                       K, G, lam, tau, lam_psi, tension, theta_p, gamma_p, el_start,
+                       K, G, lam, tau, lam_psi, tension, cap, theta_p, gamma_p, el_start,
                        el_count, skip, p, f, band, tau_r, tau_t, th_p_new, ga_p_new, plastic,
                        yield_ratio, folded, force_scale)
         for c in range(k):
