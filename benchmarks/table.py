@@ -12,15 +12,29 @@ own nu, default FE settings: error estimate on, every cell refined while its est
 
 For each: the cells (FE cases incl. the first-layer-alone column), the median wall time of
 ``--repeats`` runs (process start, imports, numba's cached kernels, pool, FE, NetCDF), cases per
-second, the largest error estimate in the written table and the number of cells above 0.5 %,
-failed cells, and the peak resident memory of the whole process tree (parent and workers,
-sampled every 50 ms with psutil).
+second, the median CPU time (user + system of the whole process tree, from the operating
+system's accounting of the finished processes), the largest error estimate in the written
+table and the number of cells above 0.5 %, failed cells, and the peak resident memory of the
+whole process tree (parent and workers, sampled every 50 ms with psutil).
 
-Run: ``python benchmarks/table.py [--repeats 3] [--workers N] [--grids issue 1200]``.
+``--baseline PYTHON`` also runs ``PYTHON -m cavex.verification.cli table`` (another checkout's
+environment, e.g. the main branch's) in turn with this one, A B A B ..., and prints the median
+of the pairwise ratios: on a shared machine whose speed drifts, the ratio of neighbouring runs
+is steadier than either median.
+
+Run: ``python benchmarks/table.py [--repeats 3] [--workers N] [--grids issue 1200]
+[--baseline /path/to/other/venv/bin/python]``.
+
+Measured (issue 21, branch fem-speed against main, issue grid, 7 pairs, a 2-core machine
+shared with other jobs, load average ~5 during the runs, so absolute times are ~2-3x a quiet
+machine's): wall 8.3 s against 13.2 s (median ratio 0.68), CPU 4.9 s against 7.4 s (0.66);
+default grid, 3 pairs: wall 29.8 s against 54.6 s (0.59), CPU 20.6 s against 30.8 s (0.67);
+see docs/fem.md, "Throughput".
 """
 
 import argparse
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -52,12 +66,20 @@ def tree_rss(process):
     return total
 
 
-def run_once(velocities, depths, workers, out):
-    command = [sys.executable, "-m", "cavex.verification.cli", "table", "-o", out]
+def children_cpu():
+    """User + system seconds of this process's finished (waited-for) children so far."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def run_once(velocities, depths, workers, out, python=sys.executable):
+    """``(wall s, peak tree RSS bytes, CPU s)`` of one ``cavex table`` run."""
+    command = [python, "-m", "cavex.verification.cli", "table", "-o", out]
     if velocities is not None:
         command += ["--velocities", *map(str, velocities), "--depths", *map(str, depths)]
     if workers:
         command += ["--workers", str(workers)]
+    cpu = children_cpu()
     started = time.perf_counter()
     process = psutil.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     peak = 0
@@ -68,7 +90,7 @@ def run_once(velocities, depths, workers, out):
     stdout, stderr = process.communicate()
     if process.returncode != 0:
         raise SystemExit(f"cavex table failed ({process.returncode}): {stderr.strip()}")
-    return seconds, peak
+    return seconds, peak, children_cpu() - cpu
 
 
 def describe(path):
@@ -84,20 +106,38 @@ def main():
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--workers", type=int, default=None, help="default: cavex's (CPUs)")
     parser.add_argument("--grids", nargs="+", default=list(GRIDS), choices=list(GRIDS))
+    parser.add_argument("--baseline", default=None,
+                        help="another environment's python, run in turn with this one")
     args = parser.parse_args()
     print(f"machine: {os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f}")
     with tempfile.TemporaryDirectory() as tmp:
         for name in args.grids:
             velocities, depths = GRIDS[name]
             out = os.path.join(tmp, f"{name}.nc")
-            runs = [run_once(velocities, depths, args.workers, out) for _ in range(args.repeats)]
+            base_out = os.path.join(tmp, f"{name}-baseline.nc")
+            runs, base = [], []
+            for _ in range(args.repeats):
+                runs.append(run_once(velocities, depths, args.workers, out))
+                if args.baseline:
+                    base.append(run_once(velocities, depths, args.workers, base_out,
+                                         args.baseline))
             cells, worst, above, failed = describe(out)
             seconds = statistics.median(r[0] for r in runs)
             print(f"grid {name}: {cells} FE cases, wall time median {seconds:.1f} s "
                   f"(min {min(r[0] for r in runs):.1f}, max {max(r[0] for r in runs):.1f}; "
                   f"{args.repeats} runs) -> {cells / seconds:.1f} cases/s end to end; "
+                  f"CPU median {statistics.median(r[2] for r in runs):.1f} s; "
                   f"largest error estimate {worst:.3%}, {above} cells above 0.5 %, "
                   f"{failed} failed; peak memory {max(r[1] for r in runs) / 2**20:.0f} MiB")
+            if base:
+                pairs = list(zip(runs, base, strict=True))
+                b_seconds = statistics.median(r[0] for r in base)
+                print(f"  baseline {args.baseline}: wall median {b_seconds:.1f} s -> "
+                      f"{cells / b_seconds:.1f} cases/s, CPU median "
+                      f"{statistics.median(r[2] for r in base):.1f} s; this/baseline, median "
+                      f"of the pairs: wall "
+                      f"{statistics.median(a[0] / b[0] for a, b in pairs):.3f}, CPU "
+                      f"{statistics.median(a[2] / b[2] for a, b in pairs):.3f}")
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

@@ -179,16 +179,26 @@ def _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_p
 
 
 @njit(cache=True, error_model="numpy")
-def _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension,
-                         out):
-    """Multi-surface return (Mohr-Coulomb, tension cut-off or their corner); returns
-    ``plastic``."""
+def _trial(theta, gamma, theta_p, gamma_p, K, G, lam, lam_psi):
+    """The elastic trial state ``(P, Q)`` and the side of the Mohr-Coulomb pyramid it lies on:
+    ``pos`` (``Q >= 0``: compression-dominated branch), its ``sign`` and the yield and flow
+    coefficients ``c_mc``, ``c_psi`` of that side (shared by every return)."""
     P_tr = -K * (theta - theta_p)
     Q_tr = -2.0 * G * (gamma - gamma_p)
     pos = Q_tr >= 0.0
     sign = 1.0 if pos else -1.0
     c_mc = 1.0 if pos else (3.0 + lam) / 3.0
     c_psi = 1.0 if pos else (3.0 + lam_psi) / 3.0
+    return P_tr, Q_tr, pos, sign, c_mc, c_psi
+
+
+@njit(cache=True, error_model="numpy")
+def _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension,
+                         out):
+    """Multi-surface return (Mohr-Coulomb, tension cut-off or their corner); returns
+    ``plastic``."""
+    P_tr, Q_tr, pos, sign, c_mc, c_psi = _trial(theta, gamma, theta_p, gamma_p, K, G, lam,
+                                                lam_psi)
     # surface normals a_k, flow vectors g_k and stress corrections d_k = E g_k
     a10, a11 = -lam, c_mc * sign
     g10, g11_ = lam_psi, -1.5 * c_psi * sign
@@ -249,12 +259,8 @@ def _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, te
     state violates no other surface (within ``1e-12 tau J``); if round-off leaves none
     admissible, the one with the smallest violation.
     """
-    P_tr = -K * (theta - theta_p)
-    Q_tr = -2.0 * G * (gamma - gamma_p)
-    pos = Q_tr >= 0.0
-    sign = 1.0 if pos else -1.0
-    c_mc = 1.0 if pos else (3.0 + lam) / 3.0
-    c_psi = 1.0 if pos else (3.0 + lam_psi) / 3.0
+    P_tr, Q_tr, pos, sign, c_mc, c_psi = _trial(theta, gamma, theta_p, gamma_p, K, G, lam,
+                                                lam_psi)
     # surfaces k = 0 (MC), 1 (cap), 2 (TC): f_k = a0[k] P + a1[k] Q - k_k J, flow g_k
     a0 = (-lam, 0.0, -1.0)
     a1 = (c_mc * sign, sign, 1.0 / 3.0 if pos else -2.0 / 3.0)

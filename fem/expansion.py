@@ -186,7 +186,8 @@ def _result(solver, c, problem, vertices, numerics, error, seconds, recorder):
                 "numerics": numerics.as_dict()}
     stats = {"elements": disc.n_elements, "dofs": disc.ndof,
              **{name: getattr(one, name) for name in ("steps", "newton_iterations", "cutbacks",
-                                                      "line_search_steps")},
+                                                      "line_search_steps",
+                                                      "residual_evaluations")},
              "seconds": seconds, "refinements": 0}
     if error is not None:
         return ExpansionResult(math.nan, None, math.nan, (), settings, stats=stats, error=error)

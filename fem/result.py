@@ -35,7 +35,9 @@ class ExpansionResult:
         ``work`` at the wall, ``kinetic``, ``stored`` (elastic), ``dissipated`` (J).
     stats : dict
         ``elements``, ``dofs``, ``steps``, ``newton_iterations``, ``cutbacks``,
-        ``line_search_steps``, ``seconds`` (of the stack the run was part of, shared),
+        ``line_search_steps``, ``residual_evaluations`` (kernel passes of plain Newton, failed
+        attempts included: the run's work), ``seconds`` (of the stack the run was part of,
+        shared),
         ``refinements``, and with an error estimate ``error_companion`` (``"coarse"``, or
         ``"finer"`` where the coarse run failed) with that run's ``coarse_cavity_stress`` or
         ``finer_cavity_stress``.

@@ -7,9 +7,9 @@ call of :func:`cavex.fem.newton.newton`, so cases whose cut-backs differ stay in
 case gives the same bits alone and inside any stack. The policy for a failing step, the same for
 every case:
 
-1. a step whose Newton iteration fails (no convergence, folded element, non-finite value,
-   singular tangent) is retried as two half steps (the load interpolated linearly), recursively,
-   up to ``max_cutbacks`` times;
+1. a step whose Newton iteration fails (a stall or no convergence, folded element,
+   non-finite value, singular tangent) is retried as two half steps (the load interpolated
+   linearly), recursively, up to ``max_cutbacks`` times;
 2. a step that still fails at the deepest cut-back is tried once more with an energy line search
    (:func:`cavex.fem.newton.newton_line_search`), which cures the two-cycle of plain Newton at
    the Mohr-Coulomb apex (docs/fem.md); steps that plain Newton solves never reach it;
@@ -40,7 +40,8 @@ from cavex.fem.stack import Stack
 DOF_STATE = ("u", "v", "a", "f", "du_prev")
 POINT_STATE = ("theta_p", "gamma_p", "eq_p", "plastic", "yield_ratio", "tau_r", "tau_t")
 CASE_STATE = ("t", "load", "dt_old", "wall_force", "work", "dissipated")
-COUNTERS = ("steps", "newton_iterations", "cutbacks", "line_search_steps")
+COUNTERS = ("steps", "newton_iterations", "cutbacks", "line_search_steps",
+            "residual_evaluations")
 
 
 def failure_message(depth, t, wall_radius, load, dt, plain, line_searched):
@@ -48,6 +49,20 @@ def failure_message(depth, t, wall_radius, load, dt, plain, line_searched):
     return (f"Newton failed after {depth} step cut-backs at t = {t:.6g} s, wall radius "
             f"{wall_radius:.6g} m, wall load {load:.6g} (dt = {dt:.3g} s): {plain}; "
             f"{line_searched}")
+
+
+def _store(state, names, rows, ok, new):
+    """``state[name][rows][ok] = new[name][ok]`` for every name; ``rows`` is ``slice(None)``
+    (the working stack is the whole stack: written in place, no index arrays) or an index
+    array (a subset)."""
+    if isinstance(rows, slice):
+        for name in names:
+            np.copyto(state[name], new[name], where=ok if state[name].ndim == 1
+                      else ok[:, None])
+        return
+    where = rows[ok]
+    for name in names:
+        state[name][where] = new[name][ok]
 
 
 class RadialSolver:
@@ -130,7 +145,7 @@ class RadialSolver:
         plain_reason = [None] * k               # why its plain Newton attempt failed
         t, load = self.cases["t"], self.cases["load"]
         stack, cases = root, np.arange(k)
-        dofs, elements = np.arange(root.ndof), np.arange(root.el_count.sum())
+        dofs = elements = slice(None)  # the working stack's rows of the state: all of it
         while True:
             for c in np.flatnonzero(~finished):
                 if pending[c]:
@@ -158,8 +173,9 @@ class RadialSolver:
                           load=task_load[cases], dt=task_dt[cases],
                           dt_old=self.cases["dt_old"][cases], has_prev=self.has_prev[cases],
                           active=active & ~task_search[cases])
-            trial, ok, iterations, reasons = self._attempt(stack, w, active,
-                                                           task_search[cases])
+            trial, ok, iterations, reasons, evaluations = self._attempt(stack, w, active,
+                                                                        task_search[cases])
+            self.counters["residual_evaluations"][cases] += evaluations
             self._commit(stack, cases, dofs, elements, ok, w, trial)
             done = cases[ok]
             self.cases["dt_old"][done] = task_dt[done]
@@ -194,9 +210,10 @@ class RadialSolver:
 
     def _attempt(self, stack, w, active, search):
         """One Newton attempt of the active cases (the line-searched ones case by case).
-        Returns ``((u, a, f, response), ok, iterations, reasons)`` on the working stack."""
-        u, a, f, resp, iterations, reasons = newton(stack, w, self.params, self.dynamic,
-                                                    self.newton_tol)
+        Returns ``((u, a, f, response), ok, iterations, reasons, evaluations)`` on the working
+        stack (``evaluations``: plain Newton's residual evaluations per case)."""
+        u, a, f, resp, iterations, reasons, evaluations = newton(
+            stack, w, self.params, self.dynamic, self.newton_tol)
         if search.any():
             u, a, f = u.copy(), a.copy(), f.copy()
             resp = copy_response(resp)
@@ -209,7 +226,7 @@ class RadialSolver:
                     u[sdofs], a[sdofs], f[sdofs] = su, sa, sf
                     replace_points(resp, selements, sresp)
         ok = active & np.array([r is None for r in reasons])
-        return (u, a, f, resp), ok, iterations, reasons
+        return (u, a, f, resp), ok, iterations, reasons, evaluations
 
     def _commit(self, stack, cases, dofs, elements, ok, w, trial):
         """Accept the converged cases ``ok`` of the working ``stack``: velocities, plastic
@@ -219,9 +236,10 @@ class RadialSolver:
         if self.dynamic:
             dt_d = w.dt[stack.dof_case]
             v = w.v0 + dt_d * ((1.0 - p.gamma) * w.a0 + p.gamma * a)
-            mid = stack.mass @ ((1.0 - p.alpha_m) * a + p.alpha_m * w.a0)
-            mid_force = (mid + (1.0 - p.alpha_f) * f + p.alpha_f * w.f0)[stack.wall]
-            end_force = f[stack.wall] + (stack.mass @ a)[stack.wall]
+            wall_mass = stack.wall_mass  # the wall rows of the mass matrix: the wall forces
+            mid = wall_mass @ ((1.0 - p.alpha_m) * a + p.alpha_m * w.a0)
+            mid_force = mid + ((1.0 - p.alpha_f) * f + p.alpha_f * w.f0)[stack.wall]
+            end_force = f[stack.wall] + wall_mass @ a
         else:
             v = np.zeros_like(u)
             mid_force = 0.5 * (f[stack.wall] + w.f0[stack.wall])
@@ -234,14 +252,12 @@ class RadialSolver:
                                        - (2.0 / 3.0) * Q * (resp.gamma_p - w.gamma_p))
         ok_dofs, ok_elements = ok[stack.dof_case], ok[stack.element_case]
         new = {"u": u, "v": v, "a": a, "f": f, "du_prev": u - w.u0}
-        for name in DOF_STATE:
-            self.dofs[name][dofs[ok_dofs]] = new[name][ok_dofs]
+        _store(self.dofs, DOF_STATE, dofs, ok_dofs, new)
         eq_p = (self.points["eq_p"][elements]
                 + np.abs(resp.gamma_p - w.gamma_p) * (2.0 / 3.0))
         new = {"eq_p": eq_p, **{name: getattr(resp, name) for name in POINT_STATE
                                 if name != "eq_p"}}
-        for name in POINT_STATE:
-            self.points[name][elements[ok_elements]] = new[name][ok_elements]
+        _store(self.points, POINT_STATE, elements, ok_elements, new)
         done = cases[ok]
         self.cases["wall_force"][done] = end_force[ok]
         self.cases["work"][done] += work[ok]

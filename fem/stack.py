@@ -79,6 +79,7 @@ class Stack:
                                 np.concatenate([d.mass.indices + o for d, o in
                                                 zip(discs, self.dof_start, strict=True)]),
                                 indptr), shape=(n, n))
+        self.wall_mass = self.mass[self.dof_start]  # rows of the wall dofs (wall forces)
         self.outer_fixed = outer_fixed
         self.wall_control = wall_control
         self.pressure_control = wall_control == "pressure"

@@ -104,3 +104,55 @@ def test_the_rescue_is_the_same_inside_a_stack(line_searches):
     assert np.array_equal(b.u, alone.u)
     assert b.stats["newton_iterations"] == alone.stats["newton_iterations"]
     assert b.stats["cutbacks"] == alone.stats["cutbacks"]
+
+
+# --- the stall rule: a failing attempt ends early -----------------------------------------------
+
+def stall_iteration(residuals):
+    """Iteration (1-based) at which the stall rule (:func:`cavex.fem.newton.stalls`) fails a
+    case whose relative residuals are ``residuals`` (the first is the predictor's), or None."""
+    best, stalled = np.full(1, np.inf), np.zeros(1, dtype=np.int64)
+    for iteration, r in enumerate(residuals[1:], start=2):
+        if newton.stalls(r, best, stalled, 0, newton.STALL_ITERATIONS):
+            return iteration
+    return None
+
+
+# relative residuals of two attempts measured on the issue grid (V = 200 m/s, L = 0.8 m): one
+# that ended in a two-cycle and used to run its 30 iterations, one that converged after
+# climbing twice
+CYCLING = [6.8e-2, 3.4e-1, 3.8e-1, 3.5e-1, 2.2e-1, 1.7e-1, 6.2e-2, 1.1e-2] + [5.9e-2, 1.1e-2] * 11
+CONVERGING = [8.6e-2, 3.8e-1, 4.3e-1, 4.0e-1, 2.7e-1, 3.9e-1, 5.4e-6, 1.0e-14]
+
+
+def test_stall_rule_on_measured_residuals():
+    assert newton.STALL_ITERATIONS == 4
+    assert stall_iteration(CYCLING) == 12  # 4 iterations after the last new low (iteration 8)
+    assert stall_iteration(CONVERGING) is None  # the predictor's residual is not a low to beat
+    assert stall_iteration([1.0, 0.5] + [0.6] * 3) is None
+    assert stall_iteration([1.0, 0.5] + [0.6] * 4) == 6
+
+
+def test_stall_rule_saves_work_and_keeps_the_answer(monkeypatch):
+    """Quasi-static macadam over soil (interface at 0.02 m): its failing attempts cycle; ending
+    them at the stall instead of after 30 iterations saves residual evaluations (measured 1058
+    against 1898, 69 cut-backs against 67) and leaves the wall stress within its error estimate
+    (measured: unchanged)."""
+    macadam, soil = load_config()[0].layers[1:]
+    args = ([macadam, soil], [0.02], 0.0, 0.0125)
+    with_rule = expand_cavity(*args)
+    monkeypatch.setattr(newton, "STALL_ITERATIONS", newton.MAX_ITERATIONS)
+    without = expand_cavity(*args)
+    assert with_rule.stats["residual_evaluations"] < 0.7 * without.stats["residual_evaluations"]
+    change = abs(with_rule.cavity_stress / without.cavity_stress - 1.0)
+    assert change <= without.error_estimate
+
+
+def test_quasi_static_predictor_follows_the_wall_increments():
+    """Quasi-static steps are all of pseudo-time 1 while the wall increments grow 3 % a step;
+    the predictor scaled by the wall's increment ratio (not by dt / dt_old) lets the default
+    concrete run take its 102 steps without a cut-back (measured 0; 29 cut-backs and 131 steps
+    with the dt ratio)."""
+    concrete = load_config()[0].layers[0]
+    run = expand_cavity([concrete], [], 0.0, 0.0125, error_estimate=False)
+    assert run.stats["cutbacks"] <= 3 and run.stats["steps"] == 102 + run.stats["cutbacks"]

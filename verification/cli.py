@@ -158,6 +158,14 @@ def build_parser():
                             help="OFPM's attenuation: an element's load falls linearly within "
                             "this angle of tangency to its velocity (deg in [0, 30]; default "
                             "0: none; docs/oblique.md)")
+    trajectory.add_argument("--entry-crater", dest="entry_crater", action="store_true",
+                            help="the shank carries no load in the entry crater, nose-tip "
+                            "depth 0 to 4.5 r + l (the 1-D crater depth; default: off, the "
+                            "tunnel wall from the surface; docs/oblique.md)")
+    trajectory.add_argument("--crater", choices=("nose-base", "nose-tip"), default=None,
+                            help="where the crater depth 4.5 r of the entry and interface "
+                            "craters is measured from (with --entry-crater or debonded "
+                            "interfaces; default nose-base, as penetrate)")
     trajectory.add_argument("--no-free-surface", action="store_true",
                             help="no free-surface reduction of the derived law")
     trajectory.add_argument("--compare-homogeneous", action="store_true",

@@ -190,7 +190,7 @@ class ObliqueModel:
 
     def __init__(self, target, projectile, law, *, body=None, bottom=None, rtol=RTOL,
                  atol=ATOL, method=METHOD, contact_ramp=None, crater="nose-base",
-                 tangency_psi=0.0):
+                 tangency_psi=0.0, entry_crater=False):
         self.target, self.projectile, self.law = target, projectile, law
         self.body = body or build_body(projectile)
         self.bottom = bottom
@@ -213,9 +213,13 @@ class ObliqueModel:
         self._p = b.points
         self._inertia = b.inertia
         # the zones of the debonded interfaces (zones.open_zones), each opened by the event of
-        # the nose tip crossing its top; none for a bonded target
-        self.zones = open_zones(target, projectile, crater) if target.debonded else []
-        tops = [top for top, _ in self.zones]
+        # the nose tip crossing its top; none for a bonded target. With ``entry_crater`` the
+        # entry crater [0, L_c] comes first and is open from the start (the nose tip starts on
+        # the surface, its top)
+        self.entry_crater = bool(entry_crater)
+        self.zones = (open_zones(target, projectile, crater, entry=self.entry_crater)
+                      if target.debonded or self.entry_crater else [])
+        tops = [top for top, _ in self.zones[int(self.entry_crater):]]
         self._zone_tops = sorted({t for t in tops if t not in target.interface_depths})
         self._open_zones(0.0)
         self._tip = b.tip
@@ -226,8 +230,9 @@ class ObliqueModel:
         """Open every zone whose top is at or above the nose-tip depth ``depth`` (a zone once
         open stays open) and rebuild the compiled surface arguments."""
         b = self.body
-        self.opened = np.array([z for z in self.zones if z[0] < depth or (
-            z[0] == depth and depth > 0.0)], dtype=float).reshape(-1, 2)
+        self.opened = np.array([z for k, z in enumerate(self.zones) if z[0] < depth or (
+            z[0] == depth and depth > 0.0) or (k == 0 and self.entry_crater)],
+            dtype=float).reshape(-1, 2)
         walls = np.array(union(self.opened.tolist()), dtype=float).reshape(-1, 2)
         self._surface = (b.points, b.normals, b.areas, b.sizes, b.partners, b.length, self.mu,
                          self.contact_ramp, np.inf if self.bottom is None else float(self.bottom),
@@ -477,9 +482,12 @@ class ObliqueModel:
 
 def fly(target, projectile, strike=None, resistance="derived", *, body=None, bottom=None,
         rtol=RTOL, atol=ATOL, method=METHOD, contact_ramp=None, progress=None,
-        tangency_psi=0.0, **law_options):
+        tangency_psi=0.0, entry_crater=False, crater="nose-base", **law_options):
     """One trajectory: :class:`Result` of ``strike`` (default: normal incidence at ``V0``);
-    ``progress(t, y)`` is called after every integrator step."""
+    ``progress(t, y)`` is called after every integrator step; ``entry_crater``: the shank
+    carries no load in the entry crater ``[0, L_c]`` (zones.open_zones; docs/oblique.md);
+    ``crater``: where ``L_c`` of the entry and interface craters is measured from
+    (zones.crater_depth)."""
     strike = strike or Strike(projectile.V0)
     require(resistance == "derived" or not target.debonded, "interfaces",
             "'bonded' unless the resistance is 'derived' (a debonded interface needs its "
@@ -487,7 +495,8 @@ def fly(target, projectile, strike=None, resistance="derived", *, body=None, bot
     law = make_law(target, projectile, resistance, bottom=bottom, **law_options)
     model = ObliqueModel(target, projectile, law, body=body, bottom=bottom, rtol=rtol,
                          atol=atol, method=method, contact_ramp=contact_ramp,
-                         tangency_psi=tangency_psi)
+                         tangency_psi=tangency_psi, entry_crater=entry_crater,
+                         crater=crater)
     return model.run(strike, progress=progress)
 
 

@@ -51,7 +51,7 @@ MAX_STEPS = 100_000
 def trajectory_job(target, projectile, strike, resistance="derived", *, boundary="dynamic",
                    epsilon="quasi-static", free_surface=True, table=None, law_A=None,
                    law_B=None, compare_homogeneous=False, contact_ramp=None, progress=False,
-                   tangency_psi=0.0):
+                   tangency_psi=0.0, entry_crater=False, crater=None):
     """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``;
     ``progress``: a tqdm bar per run on stderr (steps, simulated time, speed)."""
     contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
@@ -64,7 +64,8 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
             "of the V_r -> 0 limit)", contact_ramp)
     options = {"boundary": boundary, "epsilon": epsilon, "free_surface": free_surface,
                "table": table, "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp,
-               "tangency_psi": tangency_psi}
+               "tangency_psi": tangency_psi, "entry_crater": entry_crater,
+               "crater": crater or "nose-base"}
     if table is not None:
         from cavex.analytic.penetration.tabulated import load_table
         options["table"] = load_table(table)
@@ -93,6 +94,10 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
         settings["tunnel_walls"] = list(target.tunnel_walls)
     if tangency_psi:
         settings["tangency_psi_deg"] = tangency_psi
+    if entry_crater:  # the runway's entry crater [top, bottom] (m); the default's settings
+        settings["entry_crater_m"] = list(runs["runway"].model.zones[0])  # are unchanged
+    if crater is not None:
+        settings["crater"] = crater
     if resistance == "law":
         settings["law"] = ({"A_Pa": law_A, "B_kg_m3": law_B} if law_A is not None else
                            [{"law_A": A, "law_B": B} for A, B in target.plain_laws])
@@ -337,7 +342,9 @@ def _title(job):
     law = s["resistance"] + (f"-{s['boundary']}" if s["resistance"] == "derived" else "")
     return (f"V0 = {s['speed_m_s']:g} m/s, obliquity {s['obliquity_deg']:g} deg, attack "
             f"{s['attack_deg']:g} deg; resistance {law}, contact ramp "
-            f"{s['contact_ramp_m_s']:g} m/s")
+            f"{s['contact_ramp_m_s']:g} m/s"
+            + (f"; entry crater to {s['entry_crater_m'][1]:.3g} m" if "entry_crater_m" in s
+               else ""))
 
 
 def _note(ax, text):
@@ -572,6 +579,9 @@ def run(args, target, projectile):
     if args.compare_homogeneous and len(target.layers) < 2:
         raise CavexInputError("option '--compare-homogeneous' needs a target of two or more "
                               "layers (this one is its first layer alone already)")
+    if args.crater is not None and not (args.entry_crater or target.debonded):
+        raise CavexInputError("option '--crater nose-base|nose-tip' goes with '--entry-crater' "
+                              "or '--interfaces debonded' (it sets their crater depth)")
     folder = check_output_dir(args.out, "out")
     speed = projectile.V0 if args.velocity is None else args.velocity  # Strike checks it
     strike = Strike(speed, args.obliquity, args.attack, args.attack_plane, args.spin)
@@ -590,6 +600,7 @@ def run(args, target, projectile):
                                  compare_homogeneous=args.compare_homogeneous,
                                  contact_ramp=args.contact_ramp,
                                  tangency_psi=args.tangency_psi,
+                                 entry_crater=args.entry_crater, crater=args.crater,
                                  progress=show_progress(args.progress))
     except FloatingPointError as exc:
         raise CavexNumericalError(f"the trajectory overflowed ({exc}): forces far beyond the "

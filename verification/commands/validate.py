@@ -418,7 +418,7 @@ def write_figures(result, out):
                                      "Ratio predicted / measured against striking velocity"),
                            strict=True):
         predicted = name.startswith("predicted")
-        fig, axes = plt.subplots(rows, columns, figsize=(4.6 * columns, 4.2 * rows + 1.2),
+        fig, axes = plt.subplots(rows, columns, figsize=(max(4.6 * columns, 8.0), 4.2 * rows + 1.2),
                                  squeeze=False, sharex=True, sharey=True)
         for ax, (heading, models) in zip(axes.flat, panels, strict=False):
             for model in models:

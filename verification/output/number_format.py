@@ -24,8 +24,16 @@ justification each:
   across CPUs. 6 digits leave two orders between that spread and the rounding unit.
 - FE wall stress ``sigma_r``, FE ``S``, FE plastic radius: 6. Newton tolerance 1e-8 and a
   discretisation error of 1e-4..1e-3 (the error estimate); cross-CPU spread ~1e-11.
-- FE error estimate (Richardson): 3. A difference of two FE runs, good to a digit or two;
-  cross-CPU spread ~1e-9.
+- FE error estimate (Richardson): an absolute quantum, not significant digits,
+  :data:`ESTIMATE_DECIMALS` = 5 decimals (multiples of 1e-5, i.e. 0.001 % of the wall stress).
+  The estimate is a difference of two FE runs, ``|S_h - S_2h| / 3 |S_h|``: its cross-CPU spread
+  is *absolute*, about 1e-9 (the spread of ``S_h / S_2h``, set by where Newton stops at its
+  tolerance), whatever the estimate's size. Significant digits give a small estimate a fine
+  quantum (3 digits of 7.04e-6 are 1e-8, only 10 spreads wide: one machine wrote 7.04e-06 and
+  another 7.03e-06 for the same cell); a fixed quantum of 1e-5 is 10**4 spreads wide, so a
+  value rounds differently on another CPU with odds of about 2e-4, and it is 500 times finer
+  than the 0.5 % that the commands promise (an estimate below 5e-6 is written 0: "below
+  0.0005 %"). The estimates of a table reach 5e-3, which keeps 3 significant digits there.
 - closed forms (analytic ``sigma_r``, plastic radius ``b``): 10. Scalar libm and Newton to
   4e-16: a few ulps (~1e-15), 5 orders below the 10th digit.
 - the report's relative errors, error parts and closed-form ``S`` (``rel_err_*``, ``part_*``,
@@ -52,17 +60,30 @@ import numpy as np
 
 TRAJECTORY_DIGITS = 6
 FE_DIGITS = 6
-ESTIMATE_DIGITS = 3
+ESTIMATE_DECIMALS = 5   # an absolute quantum (10**-5), not significant digits (docstring)
 CLOSED_FORM_DIGITS = 10
 RELATIVE_DIGITS = FE_DIGITS
 DEFAULT_DIGITS = FE_DIGITS
 KEPT = None  # derived by the report from rounded values: written as computed
 
-# (variable-name pattern, significant digits or KEPT); the first matching pattern decides.
+
+
+class Decimals(int):
+    """A rule of :data:`VARIABLE_DIGITS` that rounds to this many decimal places (an absolute
+    quantum ``10**-n``) instead of significant digits."""
+
+    def __repr__(self):
+        return f"Decimals({int(self)})"
+
+
+ESTIMATE = Decimals(ESTIMATE_DECIMALS)
+
+# (variable-name pattern, significant digits, Decimals or KEPT); the first matching pattern
+# decides.
 # Names of the FE tables and report grids (cavex.verification.fedata.table, report_analysis) and of
 # the batch sweeps (cavex.verification.fedata.batch.VARIABLES).
 VARIABLE_DIGITS = (
-    ("error_estimate", ESTIMATE_DIGITS),
+    ("error_estimate", ESTIMATE),
     ("sigma_r_dynamic", CLOSED_FORM_DIGITS),
     ("sigma_r_quasi_static", CLOSED_FORM_DIGITS),
     ("sigma_r_paper", CLOSED_FORM_DIGITS),
@@ -101,6 +122,30 @@ def round_significant(values, digits):
     return np.array(flat, dtype=float).reshape(array.shape)
 
 
+def round_decimals(values, decimals):
+    """``values`` rounded to ``decimals`` places after the point (correctly rounded, through
+    ``format(x, ".{decimals}f")``; the sign of a zero result is dropped). NaN and infinities
+    unchanged; a scalar gives a ``float``, anything else an array of the same shape."""
+    if decimals < 0:
+        raise ValueError(f"decimals must be >= 0, got {decimals}")
+
+    def one(x):
+        return x if not np.isfinite(x) else float(format(x, f".{decimals}f")) + 0.0
+
+    if np.ndim(values) == 0:
+        return one(float(values))
+    array = np.asarray(values, dtype=float)
+    return np.array([one(x) for x in array.ravel().tolist()], dtype=float).reshape(array.shape)
+
+
+def round_rule(values, rule):
+    """``values`` rounded by one rule of :data:`VARIABLE_DIGITS`: :class:`Decimals` or
+    significant digits."""
+    if isinstance(rule, Decimals):
+        return round_decimals(values, int(rule))
+    return round_significant(values, rule)
+
+
 def format_number(value, digits=TRAJECTORY_DIGITS):
     """Text of one value for a CSV cell: floats with ``digits`` significant digits (``%g``
     style), integers, booleans and strings as they are."""
@@ -123,8 +168,8 @@ def round_nested(value, digits=TRAJECTORY_DIGITS):
 
 
 def variable_digits(name):
-    """Significant digits of the float variable ``name`` (see :data:`VARIABLE_DIGITS`), or
-    ``None``: written as computed."""
+    """Significant digits of the float variable ``name`` (see :data:`VARIABLE_DIGITS`), a
+    :class:`Decimals` (an absolute quantum), or ``None``: written as computed."""
     return next((digits for pattern, digits in VARIABLE_DIGITS
                  if fnmatch.fnmatchcase(name, pattern)), DEFAULT_DIGITS)
 
@@ -136,6 +181,6 @@ def round_dataset(ds):
     for name, variable in ds.data_vars.items():
         digits = variable_digits(str(name))
         if variable.dtype.kind == "f" and digits is not KEPT:
-            rounded = round_significant(variable.values, digits)
+            rounded = round_rule(variable.values, digits)
             out[name] = variable.copy(data=rounded.astype(variable.dtype))
     return out

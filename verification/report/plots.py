@@ -22,6 +22,7 @@ from matplotlib.patches import Patch  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator  # noqa: E402
 
 from cavex.verification.output.files import save_figure  # noqa: E402
+from cavex.verification.output.number_format import ESTIMATE_DECIMALS  # noqa: E402
 from cavex.verification.report.analysis import (  # noqa: E402
     MODELS,
     RESOLVED_FRACTION,
@@ -335,9 +336,13 @@ def _label_cells(ax, grid, codes, labels):
 
 
 def error_estimate_map(grid, target, out):
-    """FE relative error estimate of every cell, in %, on a log scale."""
+    """FE relative error estimate of every cell, in %, on a log scale. Estimates are stored to
+    a quantum of 1e-5 (:data:`~cavex.verification.output.number_format.ESTIMATE_DECIMALS`);
+    one stored as 0 (below half the quantum) is drawn at half the quantum, the bottom of the
+    scale, not left blank."""
     est = 100 * grid["error_estimate"].where(grid["failed"] == 0).values
-    positive = np.where(est > 0, est, np.nan)
+    positive = np.where(est > 0, est, np.where(est == 0, 50 * 10.0 ** -ESTIMATE_DECIMALS,
+                                               np.nan))
     fig, columns = map_figure(grid, target, ["FE error estimate (Richardson)"], panel_width=5.0)
     finite = positive[np.isfinite(positive)]
     norm = LogNorm(finite.min(), finite.max()) if finite.size and finite.min() < finite.max() \

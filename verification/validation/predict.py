@@ -356,7 +356,8 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         shots, {k: v for k, v in columns.items() if k not in concrete}, tables, progress)
     flags = [None] * len(shots)
     if concrete:
-        concrete_depths, flags, concrete_failures = concrete_predictions(shots, tables.workers)
+        concrete_depths, flags, concrete_failures = concrete_predictions(shots, tables.workers,
+                                                                         progress)
         for name in concrete:
             depths[name] = concrete_depths
             if concrete_failures:
@@ -379,26 +380,32 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     return add_statistics(result)
 
 
-def concrete_predictions(shots, workers=None):
+def concrete_predictions(shots, workers=None, progress=None):
     """The concrete model's ``(depths, flags, failures)`` for ``shots``: per shot the depth
     (rounded like every depth, None if it failed), the rigid-regime flag
     (:func:`~cavex.verification.validation.concrete_model.rigid_flag`, None if it failed) and
     ``{shot id: reason}``. The shots of one concrete (``f_c``, ``rho``) go to one task, so its
     cavity table is built once; tasks run on ``workers`` local processes (default: the CPUs).
     """
-    from cavex.verification.fedata.runner import process_pool
+    from cavex.verification.fedata.runner import Progress, process_pool, show_progress
 
     groups = {}
     for i, shot in enumerate(shots):
         groups.setdefault((shot.fc, shot.rho), []).append(i)
     tasks = [[shots[i] for i in group] for group in groups.values()]
     workers = min(workers or os.cpu_count() or 1, len(tasks))
+    bar = Progress(len(shots), 0, show_progress(progress), unit="prediction")
+    results = []
     if workers > 1:
         with process_pool(workers) as pool:
-            results = list(pool.map(concrete_group, tasks,
-                                    chunksize=max(1, len(tasks) // (4 * workers))))
+            for task, answers in zip(tasks, pool.map(concrete_group, tasks), strict=True):
+                results.append(answers)
+                bar.update(len(task))
     else:
-        results = [concrete_group(task) for task in tasks]
+        for task in tasks:
+            results.append(concrete_group(task))
+            bar.update(len(task))
+    bar.close()
     depths, flags, failures = [None] * len(shots), [None] * len(shots), {}
     for group, answers in zip(groups.values(), results, strict=True):
         for i, (depth, flag, reason) in zip(group, answers, strict=True):
