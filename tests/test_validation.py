@@ -461,11 +461,10 @@ def test_validate_reports_by_regime(capsys, tmp_path):
         assert row["flag"] == concrete_model.rigid_flag(
             shot, concrete_model.TableResistance(shot))
     members = {"all": lambda r: True,
-               "normal strength, V0 <= 1000 m/s": lambda r: r["fc_Pa"] <= 100e6
-               and r["V0_m_s"] <= 1000.0,
-               "V0 > 1000 m/s": lambda r: r["V0_m_s"] > 1000.0,
-               "f_c > 100 MPa": lambda r: r["fc_Pa"] > 100e6,
-               "not flagged non-rigid": lambda r: r["flag"] == ""}
+               "normal_strength": lambda r: r["fc_Pa"] <= 100e6 and r["V0_m_s"] <= 1000.0,
+               "fast": lambda r: r["V0_m_s"] > 1000.0,
+               "high_strength": lambda r: r["fc_Pa"] > 100e6,
+               "not_flagged": lambda r: r["flag"] == ""}
     expected = {name: [r for r in result["shots"] if member(r)]
                 for name, member in members.items()}
     assert set(result["regimes"]) == {name for name, rows in expected.items() if rows}

@@ -37,7 +37,7 @@ from cavex.verification.validation.predict import (
     predictions,
     validate,
 )
-from cavex.verification.validation.regimes import NON_RIGID, REGIMES
+from cavex.verification.validation.regimes import NON_RIGID, REGIME_TITLES, REGIMES
 from cavex.verification.validation.shots import read_shots
 
 DEFAULT_OUT = "results/validation"
@@ -348,7 +348,8 @@ def _regime_section(result):
              "Mean |ln(predicted/measured)| / bias (mean ln ratio; positive: too deep), n shots "
              "per regime. A shot's regime follows from its inputs "
              "(`cavex.verification.validation.regimes`).", "",
-             "| model | " + " | ".join(f"{n} ({regimes[n][first]['n']})" for n in names) + " |",
+             "| model | " + " | ".join(f"{REGIME_TITLES[n]} ({regimes[n][first]['n']})"
+                                       for n in names) + " |",
              "|---|" + "---:|" * len(names)]
     for m in result["models"]:
         cells = []
@@ -474,7 +475,7 @@ def write_regime_figures(result, out, plt):
             _scatter(ax, measured[chosen] * 1e3, depths(model)[chosen] * 1e3, flagged[chosen],
                      model)
         _frame(ax, measured[chosen], True)
-        ax.set_title(f"{name} ({int(chosen.sum())} shots)", fontsize=9)
+        ax.set_title(f"{REGIME_TITLES[name]} ({int(chosen.sum())} shots)", fontsize=9)
     _legend_below(fig, axes.flat[0], flagged.any())
     fig.suptitle("Predicted against measured depth, by regime", fontsize=11)
     fig.tight_layout(rect=(0, 0.12, 1, 0.95))

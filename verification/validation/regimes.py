@@ -3,11 +3,11 @@ r"""The regimes a validation is reported by, and each model's statistics in them
 A shot's regime follows from its inputs only (never from a measured depth):
 
 - ``all``;
-- ``normal strength, V0 <= 1000 m/s``: ``f_c <= 100`` MPa and ``V0 <= 1000`` m/s (where the
-  empirical formulas were fitted and rigid projectiles are the rule);
-- ``V0 > 1000 m/s``;
-- ``f_c > 100 MPa`` (high- and ultra-high-strength concrete);
-- ``not flagged non-rigid``: the shots the rigid-regime rule keeps
+- ``normal_strength``: ``f_c <= 100`` MPa and ``V0 <= 1000`` m/s (where the empirical formulas
+  were fitted and rigid projectiles are the rule);
+- ``fast``: ``V0 > 1000`` m/s;
+- ``high_strength``: ``f_c > 100`` MPa (high- and ultra-high-strength concrete);
+- ``not_flagged``: the shots the rigid-regime rule keeps
   (:func:`cavex.verification.validation.concrete_model.rigid_flag`: the concrete model's mean
   nose pressure at impact at most the projectile's listed yield strength, or no yield listed).
 
@@ -24,13 +24,18 @@ from cavex.verification.output.number_format import round_significant
 NORMAL_STRENGTH = 100e6  # Pa
 FAST = 1000.0  # m/s
 NON_RIGID = "non-rigid"
+#: name (a JSON key) -> membership from a shot's ``f_c`` (Pa), ``V0`` (m/s) and rigid flag
 REGIMES = {
     "all": lambda fc, V0, flag: True,
-    "normal strength, V0 <= 1000 m/s": lambda fc, V0, flag: fc <= NORMAL_STRENGTH and V0 <= FAST,
-    "V0 > 1000 m/s": lambda fc, V0, flag: V0 > FAST,
-    "f_c > 100 MPa": lambda fc, V0, flag: fc > NORMAL_STRENGTH,
-    "not flagged non-rigid": lambda fc, V0, flag: flag is not None and flag != NON_RIGID,
+    "normal_strength": lambda fc, V0, flag: fc <= NORMAL_STRENGTH and V0 <= FAST,
+    "fast": lambda fc, V0, flag: V0 > FAST,
+    "high_strength": lambda fc, V0, flag: fc > NORMAL_STRENGTH,
+    "not_flagged": lambda fc, V0, flag: flag is not None and flag != NON_RIGID,
 }
+#: name -> the words tables and figures show
+REGIME_TITLES = {"all": "all", "normal_strength": "normal strength, V0 <= 1000 m/s",
+                 "fast": "V0 > 1000 m/s", "high_strength": "f_c > 100 MPa",
+                 "not_flagged": "not flagged non-rigid"}
 
 
 def log_statistics(ratios, digits):
