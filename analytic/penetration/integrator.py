@@ -178,7 +178,7 @@ def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol
         stop_depth, stop_reason = (ahead[0][0], ahead[0][1]) if ahead else (None, None)
         phase, sol = integrate(resistance, projectile.m, start, stop_depth=stop_depth,
                                stop_reason=stop_reason, label=label, rtol=rtol, atol=atol)
-        _append_solution(columns, sol, phase.end_time, resistance, projectile.m, len(phases))
+        _append_solution(columns, sol, phase, resistance, projectile.m, len(phases))
         phases.append(replace(phase, stage=stage))
         start = (phase.end_time, phase.end_depth, phase.end_velocity)
         if phase.end_reason == stop_reason:
@@ -319,9 +319,15 @@ def _append(columns, t, depth, velocity, deceleration, phase):
         column.append(np.asarray(values, dtype=float))
 
 
-def _append_solution(columns, sol, t_end, resistance, mass, phase):
+def _append_solution(columns, sol, phase_end, resistance, mass, phase):
+    """The phase's samples up to its end; at a stop the last velocity is exactly 0 m/s, as
+    :func:`integrate` returns it (the dense output there is round-off, ~1e-14 m/s, that differs
+    between CPUs)."""
+    t_end = phase_end.end_time
     t = np.append(sol.t[sol.t < t_end], t_end)
     y = sol.sol(t)
+    if phase_end.end_reason == STOPPED:
+        y[1, -1] = 0.0
     deceleration = np.array([resistance.force(depth, max(v, 0.0)) / mass for depth, v in y.T])
     _append(columns, t, y[0], np.maximum(y[1], 0.0), deceleration, phase)
 

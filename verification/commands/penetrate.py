@@ -12,7 +12,12 @@ from cavex.analytic.penetration.integrator import crater_depth, penetrate
 from cavex.analytic.penetration.resistance import make_resistance, model_boundary, model_label
 from cavex.analytic.penetration.zones import scab_depth
 from cavex.config import load_config
-from cavex.verification.output.files import save_figure, write_columns_csv
+from cavex.verification.output.files import (
+    agg_figure,
+    collector_paused,
+    save_figure,
+    write_columns_csv,
+)
 from cavex.verification.output.paths import check_output_dir, write_staged
 from cavex.verification.studies.table2 import not_reproduced_line, table2_comparison
 
@@ -173,17 +178,20 @@ def _columns(rows):
 
 
 def _write_figures(job, out):
+    """The two figures, made without pyplot and drawn with the garbage collector paused
+    (:func:`~cavex.verification.output.files.collector_paused`); returns their paths."""
+    with collector_paused():
+        return _draw_figures(job, out)
+
+
+def _draw_figures(job, out):
     import textwrap
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
     runway, single = job["runs"]["runway"], job["runs"]["first_layer_only"]
     subtitle = textwrap.fill(job["title"], 70)
     names = job.get("layer_names", [])
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    fig = agg_figure(figsize=(6.4, 4.8))
+    ax = fig.add_subplot()
     runway_label = "runway (layered)" if job.get("table") is None else \
         "runway (layered, FE table)"
     if job.get("debonded"):
@@ -194,8 +202,9 @@ def _write_figures(job, out):
     ax.set(xlabel="time (ms)", ylabel="velocity (m/s)")
     ax.set_title(f"Velocity against time\n{subtitle}", fontsize=10)
     _legend_below(ax)
-    velocity_png = _save(fig, out / "velocity_time.png", plt)
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
+    velocity_png = _save(fig, out / "velocity_time.png")
+    fig = agg_figure(figsize=(6.4, 4.8))
+    ax = fig.add_subplot()
     ax.plot(runway.depth, runway.deceleration / 9.81 / 1e3, label=runway_label)
     ax.plot(single.depth, single.deceleration / 9.81 / 1e3, "--",
             label=f"{names[0] if names else 'first layer'} alone")
@@ -212,7 +221,7 @@ def _write_figures(job, out):
     ax.set(xlabel="nose-tip depth (m)", ylabel=r"deceleration ($10^3$ g)")
     ax.set_title(f"Deceleration against depth\n{subtitle}", fontsize=10, pad=14)
     _legend_below(ax)
-    return [velocity_png, _save(fig, out / "deceleration_depth.png", plt)]
+    return [velocity_png, _save(fig, out / "deceleration_depth.png")]
 
 
 def _legend_below(ax):
@@ -221,6 +230,6 @@ def _legend_below(ax):
               fontsize=9)
 
 
-def _save(fig, path, plt):
+def _save(fig, path):
     fig.tight_layout()
     return save_figure(fig, path, dpi=120)
