@@ -36,4 +36,5 @@ cavex trajectory --obliquity 20 --velocity 600 --compare-homogeneous --out "$sho
 cp "$shot"/*.png results/oblique/shot_20deg_600/ && rm -r "$shot"
 python -m cavex.verification.studies.concrete_validation --workers 2 > /dev/null
 python -m cavex.verification.studies.concrete_fe > /dev/null
+python -m cavex.verification.studies.rigid_form > /dev/null
 git status --short results

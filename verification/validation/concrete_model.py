@@ -103,7 +103,7 @@ def concrete_cavity(fc, rho, constants=None):
 
 def crater_calibres(crh):
     """Li and Chen's (2003) crater depth ``k = 0.707 + h/d``, ``h/d = sqrt(4 CRH - 1)/2``."""
-    return 0.707 + 0.5 * math.sqrt(4.0 * crh - 1.0)
+    return 0.707 + 0.5 * np.sqrt(4.0 * crh - 1.0)  # numbers or arrays
 
 
 def table_top(phi):

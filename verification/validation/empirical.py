@@ -31,7 +31,7 @@ of 0.906 kg, 26.9 mm, CRH 2, 277 m/s into 35.2 MPa, 2370 kg/m^3 concrete) prints
 ``X/d = 6.21`` with ``S = 12``; ``tests/test_validation.py`` reproduces it.
 """
 
-import math
+import numpy as np
 
 from cavex.errors import require
 
@@ -40,15 +40,29 @@ S_EXPONENT = -0.544
 CRATER_CALIBRES = 2.0  # crater depth k d with k = 2 (4 shank radii), Forrestal et al. 1994
 
 
+def _require_all(values, name, accepted, lower, inclusive=False):
+    """:func:`~cavex.errors.require` on a number or an array: every element finite and above
+    ``lower`` (or at it, ``inclusive``)."""
+    array = np.asarray(values, dtype=float)
+    above = array >= lower if inclusive else array > lower
+    require(bool(np.all(np.isfinite(array) & above)), name, accepted, values)
+
+
+def _number_or_array(value):
+    """A float for a 0-d result (the scalar API), the array otherwise."""
+    return float(value) if np.ndim(value) == 0 else value
+
+
 def strength_factor(fc):
     """Forrestal et al.'s empirical ``S = 82.6 f_c^-0.544`` for ``fc`` in Pa (fitted in MPa)."""
-    require(math.isfinite(fc) and fc > 0.0, "fc", "a finite number > 0 (Pa)", fc)
-    return S_COEFFICIENT * (fc / 1e6) ** S_EXPONENT
+    _require_all(fc, "fc", "a finite number > 0 (Pa)", 0.0)
+    return S_COEFFICIENT * (np.asarray(fc, dtype=float) / 1e6) ** S_EXPONENT
 
 
 def ogive_factor(crh):
     """Nose factor ``N* = (8 psi - 1)/(24 psi^2)`` of a tangent ogive, ``psi`` = CRH."""
-    require(math.isfinite(crh) and crh >= 0.5, "crh", "a finite number >= 0.5", crh)
+    _require_all(crh, "crh", "a finite number >= 0.5", 0.5, inclusive=True)
+    crh = np.asarray(crh, dtype=float)
     return (8.0 * crh - 1.0) / (24.0 * crh ** 2)
 
 
@@ -62,26 +76,28 @@ def li_chen_functions(mass, diameter, crh, velocity, fc, rho, S=None):
 
 def penetration_calibres(mass, diameter, crh, velocity, fc, rho, *, S=None,
                          crater_calibres=CRATER_CALIBRES):
-    """Depth over diameter ``X/d`` (Li and Chen's dimensionless form of Forrestal et al. 1994).
+    """Depth over diameter ``X/d`` (Li and Chen's dimensionless form of Forrestal et al. 1994),
+    elementwise on numbers or arrays (a float for numbers).
 
     Parameters
     ----------
-    mass, diameter, crh, velocity, fc, rho : float
+    mass, diameter, crh, velocity, fc, rho : float or array
         kg, m, 1, m/s, Pa, kg/m^3.
-    S : float, optional
+    S : float or array, optional
         Strength factor; default :func:`strength_factor` of ``fc``.
-    crater_calibres : float
+    crater_calibres : float or array
         Crater depth ``k`` in calibres (Forrestal et al.: 2).
     """
     for name, value in (("mass", mass), ("diameter", diameter), ("velocity", velocity),
                         ("rho", rho), ("crater_calibres", crater_calibres)):
-        require(math.isfinite(value) and value > 0.0, name, "a finite number > 0", value)
+        _require_all(value, name, "a finite number > 0", 0.0)
     I, N = li_chen_functions(mass, diameter, crh, velocity, fc, rho, S)  # noqa: E741
-    k = crater_calibres
-    crater = 1.0 + k * math.pi / (4.0 * N)
-    if I / N <= crater - 1.0:  # V_1^2 <= 0: stops inside the crater
-        return math.sqrt(I * (4.0 * k / math.pi) * crater / (1.0 + I / N))
-    return 2.0 * N / math.pi * math.log((1.0 + I / N) / crater) + k
+    k = np.asarray(crater_calibres, dtype=float)
+    crater = 1.0 + k * np.pi / (4.0 * N)
+    in_crater = I / N <= crater - 1.0  # V_1^2 <= 0: stops inside the crater
+    stopped = np.sqrt(I * (4.0 * k / np.pi) * crater / (1.0 + I / N))
+    tunnel = 2.0 * N / np.pi * np.log(np.maximum((1.0 + I / N) / crater, 1.0)) + k
+    return _number_or_array(np.where(in_crater, stopped, tunnel))
 
 
 def forrestal_depth(mass, diameter, crh, velocity, fc, rho, *, S=None,
