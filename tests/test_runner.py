@@ -226,3 +226,20 @@ def test_fe_case_ids_are_stable_and_unique():
 def test_bad_scheduler_address_is_an_input_error():
     with pytest.raises(CavexInputError, match="'scheduler' must be a Dask scheduler address"):
         run_cases(probe_cases, probes(1), scheduler="nonsense://nowhere")
+
+
+def test_while_running_is_called_once_while_the_workers_compute(cluster, tmp_path):
+    """``while_running`` runs once in the parent after the first units are handed out, on a
+    pool and on Dask (the results unchanged), and not at all serially or with nothing to run."""
+    cases = probes(12)
+    serial = run_cases(probe_cases, cases, workers=1, while_running=lambda: 1 / 0)
+    calls = []
+    pool = run_cases(probe_cases, cases, workers=2, while_running=lambda: calls.append("pool"))
+    dask = run_cases(probe_cases, cases, scheduler=cluster.scheduler_address,
+                     while_running=lambda: calls.append("dask"))
+    assert serial == pool == dask
+    assert calls == ["pool", "dask"]
+    run_cases(probe_cases, cases, workers=2, store=tmp_path / "store")
+    run_cases(probe_cases, cases, workers=2, store=tmp_path / "store",
+              while_running=lambda: calls.append("nothing left"))
+    assert calls == ["pool", "dask"]

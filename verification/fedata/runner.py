@@ -45,7 +45,7 @@ _ADDRESS = re.compile(r"^(?:(?P<protocol>tcp|tls|ws|wss|ucx)://)?"
 
 
 def run_cases(function, cases, *, store=None, scheduler=None, workers=None, progress=None,
-              chunk_size=None):
+              chunk_size=None, while_running=None):
     """Run ``function`` on every case and return the results in the order of ``cases``.
 
     Parameters
@@ -69,6 +69,12 @@ def run_cases(function, cases, *, store=None, scheduler=None, workers=None, prog
         Progress bar with ETA on stderr; None shows it when stderr is a terminal.
     chunk_size : int, optional
         Consecutive cases per work unit; default: see :func:`chunks`.
+    while_running : callable, optional
+        Called once, without arguments, in this process once the first work units have been
+        handed to the worker processes (or the Dask cluster): work the caller needs afterwards
+        (e.g. importing the libraries that write its results), done while the cases compute
+        instead of after them. Not called when the cases run in this process (``workers`` 1)
+        or none is left to run.
 
     Returns
     -------
@@ -104,7 +110,8 @@ def run_cases(function, cases, *, store=None, scheduler=None, workers=None, prog
 
         try:
             if todo:
-                _execute(function, todo, scheduler, workers, finished, chunk_size)
+                _execute(function, todo, scheduler, workers, finished, chunk_size,
+                         while_running)
         finally:
             bar.close()
     return [results[case["id"]] for case in cases]
@@ -336,15 +343,15 @@ def chunks(todo, parallelism, chunk_size=None):
     return [todo[i::n] for i in range(n)]
 
 
-def _execute(function, todo, scheduler, workers, finished, chunk_size):
+def _execute(function, todo, scheduler, workers, finished, chunk_size, while_running=None):
     if scheduler is not None:
-        _run_dask(function, todo, scheduler, finished, chunk_size)
+        _run_dask(function, todo, scheduler, finished, chunk_size, while_running)
     elif workers == 1:
         for chunk in chunks(todo, 1, chunk_size):
             finished(chunk, run_chunk(function, chunk))
     else:
         units = chunks(todo, workers, chunk_size)
-        _run_pool(function, units, min(workers, len(units)), finished)
+        _run_pool(function, units, min(workers, len(units)), finished, while_running)
 
 
 def _pool_context():
@@ -363,14 +370,17 @@ def process_pool(workers):
                                initializer=_die_with_parent)
 
 
-def _run_pool(function, todo, workers, finished):
-    """Local processes; at most ``2 * workers`` chunks in flight."""
+def _run_pool(function, todo, workers, finished, while_running=None):
+    """Local processes; at most ``2 * workers`` chunks in flight; ``while_running`` once they
+    are (the workers are forked by then)."""
     pending = iter(todo)
     with process_pool(workers) as pool:
         try:
             running = {}
             _top_up(running, pending, 2 * workers,
                     lambda chunk: pool.submit(run_chunk, function, chunk))
+            if while_running is not None:
+                while_running()
             while running:
                 done, _ = wait(running, return_when=FIRST_COMPLETED)
                 for future in done:
@@ -408,7 +418,7 @@ def _top_up(running, pending, limit, submit):
         running[submit(case)] = case
 
 
-def _run_dask(function, todo, scheduler, finished, chunk_size):
+def _run_dask(function, todo, scheduler, finished, chunk_size, while_running=None):
     """A Dask cluster: an address (a client is opened and closed here) or a ``Client``."""
     from dask.distributed import Client, as_completed
 
@@ -418,15 +428,15 @@ def _run_dask(function, todo, scheduler, finished, chunk_size):
         with client.as_current():
             threads = max(1, sum(client.nthreads().values()))
             _stream_dask(client, as_completed, function, chunks(todo, threads, chunk_size),
-                         finished)
+                         finished, while_running)
     finally:
         if own:
             client.close()
 
 
-def _stream_dask(client, as_completed, function, todo, finished):
+def _stream_dask(client, as_completed, function, todo, finished, while_running=None):
     """Keep at most twice the cluster's threads of chunks in flight; hand results back as they
-    finish."""
+    finish; ``while_running`` once the first are in flight."""
     limit = 2 * max(1, sum(client.nthreads().values()))
     pending = iter(todo)
     running = {}
@@ -437,6 +447,8 @@ def _stream_dask(client, as_completed, function, todo, finished):
                              key=f"{name}-{chunk[0]['id']}+{len(chunk) - 1}-{uuid.uuid4().hex[:8]}")
 
     _top_up(running, pending, limit, submit)
+    if while_running is not None:
+        while_running()
     stream = as_completed(list(running))
     for future in stream:
         case = running.pop(future)

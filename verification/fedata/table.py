@@ -30,7 +30,6 @@ from importlib import metadata
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
 
 from cavex.analytic.geometry import spherical_problem, switch_depths, wall_layer
 from cavex.config import config_text, fingerprint, fingerprint_data, projectile_table, target_table
@@ -150,11 +149,22 @@ def build_table(target, projectile, velocities, depths, *, nu=None, numerics=Non
     # issue grid: ~0.4 s of CPU less per worker)
     reference = analytic_grid(target, projectile, v, d)
     results = run_cases(fe_cases, grid + first, store=store, scheduler=scheduler,
-                        workers=workers, progress=progress)
+                        workers=workers, progress=progress, while_running=load_table_writer)
     cells = _cells(results[:len(grid)], grid, v, d)
     crater = _cells(results[len(grid):], first, v, [FIRST_LAYER_DEPTH])
     return assemble_table(target, projectile, v, d, cells, crater,
                           settings_json(nu, numerics, error_target), reference)
+
+
+def load_table_writer():
+    """Import xarray and what it loads on the first dataset and netCDF write (dask and
+    dask.distributed, probed for chunked arrays and schedulers) by writing a one-value
+    dataset to memory: a fixed cost of every table command (~0.4-0.8 s, more than the FE of a
+    100-case grid takes on two workers; benchmarks/table.py), which :func:`build_table` has
+    done while the FE workers compute (``run_cases(while_running=...)``)."""
+    import xarray as xr
+
+    xr.Dataset({"warm": ("n", np.zeros(1))}).to_netcdf(engine="scipy")
 
 
 def table_cases(target, projectile, velocities, depths, nu, numerics,
@@ -271,6 +281,8 @@ def assemble_table(target, projectile, velocities, depths, cells, crater, settin
     coords = {"velocity": ("velocity", v, _attrs(UNITS["velocity"],
                                                  "cavity expansion velocity V")),
               "depth": ("depth", d, _attrs(UNITS["length"], "nose-tip depth L"))}
+    import xarray as xr  # not at the top: see load_table_writer
+
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(table_attrs(target, projectile, settings))
     ds.attrs["layer_names"] = json.dumps(names)
