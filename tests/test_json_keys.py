@@ -126,6 +126,13 @@ def test_penetrate(capsys, tmp_path, resistance):
     assert document["table2"] and offending_keys(document) == []
 
 
+def test_penetrate_plain_law(capsys, tmp_path):
+    document = run_json(capsys, "penetrate", "--resistance", "law", "--law-A", "2e8",
+                        "--law-B", "2500", "--out", str(tmp_path), "--no-figures")
+    assert document["law"] == {"A_Pa": 2e8, "B_kg_m3": 2500.0}
+    assert offending_keys(document) == []
+
+
 def test_fem(capsys):
     document = run_json(capsys, "fem", "--velocity", "300", "--depth", "0.3")
     assert "fe_sigma_r_Pa" in document and offending_keys(document) == []

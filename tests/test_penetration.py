@@ -29,6 +29,7 @@ from cavex.analytic.penetration.integrator import (
     integrate,
     penetrate,
 )
+from cavex.analytic.penetration.plain_law import PlainLawResistance
 from cavex.analytic.penetration.resistance import (
     MODEL_LABELS,
     OLD_LABELS,
@@ -155,7 +156,8 @@ def test_integrate_from_a_start_state_matches_exact_solution(single):
 
 
 @pytest.mark.parametrize("implementation", [ClosedFormResistance, TabulatedResistance,
-                                            ReadingResistance, CraterAsTunnel])
+                                            ReadingResistance, CraterAsTunnel,
+                                            PlainLawResistance])
 def test_resistances_implement_the_protocol(implementation):
     assert issubclass(implementation, Resistance)
     for name in ("force", "label", "crater_force"):
@@ -168,7 +170,8 @@ def test_resistance_instances_pass_the_runtime_check(default):
     target, projectile = default
     reading = ReadingResistance(target, projectile, Reading("base"))
     for resistance in (ClosedFormResistance(target, projectile), reading,
-                       CraterAsTunnel(reading, 0.1)):
+                       CraterAsTunnel(reading, 0.1),
+                       PlainLawResistance(target, projectile, law_A=2e8, law_B=2500.0)):
         assert isinstance(resistance, Resistance)
 
 
@@ -428,5 +431,7 @@ def test_make_resistance_builds_the_chosen_resistance(default, tmp_path):
         assert isinstance(tabulated, TabulatedResistance)
     with pytest.raises(CavexInputError, match="'table'"):
         make_resistance(target, projectile, resistance="table")
+    law = make_resistance(target, projectile, resistance="law", law_A=2e8, law_B=2500.0)
+    assert isinstance(law, PlainLawResistance)  # the plain law (test_plain_law_1d)
     with pytest.raises(CavexInputError, match="'resistance'"):
-        make_resistance(target, projectile, resistance="law")
+        make_resistance(target, projectile, resistance="plain")

@@ -59,7 +59,7 @@ def build_parser():
     commands = parser.add_subparsers(dest="command", parser_class=_Parser, metavar="COMMAND")
     penetrate = commands.add_parser("penetrate", help="integrate the projectile through the target")
     _config(penetrate)
-    add_resistance_options(penetrate)
+    add_resistance_options(penetrate, ("derived", "paper", "table", "law"))
     add_interface_option(penetrate)
     penetrate.add_argument("--json", action="store_true", help="print JSON")
     penetrate.add_argument("--out", default=DEFAULT_PENETRATION_DIR, help="output folder")
@@ -145,11 +145,6 @@ def build_parser():
     trajectory.add_argument("--contact-ramp", dest="contact_ramp", type=float, default=None,
                             help="contact regularisation: the stress rises linearly over "
                             "0 < V_n < this (m/s; default 0.01; docs/oblique.md)")
-    trajectory.add_argument("--law-A", dest="law_A", type=float, help="A of sigma_n = A + B "
-                            "V_n^2 everywhere (Pa; with --resistance law; default: none, each "
-                            "layer's law_A, law_B keys)")
-    trajectory.add_argument("--law-B", dest="law_B", type=float, help="B (kg/m^3; with "
-                            "--law-A; default: none)")
     trajectory.add_argument("--tunnel-wall", dest="tunnel_wall", type=float, default=None,
                             help="factor in [0, 1] on the shank's load in every layer (a "
                             "sensitivity setting, uncalibrated; default: each layer's "

@@ -14,7 +14,12 @@ crosses an interface depth ``H_i``, or where ``V = 0``. :func:`integrate` runs o
 from any start state ``(t0, L0, V0)``; :func:`penetrate` chains them, and the Table 2 study runs
 it from the paper's own row states.
 
-The resistance is any :class:`~cavex.analytic.penetration.resistance.Resistance`.
+The resistance is any :class:`~cavex.analytic.penetration.resistance.Resistance`. One that
+has ``force_jumps`` (nose-tip depths where ``F`` jumps in ``L``: the plain law's rings crossing
+the surface and the interfaces, :class:`~cavex.analytic.penetration.plain_law.
+PlainLawResistance`) gets a step end at each: the stretch stops there and the same phase goes
+on (unless its label changes there), so that no step straddles a jump and the tolerance holds;
+a resistance without them integrates as before.
 """
 
 import math
@@ -32,6 +37,7 @@ __all__ = ["CRATER_MODES", "CRATER_RATIO", "crater_depth", "penetrate", "integra
 STOPPED = "projectile stopped"
 STATE_CHANGED = "response state changed"
 DEPTH_REACHED = "stop depth reached"
+FORCE_JUMP = "force jumps"  # a stretch's end at one of the resistance's force_jumps
 RTOL, ATOL = 1e-9, 1e-12  # solve_ivp's tolerances
 MAX_PHASE_DURATION = 10.0  # s; a phase that has not ended by then is a numerical failure
 
@@ -171,7 +177,9 @@ def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol
     crater stage below each debonded interface, :func:`phase_stops`)."""
     label = resistance.label(start[1], start[2])
     stops = phase_stops(target, projectile)
-    ahead = [stop for stop in stops if stop[0] > start[1]]
+    jumps = [(depth, FORCE_JUMP, None) for depth in getattr(resistance, "force_jumps", ())]
+    ahead = sorted((stop for stop in stops + jumps if stop[0] > start[1]),
+                   key=lambda stop: stop[0])
     stage = "rear face" if any(s[2] == "rear face" and s[0] <= start[1] < d[0]
                                for s, d in zip(stops, stops[1:], strict=False)) else "tunnel"
     while start[2] > 0.0:
@@ -179,8 +187,16 @@ def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol
         phase, sol = integrate(resistance, projectile.m, start, stop_depth=stop_depth,
                                stop_reason=stop_reason, label=label, rtol=rtol, atol=atol)
         _append_solution(columns, sol, phase, resistance, projectile.m, len(phases))
-        phases.append(replace(phase, stage=stage))
         start = (phase.end_time, phase.end_depth, phase.end_velocity)
+        if phase.end_reason == FORCE_JUMP:  # a step ends where the force jumps; the phase
+            ahead.pop(0)                    # goes on past it unless the label changes there
+            new = _next_label(resistance, sol, phase.end_time, label)
+            if new == label and start[2] > 0.0:
+                continue
+            phase, label = replace(phase, end_reason=STATE_CHANGED), new
+            phases.append(replace(phase, stage=stage))
+            continue
+        phases.append(replace(phase, stage=stage))
         if phase.end_reason == stop_reason:
             stage = ahead.pop(0)[2]
             if stage == "crater":
@@ -252,7 +268,7 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
     def rhs(t, y):  # depth never falls below the start: a trial stage past rest is clamped
         return (y[1], -resistance.force(max(y[0], depth0), max(y[1], 0.0)) / mass)
 
-    events = _phase_events(resistance, stop_depth, stop_reason, label)
+    events = _phase_events(resistance, stop_depth, stop_reason, label, t0)
     sol = solve_ivp(rhs, (t0, t0 + MAX_PHASE_DURATION), (depth0, v0),
                     method="DOP853", events=[e for e, _ in events], dense_output=True,
                     rtol=rtol, atol=atol)
@@ -275,13 +291,22 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
     return Phase(label, depth_end, v_end, t_end, reason), sol
 
 
-def _phase_events(resistance, stop_depth, stop_reason, label):
-    """Terminal events of one phase, each with the reason it ends the phase."""
+def _phase_events(resistance, stop_depth, stop_reason, label, start_time=None):
+    """Terminal events of one phase, each with the reason it ends the phase.
+
+    The state event is +1 at the phase's start time ``start_time`` itself: a phase that
+    starts where the previous one's state changed starts at that event's root, which may sit
+    a root's width (``solve_ivp``'s 4 eps) before the jump, with the old label. Counted as -1
+    there, the event would miss the phase's own end whenever the first step crosses the whole
+    phase (a short phase under a smooth force: the nose's rings crossing an interface under
+    the plain law). Only the value at the start changes: the steps do not depend on it."""
 
     def stopped(t, y):
         return y[1]
 
     def state_changed(t, y):
+        if t == start_time:
+            return 1.0
         return 1.0 if resistance.label(y[0], max(y[1], 0.0)) == label else -1.0
 
     stopped.direction = state_changed.direction = -1.0

@@ -11,6 +11,14 @@ MODELS = ("derived", "paper")  # the closed forms (ClosedFormResistance)
 #: Every 1-D resistance a caller can choose (``resistance=``, ``--resistance``): the two closed
 #: forms and the FE table (:class:`cavex.analytic.penetration.tabulated.TabulatedResistance`).
 RESISTANCES = (*MODELS, "table")
+#: The plain law ``sigma_n = A + B V_n^2`` (the global ``--law-A``/``--law-B``) or each layer's
+#: own ``tau_k A_k + B_k rho_k V_n^2`` (its ``law_A``, ``law_B`` keys): a resistance of the
+#: commands that fly the projectile only, and its label (it has no boundary convention and is
+#: no model of ``calibrate`` or ``validate``).
+PLAIN_LAW = "law"
+#: The resistances of the commands that fly the projectile (``penetrate``, ``trajectory``; the
+#: API's ``make_resistance`` and ``make_law``): :data:`RESISTANCES` and :data:`PLAIN_LAW`.
+FLIGHT_RESISTANCES = (*RESISTANCES, PLAIN_LAW)
 #: The model labels (keys and labels in JSON, CSV, reports, calibration files): the resistance
 #: and, for the derived model, its boundary convention (:func:`model_label`).
 MODEL_LABELS = ("derived-quasi-static", "derived-dynamic", "paper", "table")

@@ -23,10 +23,12 @@ from cavex.analytic.geometry import spherical_problem, surrounding
 from cavex.analytic.paper_model import PaperModel
 from cavex.analytic.penetration.labels import (  # noqa: F401 (the vocabulary, re-exported)
     DEFAULT_BOUNDARY,
+    FLIGHT_RESISTANCES,
     MODEL_LABELS,
     MODELS,
     OLD_LABELS,
     PAPER_BOUNDARY,
+    PLAIN_LAW,
     RESISTANCES,
     check_model,
     label_options,
@@ -41,12 +43,18 @@ RECENT = 32  # (depth, velocity) answers kept
 
 
 def make_resistance(target, projectile, resistance="derived", boundary=None,
-                    epsilon="quasi-static", table=None):
-    """The 1-D resistance object for ``resistance`` (:data:`RESISTANCES`):
+                    epsilon="quasi-static", table=None, *, law_A=None, law_B=None):
+    """The 1-D resistance object for ``resistance`` (:data:`FLIGHT_RESISTANCES`):
     :class:`ClosedFormResistance` for "derived" (``boundary``) and "paper" (``epsilon``),
     :class:`~cavex.analytic.penetration.tabulated.TabulatedResistance` of ``table`` (a Dataset
-    or the path of a table file, built for this target) for "table"."""
-    require_choice(resistance, RESISTANCES, "resistance")
+    or the path of a table file, built for this target) for "table",
+    :class:`~cavex.analytic.penetration.plain_law.PlainLawResistance` for "law" (the global
+    ``law_A`` Pa, ``law_B`` kg/m^3, or neither: each layer's ``law_A``, ``law_B`` keys)."""
+    require_choice(resistance, FLIGHT_RESISTANCES, "resistance")
+    if resistance == PLAIN_LAW:
+        from cavex.analytic.penetration.plain_law import PlainLawResistance
+
+        return PlainLawResistance(target, projectile, law_A, law_B)
     if resistance != "table":
         return ClosedFormResistance(target, projectile, resistance, boundary, epsilon=epsilon)
     from cavex.analytic.penetration.tabulated import TabulatedResistance, load_table

@@ -36,6 +36,7 @@ import numpy as np
 from numba import njit
 
 from cavex.analytic.cavity import FAILED, _point, material_table
+from cavex.analytic.penetration.labels import FLIGHT_RESISTANCES
 from cavex.errors import (
     CavexInputError,
     CavexNumericalError,
@@ -49,7 +50,7 @@ HORIZONTAL = 1e-12  # |n_z| below which a normal counts as horizontal
 FAR = 1e6  # m: interface radius standing for "never met"
 DEPTH_QUADRATIC, TABLE, DERIVED, LAYER_QUADRATIC = range(4)
 OK, WALK_FAILED, BEYOND_TABLE, NOT_FINITE = range(4)
-RESISTANCES = ("derived", "paper", "table", "law")
+RESISTANCES = FLIGHT_RESISTANCES  # the laws: "derived", "paper", "table", "law"
 _EMPTY1 = np.empty(0)
 _EMPTY2 = np.empty((0, 0))
 _EMPTY3 = np.empty((0, 0, 6))

@@ -1,11 +1,12 @@
 """The one choice "which resistance" on the command line, shared by every command that makes it.
 
 Options (``penetrate``, ``stress``, ``trajectory``, ``calibrate``): ``--resistance`` one of
-:data:`cavex.analytic.penetration.resistance.RESISTANCES` (``trajectory`` also ``law``; ``stress``
-only the closed forms), ``--boundary {dynamic,quasi-static}`` (the derived model's convention;
-default dynamic; the paper model keeps its own quasi-static and refuses another), ``--table
-FILE`` with ``table``, ``--epsilon`` (the paper model's reading of epsilon). Together they name
-one model label (:func:`cavex.analytic.penetration.resistance.model_label`).
+:data:`cavex.analytic.penetration.resistance.RESISTANCES` (``penetrate`` and ``trajectory`` also
+``law``, with ``--law-A``/``--law-B``; ``stress`` only the closed forms), ``--boundary
+{dynamic,quasi-static}`` (the derived model's convention; default dynamic; the paper model
+keeps its own quasi-static and refuses another), ``--table FILE`` with ``table``,
+``--epsilon`` (the paper model's reading of epsilon). Together they name one model label
+(:func:`cavex.analytic.penetration.resistance.model_label`; the plain law's is ``law``).
 
 The earlier spellings (``--model derived|paper``, ``--resistance closed-form``, ``calibrate
 --model derived-dynamic|derived-quasi-static|paper|fe-table``) are refused with one line that
@@ -19,6 +20,7 @@ from cavex.analytic.penetration.labels import (
     MODEL_LABELS,
     MODELS,
     OLD_LABELS,
+    PLAIN_LAW,
     RESISTANCES,
     check_model,
     label_options,
@@ -54,7 +56,43 @@ def add_resistance_options(command, offered=RESISTANCES, table=True, epsilon=Tru
         command.add_argument("--epsilon", choices=EPSILON_READINGS,
                              help="the paper model's reading of epsilon (docs/table2.md) "
                              "(default: quasi-static)")
+    if PLAIN_LAW in offered:
+        add_law_options(command)
     command.add_argument("--model", dest="old_model", help=argparse.SUPPRESS)
+
+
+def add_law_options(command):
+    """``--law-A PA --law-B KG_PER_M3``: the global plain law of ``--resistance law`` (added by
+    :func:`add_resistance_options` where "law" is offered: ``penetrate``, ``trajectory``)."""
+    command.add_argument("--law-A", dest="law_A", type=float, help="A of sigma_n = A + B "
+                         "V_n^2 everywhere (Pa; with --resistance law; default: none, each "
+                         "layer's law_A, law_B keys)")
+    command.add_argument("--law-B", dest="law_B", type=float, help="B (kg/m^3; with "
+                         "--law-A; default: none)")
+
+
+def law_settings(args, target):
+    """``{"law_A", "law_B"}`` of the parsed ``--law-A``/``--law-B`` (None: each layer's own),
+    checked: both or neither, only with ``--resistance law``; without them every layer of
+    ``target`` has its ``law_A``, ``law_B`` keys (the first without is named); no
+    ``--boundary`` with the law. The values' ranges are checked where the law is made
+    (:class:`cavex.analytic.penetration.stress_laws.PlainLaw`)."""
+    law = [args.law_A is not None, args.law_B is not None]
+    if any(law) and not (all(law) and args.resistance == PLAIN_LAW):
+        raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
+                              "'--resistance law' (both, or neither: each layer's law_A, "
+                              "law_B keys)")
+    if args.resistance == PLAIN_LAW and not any(law):
+        missing = next((i for i, plain in enumerate(target.plain_laws) if plain is None), None)
+        if missing is not None:
+            raise CavexInputError("must be given on every layer for '--resistance law' without "
+                                  "'--law-A PA --law-B KG_PER_M3' (the layer's plain law "
+                                  "S = A + B rho V^2 / tau; docs/config.md)",
+                                  f"layers[{missing}].law_A")
+    if args.resistance == PLAIN_LAW and args.boundary is not None:
+        raise CavexInputError("option '--boundary' goes with '--resistance derived' (or table); "
+                              "'--resistance law' has no boundary convention")
+    return {"law_A": args.law_A, "law_B": args.law_B}
 
 
 def replaced(value):

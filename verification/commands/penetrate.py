@@ -9,6 +9,7 @@ import json
 from pathlib import Path
 
 from cavex.analytic.penetration.integrator import crater_depth, penetrate
+from cavex.analytic.penetration.labels import FLIGHT_RESISTANCES, PLAIN_LAW
 from cavex.analytic.penetration.resistance import make_resistance, model_boundary, model_label
 from cavex.analytic.penetration.zones import scab_depth
 from cavex.config import load_config
@@ -25,40 +26,53 @@ from cavex.verification.studies.table2 import not_reproduced_line, table2_compar
 def run(args, target, projectile):
     """``cavex penetrate``: fly, write every file or none (also on Ctrl-C or kill), return the
     text or JSON to print."""
-    from cavex.verification.commands.options import interface_target, resistance_settings
+    from cavex.verification.commands.options import (
+        interface_target,
+        law_settings,
+        resistance_settings,
+    )
 
-    settings = resistance_settings(args)
+    settings = resistance_settings(args, FLIGHT_RESISTANCES)
     target = interface_target(args, target, settings["resistance"])
+    laws = law_settings(args, target)
     folder = check_output_dir(args.out, "out")
-    job = penetration_job(target, projectile, crater=args.crater, **settings)
+    job = penetration_job(target, projectile, crater=args.crater, **settings, **laws)
     written = write_staged(folder, lambda stage: write_outputs(job, stage, draw=args.figures))
     document = summary(job, written)
     return json.dumps(document, indent=2) if args.json else text(document)
 
 
 def penetration_job(target, projectile, *, resistance="derived", boundary=None,
-                    epsilon="quasi-static", crater="nose-base", table=None):
+                    epsilon="quasi-static", crater="nose-base", table=None, law_A=None,
+                    law_B=None):
     """Run the target and its first layer alone (the paper's Fig. 4 pair); nothing is written.
 
-    ``resistance`` is one of :data:`cavex.analytic.penetration.resistance.RESISTANCES`;
+    ``resistance`` is one of :data:`cavex.analytic.penetration.labels.FLIGHT_RESISTANCES`;
     ``boundary`` None is the default: dynamic for the derived model, the paper's own
     quasi-static for the paper model (:func:`cavex.analytic.penetration.resistance.model_boundary`).
 
     With ``resistance="table"`` the runway uses the FE-tabulated resistance of ``table`` (the
     path of a table built for this target); the first layer alone keeps the derived closed
-    form with ``boundary``.
+    form with ``boundary``. With ``resistance="law"`` both use the plain law: the global
+    ``law_A`` (Pa), ``law_B`` (kg/m^3), or neither: each layer's ``law_A``, ``law_B`` keys
+    (:class:`~cavex.analytic.penetration.plain_law.PlainLawResistance`); it has no boundary
+    convention (``boundary`` None).
     """
-    model = model_label(resistance, boundary)
+    law = resistance == PLAIN_LAW
+    model = PLAIN_LAW if law else model_label(resistance, boundary)
     closed = "derived" if resistance == "table" else resistance
-    first = model_label(closed, boundary)
-    boundary = model_boundary(closed, boundary)
+    first = model if law else model_label(closed, boundary)
+    boundary = None if law else model_boundary(closed, boundary)
     single = target.single(0)
+    laws = {"law_A": law_A, "law_B": law_B}
     runs = {"runway": penetrate(target, projectile, make_resistance(
-                target, projectile, resistance, boundary, epsilon, table), crater=crater),
+                target, projectile, resistance, boundary, epsilon, table, **laws),
+                crater=crater),
             "first_layer_only": penetrate(single, projectile, make_resistance(
-                single, projectile, closed, boundary, epsilon), crater=crater)}
+                single, projectile, closed, boundary, epsilon, **laws), crater=crater)}
     paper = (target.with_interfaces("bonded"), projectile) == load_config()
-    return {"model": model, "interfaces": interface_summary(target, projectile),
+    settings = {"law": law_echo(target, law_A, law_B)} if law else {}
+    return {**settings, "model": model, "interfaces": interface_summary(target, projectile),
             "first_layer_model": first, "resistance": resistance,
             "boundary": boundary, "epsilon": epsilon,
             "table": None if table is None else str(table), "crater": crater,
@@ -67,12 +81,21 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
             "notes": crater_notes(target, projectile, crater),
             "debonded": bool(target.debonded),
             "interface_depths": target.interface_depths,
-            "title": resistance_title(resistance, boundary, epsilon, table),
+            "title": resistance_title(resistance, boundary, epsilon, table,
+                                      settings.get("law"), target.layer_names()),
             "layer_names": target.layer_names()}
 
 
+def law_echo(target, law_A, law_B):
+    """The plain law as the JSON settings give it (as ``cavex trajectory``): the global
+    ``{"A_Pa", "B_kg_m3"}``, or each layer's ``{"law_A", "law_B"}`` keys."""
+    if law_A is not None:
+        return {"A_Pa": law_A, "B_kg_m3": law_B}
+    return [{"law_A": A, "law_B": B} for A, B in target.plain_laws]
+
+
 SETTINGS = ("model", "first_layer_model", "resistance", "boundary", "epsilon", "table",
-            "crater", "interfaces", "target_label", "notes")
+            "law", "crater", "interfaces", "target_label", "notes")  # "law": the plain law's
 
 
 def interface_summary(target, projectile):
@@ -86,7 +109,7 @@ def interface_summary(target, projectile):
 def summary(job, written=()):
     """What ``cavex penetrate --json`` prints: the settings, the runway's phases, the rows
     beside the paper's Table 2 (None for another target) and the files written."""
-    return {**{key: job[key] for key in SETTINGS},
+    return {**{key: job[key] for key in SETTINGS if key in job},
             "phases": phases_as_dicts(job["runs"]["runway"]), "table2": job["table2"],
             "outputs": list(written)}
 
@@ -95,7 +118,8 @@ def text(summary):
     """The phase table, the rows beside the paper's Table 2 and the files written."""
     s = summary
     settings = {"paper": f", epsilon {s['epsilon']}",
-                "table": f" ({s['table']}; first layer alone: {s['first_layer_model']})"}
+                "table": f" ({s['table']}; first layer alone: {s['first_layer_model']})",
+                PLAIN_LAW: f" ({law_text(s['law'])})" if "law" in s else ""}
     debonded = [i for i in s["interfaces"] if i["bottom"] == "debonded"]
     lines = [f"model {s['model']}{settings.get(s['resistance'], '')}, crater from {s['crater']}"]
     if debonded:
@@ -138,10 +162,25 @@ def crater_notes(target, projectile, crater):
             "throughout"]
 
 
-def resistance_title(resistance, boundary, epsilon, table=None):
+def law_text(law, names=None):
+    """The plain law in words: ``sigma_n = A + B V_n^2, A 2e+08 Pa, B 2500 kg/m^3`` (global) or
+    ``sigma_n = tau_k A_k + B_k rho_k V_n^2; concrete A 20, B 1; ...`` (each layer's keys,
+    ``names`` the layers' names)."""
+    if isinstance(law, dict):
+        return f"sigma_n = A + B V_n^2, A {law['A_Pa']:g} Pa, B {law['B_kg_m3']:g} kg/m^3"
+    names = names or [f"layer {k + 1}" for k in range(len(law))]
+    return "sigma_n = tau_k A_k + B_k rho_k V_n^2; " + "; ".join(
+        f"{name} A {k['law_A']:g}, B {k['law_B']:g}" for name, k in zip(names, law, strict=True))
+
+
+def resistance_title(resistance, boundary, epsilon, table=None, law=None, names=None):
     """What the figures say about the resistance: the settings the closed form uses (the
     paper's model has its own quasi-static boundary and an epsilon reading; the derived model
-    has a boundary convention), and for a table (``resistance`` "table") only its file name."""
+    has a boundary convention), for a table (``resistance`` "table") only its file name, for
+    the plain law (``resistance`` "law") ``law`` in words (:func:`law_text`, ``names`` the
+    layers')."""
+    if resistance == PLAIN_LAW:
+        return "plain law " + law_text(law, names)
     closed = (f"paper model (She 2020), epsilon: {epsilon}" if resistance == "paper"
               else f"derived model, {boundary} boundary")
     if resistance != "table":

@@ -545,11 +545,15 @@ def view_3d(job, path):
 def run(args, target, projectile):
     """``cavex trajectory``: checks, runs, writes (every file or none, also on Ctrl-C or
     kill), returns the text or JSON to print."""
-    from cavex.analytic.penetration.resistance import RESISTANCES
+    from cavex.analytic.penetration.labels import FLIGHT_RESISTANCES
     from cavex.errors import CavexInputError, CavexNumericalError
-    from cavex.verification.commands.options import interface_target, resistance_settings
+    from cavex.verification.commands.options import (
+        interface_target,
+        law_settings,
+        resistance_settings,
+    )
 
-    settings = resistance_settings(args, (*RESISTANCES, "law"))
+    settings = resistance_settings(args, FLIGHT_RESISTANCES)
     target = interface_target(args, target, settings["resistance"])
     if args.tunnel_wall is not None:
         require(is_finite_number(args.tunnel_wall) and 0.0 <= args.tunnel_wall <= 1.0,
@@ -557,21 +561,7 @@ def run(args, target, projectile):
         target = target.with_tunnel_wall(args.tunnel_wall)
     require(is_finite_number(args.tangency_psi) and 0.0 <= args.tangency_psi <= 30.0,
             "tangency-psi", "in [0, 30] degrees", args.tangency_psi)
-    law = [args.law_A is not None, args.law_B is not None]
-    if any(law) and not (all(law) and args.resistance == "law"):
-        raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
-                              "'--resistance law' (both, or neither: each layer's law_A, "
-                              "law_B keys)")
-    if args.resistance == "law" and not any(law):
-        missing = next((i for i, plain in enumerate(target.plain_laws) if plain is None), None)
-        if missing is not None:
-            raise CavexInputError("must be given on every layer for '--resistance law' without "
-                                  "'--law-A PA --law-B KG_PER_M3' (the layer's plain law "
-                                  "S = A + B rho V^2 / tau; docs/config.md)",
-                                  f"layers[{missing}].law_A")
-    if args.resistance == "law" and args.boundary is not None:
-        raise CavexInputError("option '--boundary' goes with '--resistance derived' (or table); "
-                              "'--resistance law' has no boundary convention")
+    laws = law_settings(args, target)
     if args.no_free_surface and args.resistance in ("law", "paper"):
         raise CavexInputError(f"option '--no-free-surface' goes with '--resistance derived' (or "
                               f"table); '--resistance {args.resistance}' has no free-surface "
@@ -596,7 +586,7 @@ def run(args, target, projectile):
             job = trajectory_job(target, projectile, strike, settings["resistance"],
                                  boundary=settings["boundary"], epsilon=settings["epsilon"],
                                  free_surface=not args.no_free_surface,
-                                 table=settings["table"], law_A=args.law_A, law_B=args.law_B,
+                                 table=settings["table"], **laws,
                                  compare_homogeneous=args.compare_homogeneous,
                                  contact_ramp=args.contact_ramp,
                                  tangency_psi=args.tangency_psi,
