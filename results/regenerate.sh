@@ -4,6 +4,13 @@
 # validation against the Forrestal et al. (1994) shots, the verification report, the oblique
 # study and the concrete study. Afterwards `git status results` shows what changed (on another
 # CPU: nothing; see cavex.verification.output.number_format for the digits written).
+# To see on this machine what a CPU with other vector maths would write (numpy 2.x on x86-64:
+# its AVX2 and AVX-512 loops of exp, log, pow... round differently; numba compiled for a generic
+# CPU; nothing reused from the caches):
+#   NPY_DISABLE_CPU_FEATURES="X86_V3 X86_V4 AVX512_ICL" NUMBA_CPU_NAME=generic \
+#   NUMBA_CACHE_DIR=$(mktemp -d) CAVEX_CACHE_DIR=$(mktemp -d) bash results/regenerate.sh
+# (2026-11-26, numpy 2.4.6 on an AVX-512 machine, 27 min: every file byte-identical but one
+# 6th digit of results/concrete/grid_depths.csv, since written with 4; docs/concrete.md)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cavex penetrate --out results/penetration > results/penetration/summary.txt

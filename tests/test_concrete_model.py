@@ -132,6 +132,13 @@ def committed():
     return read_csv(RESULTS / "predictions.csv"), read_csv(RESULTS / "grid_depths.csv")
 
 
+def written_as(text_value, exact, digits=study.DIGITS):
+    """``exact`` rounds to the written value (``digits`` significant): within half a unit of
+    its last digit, plus 1e-9 relative for another CPU's last bits."""
+    unit = 10.0 ** (math.floor(math.log10(abs(exact))) - digits + 1)
+    return abs(float(text_value) - exact) <= 0.5 * unit * (1.0 + 1e-9) + 1e-9 * abs(exact)
+
+
 def test_committed_study_is_consistent(shots, committed):
     """Every statistic of report.md is recomputed from the committed per-shot depths; the
     empirical depths are recomputed; the published-constants model is recomputed for every
@@ -141,10 +148,10 @@ def test_committed_study_is_consistent(shots, committed):
     depths = {m: [float(r[m]) if r[m] else None for r in rows] for m in study.MODELS}
     flags = [r["flag"] for r in rows]
     for i, shot in enumerate(shots):
-        assert depths[study.LI_CHEN][i] == pytest.approx(li_chen_depth(shot), rel=1e-5)
-        assert depths[study.FORRESTAL][i] == pytest.approx(empirical.shot_depth(shot), rel=1e-5)
+        assert written_as(depths[study.LI_CHEN][i], li_chen_depth(shot))
+        assert written_as(depths[study.FORRESTAL][i], empirical.shot_depth(shot))
     for i in range(0, len(shots), 20):
-        assert depths[study.MODEL][i] == pytest.approx(model_depth(shots[i]), rel=1e-5)
+        assert written_as(depths[study.MODEL][i], model_depth(shots[i]))
     grid = {point: [float(r[f"S_max={point[0]:g};p_l={point[1]:g}"]) for r in grid_rows]
             for point in study.GRID}
     assert grid[study.PUBLISHED] == depths[study.MODEL]
@@ -163,8 +170,8 @@ def test_headline_numbers(shots, committed):
     depths (which test_committed_study_is_consistent ties to the code)."""
     rows, _ = committed
     flags = [r["flag"] for r in rows]
-    expected = {study.MODEL: (0.486, 0.403, 0.470, 0.872), study.LORO: (0.536, 0.460, 0.387, 0.937),
-                study.LI_CHEN: (0.483, 0.356, 0.251, 1.152),
+    expected = {study.MODEL: (0.486, 0.403, 0.470, 0.872), study.LORO: (0.538, 0.462, 0.387, 0.945),
+                study.LI_CHEN: (0.483, 0.356, 0.251, 1.151),
                 study.CAVEX: (0.707, 0.646, 1.167, 0.822)}
     for model, numbers in expected.items():
         stats = study.statistics([float(r[model]) for r in rows], shots, flags)
