@@ -236,6 +236,16 @@ def report_md(result, shots_file):
     return "\n".join(lines)
 
 
+def study_inputs(args):
+    """``(output folder, shots)`` from a shot study's ``--out`` and ``--shots``; None, with
+    one line on stderr, when either is bad (the study then exits 2, writing nothing)."""
+    try:
+        return check_output_dir(args.out, "out"), read_shots(args.shots).shots
+    except CavexInputError as exc:
+        print(f"cavex: {exc}", file=sys.stderr)
+        return None
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m cavex.verification.studies."
                                      "concrete_validation", description=__doc__.splitlines()[0])
@@ -243,12 +253,10 @@ def main(argv=None):
     parser.add_argument("--out", default=str(DEFAULT_OUT))
     parser.add_argument("--workers", type=int, default=1)
     args = parser.parse_args(argv)
-    try:
-        folder = check_output_dir(args.out, "out")
-        shots = read_shots(args.shots).shots
-    except CavexInputError as exc:
-        print(f"cavex: {exc}", file=sys.stderr)
+    inputs = study_inputs(args)
+    if inputs is None:
         return 2
+    folder, shots = inputs
     result = study(shots, max(1, args.workers))
     folder.mkdir(parents=True, exist_ok=True)
     write_text_atomic(folder / "predictions.csv", predictions_csv(result))

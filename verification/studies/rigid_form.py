@@ -41,15 +41,12 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import minimize
 
-from cavex.errors import CavexInputError
 from cavex.verification.output.files import write_text_atomic
 from cavex.verification.output.number_format import round_significant
-from cavex.verification.output.paths import check_output_dir
-from cavex.verification.studies.concrete_validation import source
+from cavex.verification.studies.concrete_validation import source, study_inputs
 from cavex.verification.validation.concrete_model import LI_CHEN_COEFFICIENT, crater_calibres
 from cavex.verification.validation.empirical import penetration_calibres
 from cavex.verification.validation.regimes import REGIME_TITLES, REGIMES
-from cavex.verification.validation.shots import read_shots
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_SHOTS = ROOT / "examples" / "shots_compilation_dev.csv"
@@ -251,12 +248,10 @@ def main(argv=None):
     parser.add_argument("--shots", default=str(DEFAULT_SHOTS))
     parser.add_argument("--out", default=str(DEFAULT_OUT))
     args = parser.parse_args(argv)
-    try:
-        folder = check_output_dir(args.out, "out")
-        shots = read_shots(args.shots).shots
-    except CavexInputError as exc:
-        print(f"cavex: {exc}", file=sys.stderr)
+    inputs = study_inputs(args)
+    if inputs is None:
         return 2
+    folder, shots = inputs
     result = study(shots)
     folder.mkdir(parents=True, exist_ok=True)
     write_text_atomic(folder / "rigid_form.csv", study_csv(result))
