@@ -112,14 +112,15 @@ def test_shank_carries_no_load_inside_the_entry_crater(shots):
 def test_entry_crater_off_is_the_committed_study(default):
     """Off, the paper's shot writes the committed row of results/oblique/study.csv (the study
     regenerates byte-identical: results/regenerate.sh)."""
-    from cavex.verification.studies.oblique_study import APPROACH, _row, shot_summary
+    from cavex.verification.studies.oblique_study import APPROACH, _row, nose_length, shot_summary
 
     target, projectile = default
     result = fly(target, projectile, SHOT, entry_crater=False)
     assert result.model.zones == [] and result.model.opened.shape == (0, 2)
     case = {"target": "runway", "obliquity_deg": 20.0, "speed_m_s": 600.0,
             "contact_ramp_m_s": 0.01}
-    row = _row({**case, **shot_summary(result, target.interface_depths[0] - APPROACH)})
+    row = _row({**case, **shot_summary(result, target.interface_depths[0] - APPROACH,
+                                                nose_length(projectile))})
     study = Path(__file__).resolve().parents[1] / "results" / "oblique" / "study.csv"
     with open(study) as handle:
         assert row in handle.read().splitlines()

@@ -95,7 +95,8 @@ def _shot(o, v, target, change, deep, peaks, depth, ramp=RAMPS[0]):
             "contact_ramp_m_s": ramp, "tip_x_m": 0.1, "tip_z_m": depth, "pitch_deg": o + change,
             "pitch_change_deg": change, "pitch_change_deep_deg": deep,
             "max_pitch_rate_deg_s": 1e3, "max_axial_g": 2e4,
-            "max_lateral_g": 1e4 if o else 1e-5, "overload_peaks": peaks}
+            "max_lateral_g": 1e4 if o else 1e-5,
+            "max_lateral_low_pass_g": 6e3 if o else 1e-5, "overload_peaks": peaks}
 
 
 def test_findings_are_computed_from_the_table():
@@ -169,7 +170,8 @@ def test_debonded_study_marks_rows_that_move_one_ulp_faster():
     nominal, faster = split_ulp(results)
     assert len(nominal) == 8 and len(faster) == 4
     lines = table_csv(nominal, faster).splitlines()
-    assert lines[0].endswith(",one_ulp_stable")
+    assert lines[0].endswith(",max_lateral_low_pass_g,overload_peak_depths_m,one_ulp_stable")
+    assert all(line.split(",")[13] == "6e+03" for line in lines[1:])  # the low-pass peak
     flags = {(line.split(",")[1], line.split(",")[3]): line.split(",")[-1] for line in lines[1:]}
     assert flags[("600", "runway")] == "yes" and flags[("800", "runway")] == "no"
     assert flags[("600", "first layer only")] == ""
@@ -177,4 +179,6 @@ def test_debonded_study_marks_rows_that_move_one_ulp_faster():
     report = report_md(nominal, answers, [0.65, 1.1], faster)
     assert "## Reproducibility" in report and "20 deg 800 m/s" in report
     assert "20 deg 600 m/s (ramp" not in report.split("## Reproducibility")[1]
-    assert "one_ulp_stable" not in table_csv(nominal)  # bonded: the columns as before
+    assert "lateral peak over one nose length" in report
+    bonded = table_csv(nominal)  # bonded: the columns as before
+    assert "one_ulp_stable" not in bonded and "low_pass" not in bonded

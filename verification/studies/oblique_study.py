@@ -70,9 +70,16 @@ def study_cases(obliquities=OBLIQUITIES, velocities=VELOCITIES, ramps=RAMPS,
     return cases
 
 
-def shot_summary(result, approach_depth):
+def nose_length(projectile):
+    """Length ``sqrt(2 R r - r^2)`` of the projectile's tangent ogive nose (m)."""
+    return math.sqrt(2.0 * projectile.R * projectile.r - projectile.r ** 2)
+
+
+def shot_summary(result, approach_depth, low_pass_length):
     """Numbers of one shot; ``approach_depth``: nose-tip depth from which the attitude change
-    near the first interface is counted (the same depth for the shot into concrete alone)."""
+    near the first interface is counted (the same depth for the shot into concrete alone);
+    ``low_pass_length``: the travel over which :func:`low_pass` averages the lateral
+    overload for its peak ``max_lateral_low_pass_g``."""
     h = result.history
     near = np.flatnonzero(h["tip_z_m"] >= approach_depth)
     return {"state": result.end["state"], "time_s": result.end["time_s"],
@@ -82,6 +89,7 @@ def shot_summary(result, approach_depth):
             "pitch_change_deep_deg": (result.end["pitch_deg"] - float(h["pitch_deg"][near[0]])
                                       if near.size else None),
             **peaks(h), "overload_peaks": overload_peaks(h),
+            "max_lateral_low_pass_g": float(np.max(low_pass(h, low_pass_length))),
             "crossing_speed_m_s": next((p["end_speed_m_s"] for p in result.phases
                                         if p["end_reason"].startswith(
                                             "nose tip crossed interface 1")), None)}
@@ -101,7 +109,8 @@ def study_chunk(chunk):
                 speed = float(np.nextafter(speed, np.inf))
             strike = Strike(speed, obliquity=case["obliquity_deg"])
             out.append(shot_summary(fly(t, projectile, strike,
-                                        contact_ramp=case["contact_ramp_m_s"]), approach))
+                                        contact_ramp=case["contact_ramp_m_s"]), approach,
+                                    nose_length(projectile)))
         except Exception as exc:  # noqa: BLE001 (reported per case)
             out.append(exc)
     return out
@@ -192,11 +201,16 @@ INPUTS = ("obliquity_deg", "speed_m_s", "contact_ramp_m_s")  # written as given
 COLUMNS = ("obliquity_deg", "speed_m_s", "contact_ramp_m_s", "target", "state", "tip_x_m",
            "tip_z_m", "pitch_deg", "pitch_change_deg", "pitch_change_deep_deg",
            "max_pitch_rate_deg_s", "max_axial_g", "max_lateral_g")
+# the debonded study's further columns (issue 20; the bonded study.csv keeps its bytes): the
+# lateral overload averaged over one nose length of travel (:func:`low_pass`), whose peak is
+# steadier than the raw samples', which switch with the shank's contact
+DEBONDED_COLUMNS = ("max_lateral_low_pass_g",)
 
 
-def _row(r):
+def _row(r, columns=COLUMNS):
     peaks = " ".join(_g(z, "_m") for z, _ in r["overload_peaks"])
-    return ",".join(f"{r[c]:g}" if c in INPUTS else _g(r[c], c) for c in COLUMNS) + f",{peaks}"
+    return (",".join(f"{r[c]:g}" if c in INPUTS else _g(r[c], c) for c in columns)
+            + f",{peaks}")
 
 
 def split_ulp(results):
@@ -208,16 +222,18 @@ def split_ulp(results):
 
 
 def table_csv(results, faster=None):
-    """The CSV of every shot; with ``faster`` (:func:`split_ulp`, debonded) a last column
-    ``one_ulp_stable``: whether the runway row reads the same one ulp faster."""
-    lines = [",".join(COLUMNS) + ",overload_peak_depths_m"
+    """The CSV of every shot; with ``faster`` (:func:`split_ulp`, debonded) the
+    :data:`DEBONDED_COLUMNS` and a last column ``one_ulp_stable``: whether the runway row
+    reads the same one ulp faster."""
+    columns = COLUMNS + DEBONDED_COLUMNS if faster else COLUMNS
+    lines = [",".join(columns) + ",overload_peak_depths_m"
              + (",one_ulp_stable" if faster else "")]
     for r in sorted(results, key=lambda r: (r["obliquity_deg"], r["speed_m_s"],
                                             r["contact_ramp_m_s"], r["target"])):
-        line = _row(r)
+        line = _row(r, columns)
         if faster:
             key = (r["obliquity_deg"], r["speed_m_s"], r["contact_ramp_m_s"])
-            line += ("," + ("yes" if _row(faster[key]) == line else "no")
+            line += ("," + ("yes" if _row(faster[key], columns) == line else "no")
                      if r["target"] == "runway" else ",")
         lines.append(line)
     return "\n".join(lines) + "\n"
@@ -278,9 +294,15 @@ def report_md(results, answers, interfaces, faster=None):
              "layered / concrete (deg) | pitch change layered / concrete (deg) | pitch change "
              f"from {_g(APPROACH)} m above the first interface layered / concrete (deg) | "
              "largest pitch rate layered / concrete (deg/s) | axial peak layered / concrete (g) "
-             "| lateral peak layered / concrete (g) | layered overload peaks at tip depth (m) | "
+             "| lateral peak layered / concrete (g) | "
+             + ("lateral peak over one nose length of travel layered / concrete (g) | "
+                if faster else "")
+             + "layered overload peaks at tip depth (m) | "
              "added pitch change at the interfaces, contact ramp -> 0 (deg) |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if faster else "")]
+    quantities = ("tip_z_m", "pitch_deg", "pitch_change_deg", "pitch_change_deep_deg",
+                  "max_pitch_rate_deg_s", "max_axial_g", "max_lateral_g",
+                  *(DEBONDED_COLUMNS if faster else ()))
     limits = extrapolated_added(results)
     for o, v, lay, hom in _pairs(results):
         peaks = ", ".join(_g(z, "_m") for z, _ in lay["overload_peaks"]) or "-"
@@ -288,9 +310,7 @@ def report_md(results, answers, interfaces, faster=None):
                  if (o, v) in limits else "-")
         lines.append(
             f"| {o:g} | {v:g} | " + " | ".join(
-                f"{_g(lay[c], c)} / {_g(hom[c], c)}" for c in (
-                    "tip_z_m", "pitch_deg", "pitch_change_deg", "pitch_change_deep_deg",
-                    "max_pitch_rate_deg_s", "max_axial_g", "max_lateral_g"))
+                f"{_g(lay[c], c)} / {_g(hom[c], c)}" for c in quantities)
             + f" | {peaks} | {limit} |")
     a = answers
     lines += ["", "## Answers computed from the table", "",
@@ -444,7 +464,7 @@ def interface_figures(folder, target, projectile):
     debonded = target.with_interfaces("debonded")
     runs = {"bonded": fly(bonded, projectile, SHOT), "debonded": fly(debonded, projectile, SHOT),
             "concrete alone": fly(target.single(0), projectile, SHOT)}
-    nose_length = math.sqrt(2.0 * projectile.R * projectile.r - projectile.r ** 2)
+    length = nose_length(projectile)
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), layout="constrained")
     for k, (label, result) in enumerate(runs.items()):
         h, color = result.history, f"C{k}"
@@ -454,7 +474,7 @@ def interface_figures(folder, target, projectile):
             axes[1].plot(h["tip_z_m"], h["axial_g"] / 1e3, color=color, label=label)
             axes[2].plot(h["tip_z_m"], h["lateral_g"] / 1e3, lw=0.5, alpha=0.4, color=color,
                          label=f"{label}, raw samples")
-            axes[2].plot(h["tip_z_m"], low_pass(h, nose_length) / 1e3, lw=1.6, color=color,
+            axes[2].plot(h["tip_z_m"], low_pass(h, length) / 1e3, lw=1.6, color=color,
                          label=f"{label}, mean over one nose length")
     for a in axes:
         for top, bottom in open_zones(debonded, projectile):
