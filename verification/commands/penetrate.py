@@ -8,9 +8,8 @@ they are the same when regenerated on another CPU.
 import json
 from pathlib import Path
 
-from cavex.analytic.penetration.integrator import crater_depth, penetrate
-from cavex.analytic.penetration.resistance import make_resistance, model_boundary, model_label
-from cavex.analytic.penetration.zones import scab_depth
+from cavex.analytic.penetration.labels import model_boundary, model_label
+from cavex.analytic.penetration.zones import crater_depth, scab_depth
 from cavex.config import load_config
 from cavex.verification.output.files import (
     agg_figure,
@@ -48,6 +47,9 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
     path of a table built for this target); the first layer alone keeps the derived closed
     form with ``boundary``.
     """
+    from cavex.analytic.penetration.integrator import penetrate
+    from cavex.analytic.penetration.resistance import make_resistance
+
     model = model_label(resistance, boundary)
     closed = "derived" if resistance == "table" else resistance
     first = model_label(closed, boundary)
