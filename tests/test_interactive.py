@@ -7,6 +7,7 @@ import argparse
 import io
 import subprocess
 import sys
+from importlib.metadata import entry_points
 
 import pytest
 
@@ -75,6 +76,20 @@ def test_the_paper_model_loads_no_compiled_kernel():
     code, err, loaded = _loaded_after(["stress", "--velocity", "800", "--depth", "0.3",
                                        "--resistance", "paper"])
     assert (code, err, loaded) == (0, "", "[]")
+
+
+def test_the_program_leaves_its_objects_to_the_exit():
+    """The installed ``cavex`` runs :func:`console`: :func:`main`'s exit code, with what the
+    command left frozen (``gc.freeze``), so that the interpreter's final collections do not
+    walk numba's and scipy's objects (the time: benchmarks/commands.py)."""
+    scripts = entry_points(group="console_scripts", name="cavex")
+    assert [s.value for s in scripts] == ["cavex.verification.cli:console"]
+    probe = ("import gc, sys; from cavex.verification.cli import console; "
+             "sys.argv[1:] = ['stress', '--velocity', '-1', '--depth', '0.3']; "
+             "code = console(); print(code, gc.get_freeze_count() > 0)")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          timeout=120, check=True)
+    assert done.stdout.split() == ["2", "True"]
 
 
 def test_python_dash_m_cavex_is_the_command_line():
