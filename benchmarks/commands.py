@@ -7,6 +7,9 @@ that is not counted, so numba's cache is warm) of
 - ``cavex --help``, ``cavex penetrate --help`` and bad input (exit code 2) of ``stress``,
   ``fem``, ``penetrate`` and ``trajectory``: refused by the parser, or by the command's checks
   before it loads the numerical libraries it runs on (verification/commands/__init__.py);
+- yardsticks (:data:`YARDSTICKS`): a Python process that does nothing, imports numpy, numba,
+  calls one compiled kernel that does nothing (loaded from numba's cache: the floor of every
+  command that computes with numba), and also imports scipy.integrate;
 - ``cavex penetrate --no-figures`` and ``cavex penetrate``; ``cavex trajectory --no-figures``
   and ``cavex trajectory`` (default: normal incidence at V0);
 - in one process, after a warm-up: ``penetration_job`` (the runway and its first layer alone)
@@ -44,6 +47,29 @@ from pathlib import Path
 
 CAVEX = str(Path(sys.executable).with_name("cavex"))  # the installed command
 FLOOR = 0.4  # s: the issue's bound on a --no-figures command over its in-process computation
+
+#: A kernel that does nothing, compiled once into numba's cache (the warm-up run) and loaded
+#: from it after: what calling any compiled kernel costs a fresh process.
+KERNEL = """from numba import njit
+
+
+@njit(cache=True)
+def kernel(x):
+    return x + 1.0
+"""
+#: Yardsticks, each a fresh process that freezes its objects before it exits (as the program
+#: does, cavex.verification.cli.console): the interpreter, numpy, numba, one compiled kernel
+#: (the floor of every command that computes with numba: numba's typing and target registries,
+#: scipy.linalg, which numba loads to check its BLAS, the kernel from the cache), and with
+#: scipy.integrate (which penetrate and trajectory need: solve_ivp, quad) imported too.
+YARDSTICKS = {
+    "python: nothing (the interpreter's start)": "pass",
+    "python: import numpy": "import numpy",
+    "python: import numba": "import numba",
+    "python: one compiled kernel from numba's cache": "from kernel import kernel; kernel(1.0)",
+    "python: scipy.integrate and one compiled kernel":
+        "import scipy.integrate; from kernel import kernel; kernel(1.0)",
+}
 
 #: The job each command runs and the cavex modules it computes with (imported by the job, not
 #: by the command's module: benchmarks the budget's "cavex modules" part).
@@ -88,12 +114,12 @@ BUDGET_PARTS = ("interpreter start", "import numpy", "import numba", "import sci
                 "import cavex modules", "kernels from cache", "computation", "interpreter exit")
 
 
-def wall(argv, runs, expect=0, warm_up=True):
+def wall(argv, runs, expect=0, warm_up=True, cwd=None):
     """Wall seconds of ``argv`` as a subprocess (after one warm-up run not counted)."""
     times = []
     for k in range(runs + warm_up):
         start = time.perf_counter()
-        done = subprocess.run(argv, capture_output=True, text=True, check=False)
+        done = subprocess.run(argv, capture_output=True, text=True, check=False, cwd=cwd)
         elapsed = time.perf_counter() - start
         if done.returncode != expect:
             raise SystemExit(f"{' '.join(argv)}: exit {done.returncode}\n{done.stderr}")
@@ -172,10 +198,10 @@ def main():
                 ("cavex trajectory --velocity -1", ["trajectory", "--velocity", "-1"]),
                 ("cavex trajectory --spin 1e9", ["trajectory", "--spin", "1e9"])):
             line(f"{name} (bad input, exit 2)", wall([CAVEX, *argv], runs, expect=2))
-        line("python -c pass (the interpreter's start)", wall([sys.executable, "-c", "pass"],
-                                                             runs))
-        line("python -c 'import numba, scipy.integrate'",
-             wall([sys.executable, "-c", "import numba, scipy.integrate"], runs))
+        (out / "kernel.py").write_text(KERNEL)
+        yardstick = {name: line(name, wall([sys.executable, "-c", f"{code}; import gc; "
+                                           "gc.freeze()"], runs, cwd=out))
+                     for name, code in YARDSTICKS.items()}
         measured = {}
         for command in ("penetrate", "trajectory"):
             for figures in ("--no-figures", "--figures")[:2 if args.figures else 1]:
@@ -205,10 +231,12 @@ def main():
     print(f"{'the command':<24}" + "".join(f"{b['the command']:12.3f}"
                                           for b in budgets.values()))
     print()
+    floor_name = list(YARDSTICKS)[-1]
     for command, seconds in computation.items():
         total = measured[command, "--no-figures"]
         print(f"cavex {command} --no-figures: {total:.3f} s, in process {seconds:.3f} s, "
-              f"difference {total - seconds:.3f} s (floor {FLOOR} s)")
+              f"difference {total - seconds:.3f} s (floor {FLOOR} s); over '{floor_name}' "
+              f"({yardstick[floor_name]:.3f} s): {total - yardstick[floor_name]:.3f} s")
     for command in computation if args.figures else ():
         extra = measured[command, "--figures"] - measured[command, "--no-figures"]
         print(f"cavex {command}: the figures add {extra:.3f} s (median with less median "
