@@ -2,7 +2,7 @@
 
 import sys
 
-from cavex.verification.cli import main
+from cavex.verification.cli import console
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(console())

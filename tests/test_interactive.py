@@ -7,6 +7,7 @@ import argparse
 import io
 import subprocess
 import sys
+from importlib.metadata import entry_points
 
 import pytest
 
@@ -30,6 +31,65 @@ def test_the_parser_loads_no_numerical_library():
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                           timeout=120, check=True)
     assert done.stdout.strip() == "[]"
+
+
+def _loaded_after(argv):
+    """``(exit code, stderr, the HEAVY modules loaded)`` of ``cavex argv`` run in a fresh
+    process."""
+    probe = ("import sys; from cavex.verification.cli import main; code = main(sys.argv[1:]); "
+             f"print(code, sorted(m for m in {HEAVY!r} if m in sys.modules))")
+    done = subprocess.run([sys.executable, "-c", probe, *argv], capture_output=True,
+                          text=True, timeout=120, check=True)
+    code, loaded = done.stdout.strip().splitlines()[-1].split(" ", 1)
+    return int(code), done.stderr, loaded
+
+
+#: One bad input of each kind a command checks itself (after the parser), for the commands
+#: that refuse it before loading the numerical libraries (verification/commands/__init__.py).
+BAD_INPUTS = {
+    "penetrate --resistance table": ["penetrate", "--resistance", "table"],
+    "penetrate --out in /proc": ["penetrate", "--out", "/proc/cavex-no-such-dir/x"],
+    "trajectory --velocity -1": ["trajectory", "--velocity", "-1"],
+    "trajectory --obliquity 90": ["trajectory", "--obliquity", "90"],
+    "trajectory --spin 1e9": ["trajectory", "--spin", "1e9"],
+    "trajectory --contact-ramp 5": ["trajectory", "--contact-ramp", "5"],
+    "trajectory --tangency-psi 99": ["trajectory", "--tangency-psi", "99"],
+    "trajectory --law-A without law": ["trajectory", "--law-A", "5"],
+    "stress --velocity -1": ["stress", "--velocity", "-1", "--depth", "0.3"],
+    "stress --depth -1": ["stress", "--velocity", "800", "--depth", "-1"],
+    "fem --velocity 1e9": ["fem", "--velocity", "1e9", "--depth", "0.3"],
+    "config missing file": ["config", "--config", "/proc/cavex-no-such-file.toml"],
+}
+
+
+@pytest.mark.parametrize("argv", BAD_INPUTS.values(), ids=BAD_INPUTS.keys())
+def test_bad_input_is_refused_before_the_numerical_libraries_load(argv):
+    """A bad input the command checks itself answers (one line, exit 2) without loading any of
+    :data:`HEAVY` (the time: benchmarks/commands.py)."""
+    code, err, loaded = _loaded_after(argv)
+    assert (code, len(err.splitlines()), loaded) == (2, 1, "[]"), err
+
+
+def test_the_paper_model_loads_no_compiled_kernel():
+    """``cavex stress --resistance paper`` computes with the paper's printed model (numpy):
+    it neither loads numba nor scipy."""
+    code, err, loaded = _loaded_after(["stress", "--velocity", "800", "--depth", "0.3",
+                                       "--resistance", "paper"])
+    assert (code, err, loaded) == (0, "", "[]")
+
+
+def test_the_program_leaves_its_objects_to_the_exit():
+    """The installed ``cavex`` runs :func:`console`: :func:`main`'s exit code, with what the
+    command left frozen (``gc.freeze``), so that the interpreter's final collections do not
+    walk numba's and scipy's objects (the time: benchmarks/commands.py)."""
+    scripts = entry_points(group="console_scripts", name="cavex")
+    assert [s.value for s in scripts] == ["cavex.verification.cli:console"]
+    probe = ("import gc, sys; from cavex.verification.cli import console; "
+             "sys.argv[1:] = ['stress', '--velocity', '-1', '--depth', '0.3']; "
+             "code = console(); print(code, gc.get_freeze_count() > 0)")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          timeout=120, check=True)
+    assert done.stdout.split() == ["2", "True"]
 
 
 def test_python_dash_m_cavex_is_the_command_line():

@@ -3,6 +3,7 @@
 the text to print) and exit codes."""
 
 import argparse
+import gc
 import importlib
 import os
 import re
@@ -283,5 +284,20 @@ def main(argv=None):
     return 0
 
 
+def console():
+    """The ``cavex`` program (its console script and ``python -m cavex``): :func:`main`; returns
+    its exit code.
+
+    What the command leaves lives until the process ends: it is moved out of the cyclic
+    garbage collector's reach (``gc.freeze``) before the interpreter exits, whose final
+    collections would walk every object numba and scipy made (0.3-0.5 s of a ``cavex penetrate
+    --no-figures``, benchmarks/commands.md). Functions registered with ``atexit`` or
+    ``weakref.finalize`` still run; the tests call :func:`main`, which leaves the collector
+    as it is."""
+    code = main()
+    gc.freeze()
+    return code
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(console())

@@ -8,10 +8,13 @@ they are the same when regenerated on another CPU.
 import json
 from pathlib import Path
 
-from cavex.analytic.penetration.integrator import crater_depth, penetrate
-from cavex.analytic.penetration.labels import FLIGHT_RESISTANCES, PLAIN_LAW
-from cavex.analytic.penetration.resistance import make_resistance, model_boundary, model_label
-from cavex.analytic.penetration.zones import scab_depth
+from cavex.analytic.penetration.labels import (
+    FLIGHT_RESISTANCES,
+    PLAIN_LAW,
+    model_boundary,
+    model_label,
+)
+from cavex.analytic.penetration.zones import crater_depth, scab_depth
 from cavex.config import load_config
 from cavex.verification.output.files import (
     agg_figure,
@@ -58,6 +61,9 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
     (:class:`~cavex.analytic.penetration.plain_law.PlainLawResistance`); it has no boundary
     convention (``boundary`` None).
     """
+    from cavex.analytic.penetration.integrator import penetrate
+    from cavex.analytic.penetration.resistance import make_resistance
+
     law = resistance == PLAIN_LAW
     model = PLAIN_LAW if law else model_label(resistance, boundary)
     closed = "derived" if resistance == "table" else resistance

@@ -6,6 +6,7 @@ import math
 from cavex.analytic.geometry import spherical_problem, wall_layer
 from cavex.analytic.paper_model import paper_coefficients
 from cavex.analytic.penetration.labels import check_model, model_boundary, model_label
+from cavex.analytic.states import state_meaning
 from cavex.errors import CavexNumericalError, require
 from cavex.materials import MAX_VELOCITY
 
@@ -38,12 +39,12 @@ def stress_at_depth(target, projectile, depth, velocity, *, resistance="derived"
     check_model(resistance, boundary)
     boundary = model_boundary(resistance, boundary)
     layers, interfaces = spherical_problem(target, projectile, depth)  # checks the depth
-    # loaded once the input is checked: bad input answers before numba and scipy load
-    from cavex.analytic.cavity import cavity_solution
-    from cavex.verification.report.analysis import state_meaning
-
     if resistance == "paper":
-        return _finite(_paper(target, projectile, depth, velocity, epsilon, state_meaning))
+        return _finite(_paper(target, projectile, depth, velocity, epsilon))
+    # loaded once the input is checked: bad input answers before numba loads (and the paper
+    # model, plain numpy, never loads it)
+    from cavex.analytic.cavity import cavity_solution
+
     state = cavity_solution(layers, interfaces, velocity, projectile.r, boundary=boundary)
     index = wall_layer(target, projectile, depth)
     return _finite({"model": model_label(resistance, boundary), "resistance": resistance,
@@ -113,7 +114,7 @@ def _finite(result):
     return result
 
 
-def _paper(target, projectile, depth, velocity, epsilon, state_meaning):
+def _paper(target, projectile, depth, velocity, epsilon):
     c = paper_coefficients(target, projectile, depth, epsilon=epsilon)
     return {"model": "paper", "resistance": "paper", "epsilon": epsilon, "depth_m": depth,
             "velocity_m_s": velocity,

@@ -16,14 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.penetration.oblique import (
-    CONTACT_RAMP,
-    Strike,
-    fly,
-    overload_peaks,
-    peaks,
-)
-from cavex.analytic.penetration.surface_force import rotation_matrix as rotation
+from cavex.analytic.penetration.strike import Strike
 from cavex.errors import is_finite_number, require
 from cavex.verification.fedata.runner import show_progress
 from cavex.verification.output.files import (
@@ -53,15 +46,19 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
                    law_B=None, compare_homogeneous=False, contact_ramp=None, progress=False,
                    tangency_psi=0.0, entry_crater=False, crater=None):
     """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``;
-    ``progress``: a tqdm bar per run on stderr (steps, simulated time, speed)."""
-    contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
+    ``progress``: a tqdm bar per run on stderr (steps, simulated time, speed);
+    ``contact_ramp`` None: the model's default
+    (:data:`~cavex.analytic.penetration.oblique.CONTACT_RAMP`)."""
     # the command keeps the regularisation on: without it (or far below the default) an
     # oblique shot's sliding shank needs millions of steps (docs/oblique.md); above
     # MAX_CONTACT_RAMP the depth leaves the stated accuracy
-    require(is_finite_number(contact_ramp)
-            and MIN_CONTACT_RAMP <= contact_ramp <= MAX_CONTACT_RAMP, "contact_ramp",
+    require(contact_ramp is None or (is_finite_number(contact_ramp)
+            and MIN_CONTACT_RAMP <= contact_ramp <= MAX_CONTACT_RAMP), "contact_ramp",
             f"in [{MIN_CONTACT_RAMP:g}, {MAX_CONTACT_RAMP:g}] m/s (final depth within 0.1 % "
             "of the V_r -> 0 limit)", contact_ramp)
+    from cavex.analytic.penetration.oblique import CONTACT_RAMP, fly
+
+    contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
     options = {"boundary": boundary, "epsilon": epsilon, "free_surface": free_surface,
                "table": table, "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp,
                "tangency_psi": tangency_psi, "entry_crater": entry_crater,
@@ -167,6 +164,8 @@ def run_summary(result):
     the largest pitch rate and overloads, and the axial overload's peaks
     (:func:`~cavex.analytic.penetration.oblique.overload_peaks`) as ``overload_peaks``
     ``[{"tip_depth_m", "axial_g"}]``."""
+    from cavex.analytic.penetration.oblique import overload_peaks, peaks
+
     return {"end": result.end, "phases": result.phases, **peaks(result.history),
             "overload_peaks": [{"tip_depth_m": z, "axial_g": g}
                                for z, g in overload_peaks(result.history)]}
@@ -258,16 +257,10 @@ def _layer_names(ax, target):
 
 
 def outline_points(result, y):
-    """Closed outline of the projectile (x, z) in the plane of obliquity at state ``y``."""
-    body = result.model.body
-    ax, rad = body.outline[:, 0], body.outline[:, 1]
-    top = np.stack([ax, rad, np.zeros_like(ax)], -1)
-    bottom = np.stack([ax[::-1], -rad[::-1], np.zeros_like(ax)], -1)
-    pts = np.concatenate([top, bottom, top[:1]])
-    rot = rotation(y[3:7])
-    # in the plane that contains the axis and the body e2 axis (the plane of obliquity
-    # for in-plane shots)
-    world = y[0:3] + pts @ rot.T
+    """Closed outline of the projectile (x, z) in the plane of obliquity at state ``y``: the
+    outline of :func:`body_outline_3d` (in the plane that contains the axis and the body e2
+    axis, the plane of obliquity for in-plane shots)."""
+    world = body_outline_3d(result, y)
     return world[:, 0], world[:, 2]
 
 
@@ -466,12 +459,14 @@ def block_limits(result, target, min_ratio=0.4):
 def body_outline_3d(result, y):
     """Closed outline of the body in the plane of its axis and its e2 axis, as world points
     ``(n, 3)`` (m; z depth) at state ``y``."""
+    from cavex.analytic.penetration.surface_force import rotation_matrix
+
     body = result.model.body
     ax, rad = body.outline[:, 0], body.outline[:, 1]
     top = np.stack([ax, rad, np.zeros_like(ax)], -1)
     bottom = np.stack([ax[::-1], -rad[::-1], np.zeros_like(ax)], -1)
     pts = np.concatenate([top, bottom, top[:1]])
-    return y[0:3] + pts @ rotation(y[3:7]).T
+    return y[0:3] + pts @ rotation_matrix(y[3:7]).T
 
 
 def view_3d(job, path):

@@ -21,14 +21,13 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator  # noqa: E402
 
+from cavex.analytic.states import STATE_GROUPS, state_meaning  # noqa: E402
 from cavex.verification.output.files import save_figure  # noqa: E402
 from cavex.verification.output.number_format import ESTIMATE_DECIMALS  # noqa: E402
 from cavex.verification.report.analysis import (  # noqa: E402
     MODELS,
     RESOLVED_FRACTION,
-    STATE_GROUPS,
     TOLERANCES,
-    state_meaning,
 )
 
 # Okabe-Ito: within 1 % (blue), within 5 % (sky blue), beyond 5 % (orange), FE failed (grey)

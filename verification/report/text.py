@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from cavex.analytic.states import state_meaning
 from cavex.verification.report.analysis import (
     ERROR_PARTS,
     MODELS,
@@ -17,7 +18,6 @@ from cavex.verification.report.analysis import (
     attribution,
     part_medians,
     state_labels,
-    state_meaning,
 )
 
 LABELS = {key: label for key, label, _ in MODELS}
