@@ -288,3 +288,31 @@ def test_the_collector_pause_restores_the_collector():
         assert not gc.isenabled()
     finally:
         gc.enable()
+
+
+def test_penetrate_layer_names_fit_without_overlap():
+    """The deceleration figure's layer names: a layer narrower than its name keeps it when its
+    neighbours leave room (the runway's macadam on a 5 m axis); names that would overlap or
+    stick out of the axes are left out; the placed ones never overlap."""
+    from cavex.verification.commands.penetrate import _layer_names
+    from cavex.verification.output.files import agg_figure
+
+    def placed(bounds, names, xlim):
+        fig = agg_figure(figsize=(6.4, 4.8))
+        ax = fig.add_subplot()
+        ax.set_xlim(*xlim)
+        _layer_names(ax, names, [xlim[0], *bounds, xlim[1]])
+        renderer = fig.canvas.get_renderer()
+        boxes = sorted(((t.get_window_extent(renderer), t.get_text()) for t in ax.texts),
+                       key=lambda b: b[0].x0)
+        for (a, _), (b, _) in zip(boxes, boxes[1:], strict=False):
+            assert a.x1 <= b.x0  # never overlapping
+        frame = ax.get_window_extent(renderer)
+        assert all(frame.x0 <= box.x0 and box.x1 <= frame.x1 for box, _ in boxes)
+        return [name for _, name in boxes]
+
+    names = ["concrete", "macadam", "soil"]
+    assert placed([0.65, 1.1], names, (-0.26, 5.52)) == names  # macadam 7.8 % of the axis
+    crowded = placed([0.65, 0.7], names, (0.0, 5.5))  # a 5 cm layer between two names
+    assert "macadam" not in crowded and {"concrete", "soil"} <= set(crowded)
+    assert placed([0.65, 1.1], names, (0.0, 0.5)) == ["concrete"]  # only the layer in view

@@ -257,16 +257,34 @@ def _draw_figures(job, out):
     bounds = [left, *job["interface_depths"], right]
     for depth in job["interface_depths"]:
         ax.axvline(depth, color="grey", linewidth=0.8, linestyle=":")
-    for k, name in enumerate(names[:len(bounds) - 1]):
-        lo, hi = max(bounds[k], left), min(bounds[k + 1], right)
-        if hi - lo > 0.08 * (right - left):
-            ax.text(0.5 * (lo + hi), 1.0, name, ha="center", va="bottom", fontsize=8,
-                    style="italic", transform=ax.get_xaxis_transform())
     ax.set_xlim(left, right)
+    _layer_names(ax, names, bounds)
     ax.set(xlabel="nose-tip depth (m)", ylabel=r"deceleration ($10^3$ g)")
     ax.set_title(f"Deceleration against depth\n{subtitle}", fontsize=10, pad=14)
     _legend_below(ax)
     return [velocity_png, _save(fig, out / "deceleration_depth.png")]
+
+
+def _layer_names(ax, names, bounds):
+    """Each layer's name above the axes, centred on the part of its depth range ``bounds[k]``
+    to ``bounds[k + 1]`` in view; a name that would stick out of the axes or overlap a
+    name already placed is left out (its extent measured, not guessed: a layer narrower
+    than its name keeps it when its neighbours leave room)."""
+    left, right = ax.get_xlim()
+    renderer = ax.figure.canvas.get_renderer()
+    frame, placed = ax.get_window_extent(renderer), []
+    for k, name in enumerate(names[:len(bounds) - 1]):
+        lo, hi = max(bounds[k], left), min(bounds[k + 1], right)
+        if hi <= lo:
+            continue
+        text = ax.text(0.5 * (lo + hi), 1.0, name, ha="center", va="bottom", fontsize=8,
+                       style="italic", transform=ax.get_xaxis_transform())
+        box = text.get_window_extent(renderer)
+        if (box.x0 < frame.x0 or box.x1 > frame.x1
+                or any(box.x0 < other.x1 and other.x0 < box.x1 for other in placed)):
+            text.remove()
+        else:
+            placed.append(box)
 
 
 def _legend_below(ax):
