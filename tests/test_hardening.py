@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from cli_helpers import refused, run
 
 from cavex.analytic.penetration.tabulated import load_table
 from cavex.config import default_config_text, load_config
@@ -31,26 +32,6 @@ depths = [0.3]
 elements_per_decade = 8
 error_estimate = false
 """
-
-
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
-
-
-def refused(capsys, tmp_path, argv, name, untouched=()):
-    """The command exits 2 with one line naming ``name`` and leaves ``tmp_path`` as it was."""
-    before = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*"))
-    code, out, err = run(capsys, *argv)
-    assert code == 2, (out, err)
-    assert out == ""
-    lines = err.splitlines()
-    assert len(lines) == 1 and lines[0].startswith("cavex: error: "), err
-    assert name in lines[0], lines[0]
-    after = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*"))
-    assert after == before, "a refused command wrote something"
-    return lines[0]
 
 
 @pytest.fixture

@@ -7,6 +7,7 @@ import tomllib
 
 import numpy as np
 import pytest
+from cli_helpers import refused
 
 from cavex.analytic.penetration.oblique import Strike, fly
 from cavex.analytic.penetration.stress_laws import LayerPlainLaw, PlainLaw, make_law
@@ -86,12 +87,8 @@ def test_command_refusals(capsys, tmp_path):
             (["--config", str(bad), "--resistance", "law"], "layers[1].law_B"),
             (["--resistance", "law", "--law-A", "1e8"], "--law-A"),
             (["--law-A", "1e8", "--law-B", "1000"], "--law-A")):
-        out_dir = tmp_path / "out"
-        code = main(["trajectory", *argv, "--out", str(out_dir), "--no-figures"])
-        out, err = capsys.readouterr()
-        assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (argv, err)
-        assert expect in err, (argv, err)
-        assert not out_dir.exists()
+        refused(capsys, tmp_path, ["trajectory", *argv, "--out", tmp_path / "out",
+                                   "--no-figures"], expect)
 
 
 def test_layer_law_is_each_layers_own():
