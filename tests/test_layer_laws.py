@@ -15,6 +15,7 @@ from cavex.config import config_text, default_config_text, fingerprint, load_con
 from cavex.errors import CavexInputError
 from cavex.verification.cli import main
 
+NAMES = ("concrete", "macadam", "soil")  # the default runway's layers
 LAWS = [(20.0, 1.0), (12.0, 1.2), (8.0, 1.5)]  # Forrestal-like S for concrete, then softer
 
 
@@ -131,6 +132,7 @@ def test_trajectory_with_layer_laws_runs_and_reports_them(capsys, tmp_path):
     out, _ = capsys.readouterr()
     assert code == 0
     document = json.loads(out)
-    assert document["settings"]["law"] == [{"law_A": A, "law_B": B} for A, B in LAWS]
+    assert document["settings"]["law"] == [{"layer": name, "law_A": A, "law_B": B}
+                                           for name, (A, B) in zip(NAMES, LAWS, strict=True)]
     # concrete with S = 20 + rho V^2 / tau stops the 600 m/s shot in the concrete
     assert 0.0 < document["end"]["nose_tip_m"][2] < 0.65

@@ -45,6 +45,7 @@ from cavex.errors import CavexInputError
 from cavex.materials import Target
 from cavex.verification.cli import build_parser, main
 
+NAMES = ("concrete", "macadam", "soil")  # the default runway's layers
 LAWS = [(20.0, 1.0), (12.0, 1.2), (8.0, 1.5)]  # Forrestal-like S for concrete, then softer
 RTOL = 1e-9  # the 1-D integrator's relative tolerance (integrator.RTOL)
 EVENT_DEPTH_TOL = 1e-9  # m: phase ends located by brentq, as in test_penetration
@@ -393,7 +394,8 @@ def test_penetrate_command_with_each_layers_law(capsys, tmp_path):
     document = json.loads(out)
     assert document["model"] == document["first_layer_model"] == "law"
     assert document["boundary"] is None
-    assert document["law"] == [{"law_A": A, "law_B": B} for A, B in LAWS]
+    assert document["law"] == [{"layer": name, "law_A": A, "law_B": B}
+                               for name, (A, B) in zip(NAMES, LAWS, strict=True)]
     labels = [p["label"] for p in document["phases"]]
     assert labels[0] == "crater" and labels[-1] == "soil (law)"
     assert "concrete + macadam (law)" in labels and "macadam + soil (law)" in labels
@@ -404,8 +406,8 @@ def test_penetrate_command_with_each_layers_law(capsys, tmp_path):
                  "--out", str(tmp_path / "text")])
     out, _ = capsys.readouterr()
     assert code == 0
-    assert out.splitlines()[0] == ("model law (sigma_n = tau_k A_k + B_k rho_k V_n^2; layer 1 "
-                                   "A 20, B 1; layer 2 A 12, B 1.2; layer 3 A 8, B 1.5), "
+    assert out.splitlines()[0] == ("model law (sigma_n = tau_k A_k + B_k rho_k V_n^2; concrete "
+                                   "A 20, B 1; macadam A 12, B 1.2; soil A 8, B 1.5), "
                                    "crater from nose-base")
 
 

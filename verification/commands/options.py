@@ -169,3 +169,12 @@ def refuse_debonded(target, command):
         raise CavexInputError(f"is \"debonded\", which `cavex {command}` does not model (the "
                               "spherical problem is one bonded continuum): remove the key, or "
                               "use penetrate or trajectory", f"layers[{j}].bottom")
+
+
+def law_echo(target, law_A, law_B):
+    """The plain law as the JSON settings of ``penetrate`` and ``trajectory`` give it: the
+    global ``{"A_Pa", "B_kg_m3"}``, or each layer's ``{"layer", "law_A", "law_B"}``."""
+    if law_A is not None:
+        return {"A_Pa": law_A, "B_kg_m3": law_B}
+    return [{"layer": name, "law_A": A, "law_B": B}
+            for name, (A, B) in zip(target.layer_names(), target.plain_laws, strict=True)]

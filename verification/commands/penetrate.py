@@ -63,6 +63,7 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
     """
     from cavex.analytic.penetration.integrator import penetrate
     from cavex.analytic.penetration.resistance import make_resistance
+    from cavex.verification.commands.options import law_echo
 
     law = resistance == PLAIN_LAW
     model = PLAIN_LAW if law else model_label(resistance, boundary)
@@ -88,16 +89,8 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
             "debonded": bool(target.debonded),
             "interface_depths": target.interface_depths,
             "title": resistance_title(resistance, boundary, epsilon, table,
-                                      settings.get("law"), target.layer_names()),
+                                      settings.get("law")),
             "layer_names": target.layer_names()}
-
-
-def law_echo(target, law_A, law_B):
-    """The plain law as the JSON settings give it (as ``cavex trajectory``): the global
-    ``{"A_Pa", "B_kg_m3"}``, or each layer's ``{"law_A", "law_B"}`` keys."""
-    if law_A is not None:
-        return {"A_Pa": law_A, "B_kg_m3": law_B}
-    return [{"law_A": A, "law_B": B} for A, B in target.plain_laws]
 
 
 SETTINGS = ("model", "first_layer_model", "resistance", "boundary", "epsilon", "table",
@@ -168,25 +161,23 @@ def crater_notes(target, projectile, crater):
             "throughout"]
 
 
-def law_text(law, names=None):
-    """The plain law in words: ``sigma_n = A + B V_n^2, A 2e+08 Pa, B 2500 kg/m^3`` (global) or
-    ``sigma_n = tau_k A_k + B_k rho_k V_n^2; concrete A 20, B 1; ...`` (each layer's keys,
-    ``names`` the layers' names)."""
+def law_text(law):
+    """The plain law (:func:`~cavex.verification.commands.options.law_echo`) in words:
+    ``sigma_n = A + B V_n^2, A 2e+08 Pa, B 2500 kg/m^3`` (global) or ``sigma_n = tau_k A_k +
+    B_k rho_k V_n^2; concrete A 20, B 1; ...`` (each layer's keys, by the layer's name)."""
     if isinstance(law, dict):
         return f"sigma_n = A + B V_n^2, A {law['A_Pa']:g} Pa, B {law['B_kg_m3']:g} kg/m^3"
-    names = names or [f"layer {k + 1}" for k in range(len(law))]
     return "sigma_n = tau_k A_k + B_k rho_k V_n^2; " + "; ".join(
-        f"{name} A {k['law_A']:g}, B {k['law_B']:g}" for name, k in zip(names, law, strict=True))
+        f"{k['layer']} A {k['law_A']:g}, B {k['law_B']:g}" for k in law)
 
 
-def resistance_title(resistance, boundary, epsilon, table=None, law=None, names=None):
+def resistance_title(resistance, boundary, epsilon, table=None, law=None):
     """What the figures say about the resistance: the settings the closed form uses (the
     paper's model has its own quasi-static boundary and an epsilon reading; the derived model
     has a boundary convention), for a table (``resistance`` "table") only its file name, for
-    the plain law (``resistance`` "law") ``law`` in words (:func:`law_text`, ``names`` the
-    layers')."""
+    the plain law (``resistance`` "law") ``law`` in words (:func:`law_text`)."""
     if resistance == PLAIN_LAW:
-        return "plain law " + law_text(law, names)
+        return "plain law " + law_text(law)
     closed = (f"paper model (She 2020), epsilon: {epsilon}" if resistance == "paper"
               else f"derived model, {boundary} boundary")
     if resistance != "table":

@@ -96,8 +96,9 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
     if crater is not None:
         settings["crater"] = crater
     if resistance == "law":
-        settings["law"] = ({"A_Pa": law_A, "B_kg_m3": law_B} if law_A is not None else
-                           [{"law_A": A, "law_B": B} for A, B in target.plain_laws])
+        from cavex.verification.commands.options import law_echo
+
+        settings["law"] = law_echo(target, law_A, law_B)
     return {"runs": runs, "settings": settings, "target": target}
 
 
