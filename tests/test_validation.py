@@ -377,8 +377,8 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
         final, rel=DIGITS_6)
     # the JSON of the issue, and the statistics recomputed from it
     assert set(result["summary"]) == {"derived-quasi-static", "derived-dynamic", "paper",
-                                      "table", "concrete", "li-chen-2003", "forrestal-1994",
-                                      "derived-quasi-static calibrated"}
+                                      "table", "concrete", "li-chen-2003", "li-chen-concrete",
+                                      "forrestal-1994", "derived-quasi-static calibrated"}
     for model, stats in result["summary"].items():
         ratios = [row["predicted_m"][model] / row["measured_m"] for row in result["shots"]]
         assert stats["n"] == 2
@@ -409,36 +409,41 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
 
 
 def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
-    """``--models concrete forrestal-1994``: those two columns and nothing else, in JSON, CSV and
-    report; the concrete model's depths are :func:`concrete_model.model_depth`'s; the
-    recommended model and its sentence are there."""
+    """``--models concrete li-chen-concrete forrestal-1994``: those three columns and nothing
+    else, in JSON, CSV and report; the concrete model's depths are
+    :func:`concrete_model.model_depth`'s, the recommended model's
+    :func:`concrete_model.split_depth`'s (Li and Chen up to 100 MPa, above the concrete
+    model's); the recommended model and its sentence are there."""
     from cavex.verification.commands.validate import recommendation
     from cavex.verification.validation import concrete_model
 
     out_dir = tmp_path / "val"
     code, out, err = run(capsys, "validate", "--shots", SHOTS, "--models", "concrete",
-                         "forrestal-1994", "--json", "--out", str(out_dir))
-    assert code == 0 and err.startswith("cavex: validate 17 shots x 2 models = 34 predictions")
+                         "li-chen-concrete", "forrestal-1994", "--json", "--out", str(out_dir))
+    assert code == 0 and err.startswith("cavex: validate 17 shots x 3 models = 51 predictions")
     result = json.loads(out)
-    assert result["models"] == ["concrete", "forrestal-1994"]
-    assert result["recommended_model"] == "concrete"
+    assert result["models"] == ["concrete", "li-chen-concrete", "forrestal-1994"]
+    assert result["recommended_model"] == "li-chen-concrete"
     assert json.loads((out_dir / "validation.json").read_text()) == result
-    assert set(result["summary"]) == {"concrete", "forrestal-1994"}
+    assert set(result["summary"]) == {"concrete", "li-chen-concrete", "forrestal-1994"}
     assert result["failures"] == {}
     shots = read_shots(SHOTS).shots
     for row, shot in zip(result["shots"], shots, strict=True):
-        assert set(row["predicted_m"]) == {"concrete", "forrestal-1994"}
+        assert set(row["predicted_m"]) == {"concrete", "li-chen-concrete", "forrestal-1994"}
+        split = (concrete_model.li_chen_depth(shot) if shot.fc <= 100e6
+                 else row["predicted_m"]["concrete"])  # F94-41 and F94-46 are above
+        assert row["predicted_m"]["li-chen-concrete"] == pytest.approx(split, rel=DIGITS_6)
         assert row["predicted_m"]["concrete"] == pytest.approx(
             concrete_model.model_depth(shot), rel=DIGITS_6)
         assert row["predicted_m"]["forrestal-1994"] == pytest.approx(
             empirical.shot_depth(shot), rel=DIGITS_6)
     header = (out_dir / "predictions.csv").read_text().splitlines()[0].split(",")
-    assert header[5:] == ["flag", "concrete_m", "forrestal_1994_m", "concrete_ratio",
-                          "forrestal_1994_ratio"]
+    assert header[5:] == ["flag", "concrete_m", "li_chen_concrete_m", "forrestal_1994_m",
+                          "concrete_ratio", "li_chen_concrete_ratio", "forrestal_1994_ratio"]
     report = (out_dir / "report.md").read_text()
-    sentence = recommendation("concrete", result["summary"])
-    assert sentence.startswith("Recommended model: `concrete`") and sentence in report
-    assert "--models concrete forrestal-1994" in report
+    sentence = recommendation("li-chen-concrete", result["summary"])
+    assert sentence.startswith("Recommended model: `li-chen-concrete`") and sentence in report
+    assert "--models concrete li-chen-concrete forrestal-1994" in report
     assert "| derived-dynamic |" not in report and "| table |" not in report
 
 
@@ -552,7 +557,7 @@ def test_committed_development_validation_is_consistent():
 
     folder = Path("results/validation/compilation_dev")
     result = json.loads((folder / "validation.json").read_text())
-    assert result["shots_file"]["n"] == 286 and result["recommended_model"] == "concrete"
+    assert result["shots_file"]["n"] == 286 and result["recommended_model"] == "li-chen-concrete"
     for name, models in result["regimes"].items():
         rows = [r for r in result["shots"] if REGIMES[name](r["fc_Pa"], r["V0_m_s"], r["flag"])]
         for model, stats in models.items():
@@ -563,7 +568,7 @@ def test_committed_development_validation_is_consistent():
                                                                 rel=DIGITS_6)
             assert stats["mean_log_ratio"] == pytest.approx(logs.mean(), rel=DIGITS_6)
     docs = Path("docs/validation.md").read_text()
-    for model in ("concrete", "li-chen-2003", "forrestal-1994"):
+    for model in ("concrete", "li-chen-2003", "li-chen-concrete", "forrestal-1994"):
         cells = [f"{s['mean_abs_log_ratio']:.3f} / {s['mean_log_ratio']:+.3f}"
                  for s in (result["regimes"][name][model] for name in REGIMES)]
         assert f"| {model} | " + " | ".join(cells) + " |" in docs
@@ -578,3 +583,35 @@ def test_a_shot_id_of_any_characters_is_one_markdown_table_cell():
         assert table_cell(shot_id) == cell
         row = f"| {table_cell(shot_id)} | 1 |"
         assert row.replace("\\|", "").count("|") == 3 and "\n" not in row
+
+
+def test_recommended_split_holds_with_each_reference_left_out():
+    """The recommended model's two choices (Li and Chen at f_c <= 100 MPa, the concrete model
+    above) were made on the development shots: refitted with each of the 21 references left
+    out, both choices stay the same (so its LORO scores are its in-sample ones: 0.436 all,
+    0.356 normal strength, docs/validation.md), and the split beats both of its parts over all
+    shots and at every threshold from 60 to 120 MPa."""
+    import csv
+    from pathlib import Path
+
+    result = json.loads(Path("results/validation/compilation_dev/validation.json").read_text())
+    with open("examples/shots_compilation_dev.csv", newline="") as handle:
+        source = {r["id"]: r["source"] for r in csv.DictReader(
+            line for line in handle if not line.startswith("#"))}
+    rows = result["shots"]
+    logs = {m: np.array([abs(math.log(r["predicted_m"][m] / r["measured_m"])) for r in rows])
+            for m in ("li-chen-2003", "concrete", "li-chen-concrete")}
+    fc = np.array([r["fc_Pa"] for r in rows])
+    refs = np.array([source[r["id"]] for r in rows])
+    high = fc > 100e6
+    for ref in sorted(set(refs)):
+        rest = refs != ref
+        assert logs["li-chen-2003"][rest & ~high].mean() < logs["concrete"][rest & ~high].mean()
+        assert logs["concrete"][rest & high].mean() < logs["li-chen-2003"][rest & high].mean()
+    split = np.where(high, logs["concrete"], logs["li-chen-2003"])
+    assert np.allclose(split, logs["li-chen-concrete"], rtol=1e-5, atol=1e-6)
+    assert split.mean() == pytest.approx(0.436, abs=5e-4)
+    for threshold in (60e6, 80e6, 100e6, 120e6):
+        other = np.where(fc > threshold, logs["concrete"], logs["li-chen-2003"]).mean()
+        assert other < min(logs["concrete"].mean(), logs["li-chen-2003"].mean()) - 0.03
+        assert other <= 0.445

@@ -29,9 +29,13 @@ MODEL_LABELS = ("derived-quasi-static", "derived-dynamic", "paper", "table")
 CONCRETE_LABEL = "concrete"
 LI_CHEN_LABEL = "li-chen-2003"  # Li and Chen's (2003) empirical formula
 EMPIRICAL_LABEL = "forrestal-1994"
+#: Li and Chen (2003) for normal-strength concrete (f_c <= 100 MPa), the concrete model above
+#: (:func:`cavex.verification.validation.concrete_model.split_depth`): ``cavex validate``'s
+#: recommended model
+SPLIT_LABEL = "li-chen-concrete"
 #: Every model ``cavex validate`` predicts with (``--models`` choices), in the order of its
 #: columns.
-VALIDATION_LABELS = (*MODEL_LABELS, CONCRETE_LABEL, LI_CHEN_LABEL, EMPIRICAL_LABEL)
+VALIDATION_LABELS = (*MODEL_LABELS, CONCRETE_LABEL, LI_CHEN_LABEL, SPLIT_LABEL, EMPIRICAL_LABEL)
 #: Earlier spellings of a model label (validation's columns, ``calibrate --model``), each with
 #: the label that replaced it; refused with a line that names the new one.
 OLD_LABELS = {"derived quasi-static": "derived-quasi-static",

@@ -32,6 +32,7 @@ from cavex.verification.validation.predict import (
     FE_MODEL,
     LI_CHEN,
     MODELS,
+    SPLIT,
     TableCache,
     add_statistics,
     predictions,
@@ -202,15 +203,22 @@ def verdict(summary, calibrations):
             f"{EMPIRICAL}'s {empirical:.4f}")
 
 
+#: why a model is recommended, in words (:func:`recommendation`)
+RECOMMENDATION_REASONS = {
+    SPLIT: f"`{LI_CHEN}` for f_c <= 100 MPa, the strength its constant was fitted at, "
+           f"`{CONCRETE}` above; no constant fitted by cavex",
+    CONCRETE: "uncalibrated, every constant published, none fitted to shots"}
+
+
 def recommendation(model, summary):
     """One sentence: why ``model`` (the recommended one) is recommended and how it does on
     ``summary``'s shots against :data:`EMPIRICAL` (None when it was not run)."""
     ours = summary.get(model, {}).get("mean_abs_log_ratio")
     if ours is None:
         return None
-    sentence = (f"Recommended model: `{model}`, because it is the uncalibrated model with no "
-                f"constant fitted to the shots; on these {summary[model]['n']} shots its mean "
-                f"abs ln ratio is {ours:.4f}")
+    why = RECOMMENDATION_REASONS.get(model, "uncalibrated, no constant fitted to the shots")
+    sentence = (f"Recommended model: `{model}` ({why}; docs/validation.md); on these "
+                f"{summary[model]['n']} shots its mean abs ln ratio is {ours:.4f}")
     empirical = summary.get(EMPIRICAL, {}).get("mean_abs_log_ratio")
     if empirical is not None:
         relation = "no larger than" if ours <= empirical else "LARGER than"
@@ -265,6 +273,9 @@ def report_markdown(result, figures=True):
               "it does not use the mapping below;",
               f"- `{LI_CHEN}`: S = 72 f_c^-0.5 (f_c in MPa), crater 0.707 + h/d calibres "
               "(Li and Chen 2003, fitted by them to published shots);",
+              f"- `{SPLIT}` (recommended): `{LI_CHEN}` for f_c <= 100 MPa, `{CONCRETE}` "
+              "above (no constant fitted; the split chosen on the development shots, "
+              "docs/validation.md);",
               f"- `{EMPIRICAL}`: S = 82.6 f_c^-0.544 (f_c in MPa), crater of two calibres "
               "(Forrestal et al. 1994). Forrestal et al. fitted S to their own shots, so on "
               "their data it is not an out-of-sample prediction;",
@@ -323,8 +334,9 @@ def report_markdown(result, figures=True):
               "the empirical formula, then each calibrated model with its fitted shots filled "
               "and its held-out shots open)](predicted_vs_measured.png)", "",
               "![ratio against striking velocity](ratio_vs_velocity.png)", "",
-              "![the recommended model and the empirical formulas, predicted against measured "
-              "by regime (open: flagged non-rigid)](by_regime.png)", "",
+              "![the recommended model, the concrete model and the empirical formulas, "
+              "predicted against measured by regime (open: flagged non-rigid)](by_regime.png)",
+              "",
               "![ln(predicted/measured) against striking velocity and f_c](residuals.png)",
               ""] if figures \
         else ["", "(figures not drawn: `--no-figures`)", ""]
@@ -440,9 +452,11 @@ def write_figures(result, out):
 
 
 def regime_models(result):
-    """The models of the regime figures: the recommended one and the empirical formulas (those
-    that ran)."""
-    return [m for m in (result["recommended_model"], LI_CHEN, EMPIRICAL) if m in result["models"]]
+    """The models of the regime figures: the concrete model, the empirical formulas and, drawn
+    last (on top of the one it equals in a regime), the recommended one (those that ran, each
+    once)."""
+    chosen = (CONCRETE, LI_CHEN, EMPIRICAL, result["recommended_model"])
+    return [m for k, m in enumerate(chosen) if m in result["models"] and m not in chosen[k + 1:]]
 
 
 def write_regime_figures(result, out, plt):
@@ -564,9 +578,9 @@ def fitted_ids(result, model):
     return set()
 
 
-MARKERS = dict(zip(MODELS, ["o", "s", "^", "D", "v", "X", "*"], strict=True))
+MARKERS = dict(zip(MODELS, ["o", "s", "^", "D", "v", "X", "h", "*"], strict=True))
 COLOURS = dict(zip(MODELS, ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple",
-                            "tab:brown", "black"], strict=True))
+                            "tab:brown", "tab:pink", "black"], strict=True))
 
 
 def _draw_model(ax, result, model, measured, velocity):

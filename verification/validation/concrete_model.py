@@ -186,6 +186,25 @@ def li_chen_depth(shot):
         crater_calibres=crater_calibres(shot.crh))
 
 
+#: f_c (Pa) above which the recommended model leaves Li and Chen's formula for the concrete
+#: model: the upper bound of normal strength in the validation's regimes
+SPLIT_STRENGTH = 100e6
+
+
+def split_depth(shot, concrete_depth=None):
+    """The recommended model: Li and Chen's (2003) depth for ``f_c <= 100 MPa``
+    (:data:`SPLIT_STRENGTH`), the concrete model's above (``concrete_depth`` if it is known,
+    else :func:`model_depth`; None stays None).
+
+    Li and Chen's ``S = 72 f_c^-1/2`` was fitted to shots into normal-strength concrete; above,
+    on the development shots, it over-predicts depths threefold (bias +1.10), the concrete
+    model, whose strength is capped at ``7 f_c`` from its correlations, twofold (+0.72), and
+    the choice holds with any one reference left out (docs/validation.md)."""
+    if shot.fc <= SPLIT_STRENGTH:
+        return li_chen_depth(shot)
+    return model_depth(shot) if concrete_depth is None else concrete_depth
+
+
 def nose_pressure(shot, resistance):
     """Mean nose pressure at impact ``F(V0)/(pi a^2)`` (Pa)."""
     return resistance.force(0.0, shot.V0) / (math.pi * 0.25 * shot.diameter ** 2)

@@ -43,6 +43,7 @@ from cavex.analytic.penetration.labels import (
     CONCRETE_LABEL,
     EMPIRICAL_LABEL,
     LI_CHEN_LABEL,
+    SPLIT_LABEL,
     VALIDATION_LABELS,
 )
 from cavex.analytic.penetration.nose import nose_rule
@@ -59,11 +60,13 @@ FE_MODEL = "table"
 EMPIRICAL = EMPIRICAL_LABEL
 CONCRETE = CONCRETE_LABEL
 LI_CHEN = LI_CHEN_LABEL
+SPLIT = SPLIT_LABEL
 CAVEX_MODELS = MODEL_LABELS  # the closed forms and the FE table: what a calibration can fit
 MODELS = VALIDATION_LABELS  # the cavex models, the concrete model, the empirical formula
-#: The model ``cavex validate`` recommends: the uncalibrated one with no constant fitted to any
-#: shot (docs/concrete.md)
-RECOMMENDED_MODEL = CONCRETE
+#: The model ``cavex validate`` recommends: Li and Chen (2003) at normal strength, the concrete
+#: model above (:func:`~cavex.verification.validation.concrete_model.split_depth`; no constant
+#: fitted to any shot, the split chosen on the development shots: docs/validation.md)
+RECOMMENDED_MODEL = SPLIT
 DEPTH_DIGITS = FE_DIGITS  # predicted depths and statistics in the result files
 TABLE_VELOCITY_STEP = 50.0  # m/s between FE table velocities (interpolated by PCHIP in V^2)
 TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on depth
@@ -118,6 +121,8 @@ def predict(shot, model, mapping=None, tables=None):
         return concrete_model.model_depth(shot)
     if model == LI_CHEN:
         return concrete_model.li_chen_depth(shot)
+    if model == SPLIT:
+        return concrete_model.split_depth(shot)
     resistance, boundary = parse_model_label(model)
     if resistance == "table":
         tables = tables or TableCache()
@@ -351,17 +356,23 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     columns = validation_columns(calibrations, mapping, models)
     tables = tables or TableCache()
     tables.velocities_for(shots)
-    concrete = [name for name, (model, _) in columns.items() if model == CONCRETE]
+    concrete = [name for name, (model, _) in columns.items() if model in (CONCRETE, SPLIT)]
+    ids = [shot.id for shot in shots]
     depths, failures = predictions(
         shots, {k: v for k, v in columns.items() if k not in concrete}, tables, progress)
     flags = [None] * len(shots)
-    if concrete:
+    if concrete:  # the concrete model's depths and flags, once for both models that use them
         concrete_depths, flags, concrete_failures = concrete_predictions(shots, tables.workers,
                                                                          progress)
         for name in concrete:
-            depths[name] = concrete_depths
-            if concrete_failures:
-                failures[name] = concrete_failures
+            depths[name], failed = concrete_depths, concrete_failures
+            if columns[name][0] == SPLIT:
+                depths[name] = [_split_depth(shot, depth)
+                                for shot, depth in zip(shots, concrete_depths, strict=True)]
+                failed = {i: reason for i, reason in concrete_failures.items()
+                          if depths[name][ids.index(i)] is None}
+            if failed:
+                failures[name] = failed
     depths = {name: depths[name] for name in columns}
     rows = []
     for i, shot in enumerate(shots):
@@ -378,6 +389,14 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     if calibrations:
         result["held_out"] = [row["id"] for row in rows if row["id"] not in fitted]
     return add_statistics(result)
+
+
+def _split_depth(shot, concrete_depth):
+    """The recommended model's depth from the concrete model's (None where that failed and
+    the shot needs it), rounded like every depth."""
+    if concrete_depth is None and shot.fc > concrete_model.SPLIT_STRENGTH:
+        return None
+    return round_significant(concrete_model.split_depth(shot, concrete_depth), DEPTH_DIGITS)
 
 
 def concrete_predictions(shots, workers=None, progress=None):
