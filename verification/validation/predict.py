@@ -38,19 +38,19 @@ from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.labels import (
     CONCRETE_LABEL,
     EMPIRICAL_LABEL,
     LI_CHEN_LABEL,
+    MODEL_LABELS,
     VALIDATION_LABELS,
+    parse_model_label,
 )
+from cavex.analytic.penetration.labels import MODELS as CLOSED_FORMS
 from cavex.analytic.penetration.nose import nose_rule
-from cavex.analytic.penetration.resistance import MODEL_LABELS, make_resistance, parse_model_label
-from cavex.analytic.penetration.resistance import MODELS as CLOSED_FORMS
 from cavex.errors import CavexInputError, CavexNumericalError, require_choice
 from cavex.verification.output.number_format import FE_DIGITS, round_significant
-from cavex.verification.validation import concrete_model, empirical
+from cavex.verification.validation import empirical
 from cavex.verification.validation.concrete import Mapping, shot_target
 from cavex.verification.validation.regimes import regime_statistics
 from cavex.verification.validation.shots import shot_projectile
@@ -88,12 +88,16 @@ OUTLIER_FACTOR = 3.0
 
 def penetration_depth(target, projectile, resistance):
     """Final nose-tip depth (m) of the integrator (also where the crater stops it)."""
+    from cavex.analytic.penetration.integrator import penetrate
+
     return float(penetrate(target, projectile, resistance).depth[-1])
 
 
 def closed_form_depth(shot, resistance="derived", *, boundary=None, mapping=None):
     """Depth (m) of the closed form ``resistance`` ("derived" with ``boundary``, or "paper")
     for ``shot`` under ``mapping``."""
+    from cavex.analytic.penetration.resistance import make_resistance
+
     require_choice(resistance, CLOSED_FORMS, "resistance")
     target, projectile = shot_target(shot, mapping), shot_projectile(shot)
     return penetration_depth(target, projectile,
@@ -102,6 +106,8 @@ def closed_form_depth(shot, resistance="derived", *, boundary=None, mapping=None
 
 def table_depth(shot, table, mapping=None):
     """Depth (m) with the FE-tabulated resistance of ``table`` (built for the shot's target)."""
+    from cavex.analytic.penetration.resistance import make_resistance
+
     target, projectile = shot_target(shot, mapping), shot_projectile(shot)
     return penetration_depth(target, projectile,
                              make_resistance(target, projectile, "table", table=table))
@@ -112,6 +118,8 @@ def predict(shot, model, mapping=None, tables=None):
 
     ``tables`` (a :class:`TableCache`) gives the FE tables of the ``table`` model.
     """
+    from cavex.verification.validation import concrete_model
+
     if model == EMPIRICAL:
         return empirical.shot_depth(shot)
     if model == CONCRETE:
@@ -388,6 +396,7 @@ def concrete_predictions(shots, workers=None, progress=None):
     cavity table is built once; tasks run on ``workers`` local processes (default: the CPUs).
     """
     from cavex.verification.fedata.runner import Progress, process_pool, show_progress
+    from cavex.verification.validation import concrete_model  # noqa: F401 (before the fork)
 
     groups = {}
     for i, shot in enumerate(shots):
@@ -417,6 +426,8 @@ def concrete_predictions(shots, workers=None, progress=None):
 
 def concrete_group(shots):
     """``[(depth, flag, reason)]`` of the concrete model for ``shots`` (one concrete)."""
+    from cavex.verification.validation import concrete_model
+
     out = []
     for shot in shots:
         try:
