@@ -5,8 +5,9 @@ Prints medians (and min, max) of wall time over ``--runs`` runs (default 7, afte
 that is not counted, so numba's cache is warm) of
 
 - ``cavex --help``, ``cavex penetrate --help`` and bad input (exit code 2) of ``stress``,
-  ``fem``, ``penetrate`` and ``trajectory``: refused by the parser, or by the command's checks
-  before it loads the numerical libraries it runs on (verification/commands/__init__.py);
+  ``fem``, ``penetrate``, ``trajectory``, ``table``, ``verify``, ``batch``, ``calibrate`` and
+  ``validate`` (:data:`BAD_INPUTS`): refused by the parser, or by the command's checks before it
+  loads the numerical libraries it runs on (verification/commands/__init__.py);
 - yardsticks (:data:`YARDSTICKS`): a Python process that does nothing, imports numpy, numba,
   calls one compiled kernel that does nothing (loaded from numba's cache: the floor of every
   command that computes with numba), and also imports scipy.integrate;
@@ -46,7 +47,28 @@ import time
 from pathlib import Path
 
 CAVEX = str(Path(sys.executable).with_name("cavex"))  # the installed command
+SHOTS = str(Path(__file__).resolve().parents[1] / "examples" / "shots_forrestal1994.csv")
 FLOOR = 0.4  # s: the bound on a --no-figures command over its in-process computation
+
+#: Bad input, each refused with exit code 2 (``{out}``: the benchmark's temporary folder, which
+#: holds ``bad_key.toml``, a sweep with a key the batch schema does not have).
+BAD_INPUTS = {
+    "cavex stress --velocity x (parser)": ["stress", "--velocity", "x", "--depth", "0.3"],
+    "cavex stress --velocity -1": ["stress", "--velocity", "-1", "--depth", "0.3"],
+    "cavex fem --velocity 1e9": ["fem", "--velocity", "1e9", "--depth", "0.3"],
+    "cavex penetrate --resistance table (no --table)": ["penetrate", "--resistance", "table"],
+    "cavex trajectory --velocity -1": ["trajectory", "--velocity", "-1"],
+    "cavex trajectory --spin 1e9": ["trajectory", "--spin", "1e9"],
+    "cavex table --velocities -5 0": ["table", "--velocities", "-5", "0"],
+    "cavex table --depths 0": ["table", "--depths", "0"],
+    "cavex verify --workers 0": ["verify", "--workers", "0"],
+    "cavex batch (a sweep with a bad key)": ["batch", "{out}/bad_key.toml"],
+    "cavex calibrate --shots missing.csv": ["calibrate", "--shots", "{out}/missing.csv",
+                                            "--out", "{out}/c.toml"],
+    "cavex validate --shots missing.csv": ["validate", "--shots", "{out}/missing.csv"],
+    "cavex validate --models nosuch": ["validate", "--shots", SHOTS, "--models", "nosuch"],
+}
+BAD_SWEEP = '[sweep]\nname = "bad"\n\n[grid]\nvelocity = [0.0, 100.0]\n'
 
 #: A kernel that does nothing, compiled once into numba's cache (the warm-up run) and loaded
 #: from it after: what calling any compiled kernel costs a fresh process.
@@ -188,16 +210,10 @@ def main():
         out = Path(folder)
         line("cavex --help", wall([CAVEX, "--help"], runs))
         line("cavex penetrate --help", wall([CAVEX, "penetrate", "--help"], runs))
-        for name, argv in (
-                ("cavex stress --velocity x (parser)", ["stress", "--velocity", "x",
-                                                       "--depth", "0.3"]),
-                ("cavex stress --velocity -1", ["stress", "--velocity", "-1", "--depth", "0.3"]),
-                ("cavex fem --velocity 1e9", ["fem", "--velocity", "1e9", "--depth", "0.3"]),
-                ("cavex penetrate --resistance table (no --table)",
-                 ["penetrate", "--resistance", "table"]),
-                ("cavex trajectory --velocity -1", ["trajectory", "--velocity", "-1"]),
-                ("cavex trajectory --spin 1e9", ["trajectory", "--spin", "1e9"])):
-            line(f"{name} (bad input, exit 2)", wall([CAVEX, *argv], runs, expect=2))
+        (out / "bad_key.toml").write_text(BAD_SWEEP)
+        for name, argv in BAD_INPUTS.items():
+            line(f"{name} (bad input, exit 2)",
+                 wall([CAVEX, *(a.format(out=out) for a in argv)], runs, expect=2))
         (out / "kernel.py").write_text(KERNEL)
         yardstick = {name: line(name, wall([sys.executable, "-c", f"{code}; import gc; "
                                            "gc.freeze()"], runs, cwd=out))

@@ -10,11 +10,28 @@ quadrature, mass), ``constitutive`` (the compiled point kernel: Hencky/Mohr-Coul
 block-banded solve), ``newton`` (per-case Newton, line search), ``solver`` (stepping, cut-backs,
 observers), ``estimate`` (error companion and refinement policies), ``expansion`` (the problems
 and the public API), ``fields``/``output`` (post-processing, ParaView files).
+
+The names below are imported on first use (PEP 562), as in :mod:`cavex.analytic`, so that
+importing a plain submodule (``settings``, ``estimate``: what the commands check their input
+with) does not load scikit-fem, numba or scipy.
 """
 
-from cavex.fem.expansion import expand_cavities, expand_cavity
-from cavex.fem.output import write_result
-from cavex.fem.result import ExpansionResult
-from cavex.fem.settings import Numerics
+import importlib
 
-__all__ = ["ExpansionResult", "Numerics", "expand_cavities", "expand_cavity", "write_result"]
+#: public name -> the submodule that defines it
+_WHERE = {"expand_cavities": "expansion", "expand_cavity": "expansion",
+          "write_result": "output", "ExpansionResult": "result", "Numerics": "settings"}
+
+__all__ = sorted(_WHERE)
+
+
+def __getattr__(name):
+    if name not in _WHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted([*globals(), *_WHERE])

@@ -8,13 +8,16 @@ import io
 import subprocess
 import sys
 from importlib.metadata import entry_points
+from pathlib import Path
 
 import pytest
 
 from cavex.config import default_config_text, load_config
 from cavex.verification.cli import announce_compiling, build_parser, main
 
-HEAVY = ("numba", "scipy", "matplotlib", "skfem", "xarray", "dask")
+HEAVY = ("numba", "scipy", "matplotlib", "skfem", "xarray", "dask", "pandas")
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+SHOTS = str(EXAMPLES / "shots_forrestal1994.csv")
 
 
 def _run(capsys, *argv):
@@ -33,19 +36,23 @@ def test_the_parser_loads_no_numerical_library():
     assert done.stdout.strip() == "[]"
 
 
-def _loaded_after(argv):
+def _loaded_after(argv, cwd=None):
     """``(exit code, stderr, the HEAVY modules loaded)`` of ``cavex argv`` run in a fresh
-    process."""
+    process (in ``cwd``: None, this one's)."""
     probe = ("import sys; from cavex.verification.cli import main; code = main(sys.argv[1:]); "
              f"print(code, sorted(m for m in {HEAVY!r} if m in sys.modules))")
     done = subprocess.run([sys.executable, "-c", probe, *argv], capture_output=True,
-                          text=True, timeout=120, check=True)
+                          text=True, timeout=120, check=True, cwd=cwd)
     code, loaded = done.stdout.strip().splitlines()[-1].split(" ", 1)
     return int(code), done.stderr, loaded
 
 
+#: A sweep with a key the batch schema does not have (written as ``{tmp}/bad_key.toml``).
+BAD_SWEEP = '[sweep]\nname = "bad"\n\n[grid]\nvelocity = [0.0, 100.0]\n'
+
 #: One bad input of each kind a command checks itself (after the parser), for the commands
-#: that refuse it before loading the numerical libraries (verification/commands/__init__.py).
+#: that refuse it before loading the numerical libraries (verification/commands/__init__.py);
+#: ``{tmp}``: the folder the command runs in (nothing may be written there).
 BAD_INPUTS = {
     "penetrate --resistance table": ["penetrate", "--resistance", "table"],
     "penetrate --out in /proc": ["penetrate", "--out", "/proc/cavex-no-such-dir/x"],
@@ -59,15 +66,47 @@ BAD_INPUTS = {
     "stress --depth -1": ["stress", "--velocity", "800", "--depth", "-1"],
     "fem --velocity 1e9": ["fem", "--velocity", "1e9", "--depth", "0.3"],
     "config missing file": ["config", "--config", "/proc/cavex-no-such-file.toml"],
+    "table --velocities -5": ["table", "--velocities", "-5", "0", "--out", "{tmp}/t.nc"],
+    "table --velocities without 0": ["table", "--velocities", "100", "200"],
+    "table --depths 0": ["table", "--depths", "0"],
+    "table --nu 0.6": ["table", "--velocities", "0", "100", "--depths", "0.2", "0.3", "--nu",
+                       "0.6", "--out", "{tmp}/t.nc"],
+    "table --workers 0": ["table", "--workers", "0"],
+    "table --out in /proc": ["table", "--out", "/proc/cavex-no-such-dir/t.nc"],
+    "verify --workers 0": ["verify", "--workers", "0"],
+    "verify --scheduler nosuch": ["verify", "--quick", "--scheduler", "nosuch"],
+    "verify --out in /proc": ["verify", "--out", "/proc/cavex-no-such-dir/report"],
+    "batch missing sweep": ["batch", "/proc/cavex-no-such-file.toml"],
+    "batch bad key": ["batch", "{tmp}/bad_key.toml"],
+    "batch --workers 0": ["batch", str(EXAMPLES / "sweep.toml"), "--workers", "0", "--out",
+                          "{tmp}/sweep"],
+    "calibrate missing shots": ["calibrate", "--shots", "/proc/cavex-no-such.csv", "--out",
+                                "{tmp}/c.toml"],
+    "calibrate --params nosuch": ["calibrate", "--shots", SHOTS, "--out", "{tmp}/c.toml",
+                                  "--params", "nosuch"],
+    "calibrate --ids nosuch": ["calibrate", "--shots", SHOTS, "--out", "{tmp}/c.toml",
+                               "--ids", "nosuch"],
+    "calibrate --out in /proc": ["calibrate", "--shots", SHOTS, "--out",
+                                 "/proc/cavex-no-such-dir/c.toml"],
+    "validate missing shots": ["validate", "--shots", "/proc/cavex-no-such.csv"],
+    "validate --models nosuch": ["validate", "--shots", SHOTS, "--models", "nosuch"],
+    "validate missing calibration": ["validate", "--shots", SHOTS, "--calibration",
+                                     "/proc/cavex-no-such.toml"],
+    "validate --workers 0": ["validate", "--shots", SHOTS, "--workers", "0", "--out",
+                             "{tmp}/v"],
 }
 
 
 @pytest.mark.parametrize("argv", BAD_INPUTS.values(), ids=BAD_INPUTS.keys())
-def test_bad_input_is_refused_before_the_numerical_libraries_load(argv):
+def test_bad_input_is_refused_before_the_numerical_libraries_load(argv, tmp_path):
     """A bad input the command checks itself answers (one line, exit 2) without loading any of
-    :data:`HEAVY` (the time: benchmarks/commands.py)."""
-    code, err, loaded = _loaded_after(argv)
+    :data:`HEAVY` (the time: benchmarks/commands.py) and writes nothing (run in ``tmp_path``,
+    so that a default output folder would show there too)."""
+    (tmp_path / "bad_key.toml").write_text(BAD_SWEEP)
+    before = sorted(tmp_path.rglob("*"))
+    code, err, loaded = _loaded_after([a.format(tmp=tmp_path) for a in argv], cwd=tmp_path)
     assert (code, len(err.splitlines()), loaded) == (2, 1, "[]"), err
+    assert sorted(tmp_path.rglob("*")) == before
 
 
 def test_the_paper_model_loads_no_compiled_kernel():

@@ -31,12 +31,13 @@ def job(target, projectile, *, config_path=None, quick=False, out_dir=None, sche
     from cavex.config import default_config_text
     from cavex.verification.fedata.runner import check_execution
     from cavex.verification.output.paths import check_output_dir, staged_output
-    from cavex.verification.report import build
 
     config = default_config_text() if config_path is None else Path(config_path).read_text(
         encoding="utf-8")
     out_dir = check_output_dir(DEFAULT_OUT if out_dir is None else out_dir, "out")
     check_execution(workers, scheduler)
+    from cavex.verification.report import build  # the numerical libraries, after the checks
+
     with staged_output(out_dir) as stage:
         result = build.verify(target, projectile, quick=quick, out_dir=stage,
                               scheduler=scheduler, workers=workers, config_text=config,

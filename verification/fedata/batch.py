@@ -29,7 +29,6 @@ from cavex.verification.fedata.cases import (
     fe_cases,
     numerics_names,
 )
-from cavex.verification.fedata.comparison import with_closed_forms
 from cavex.verification.fedata.runner import check_execution, check_store, read_store, run_cases
 from cavex.verification.fedata.table import MAX_DEPTH, write_table
 from cavex.verification.output.cf_metadata import CONVENTIONS, boolean_attrs
@@ -399,6 +398,10 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
     workers = workers if workers is not None else sweep.workers
     check_execution(workers, scheduler)
     check_store(os.path.join(out_dir, STORE_DIR), cases)  # before sweep.json is rewritten
+    # scikit-fem and numba, after the checks (bad input is refused without them) and before the
+    # workers are forked (they inherit them)
+    from cavex.verification.fedata.comparison import with_closed_forms
+
     os.makedirs(out_dir, exist_ok=True)
     description = _description(sweep, cases)
     write_text_atomic(os.path.join(out_dir, SWEEP_FILE), json.dumps(description, indent=1))
@@ -432,6 +435,8 @@ def load_sweep(out_dir):
         ``cases``, ``failed_cases``, ``missing_cases`` and ``fixed`` (JSON of the settings
         that are not swept).
     """
+    from cavex.verification.fedata.comparison import with_closed_forms
+
     out_dir = os.fspath(out_dir)
     path = os.path.join(out_dir, SWEEP_FILE)
     if not os.path.exists(path):

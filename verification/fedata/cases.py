@@ -28,13 +28,15 @@ import os
 import time
 import uuid
 from collections.abc import Mapping
-from dataclasses import fields
+from dataclasses import fields, replace
 
+from cavex.analytic.geometry import spherical_problem
 from cavex.config import load_config, parse_projectile, parse_target, projectile_table, target_table
 from cavex.errors import CavexInputError, CavexNumericalError, check_keys, require
 from cavex.errors import is_finite_number as _finite
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
 from cavex.fem.settings import Numerics, check_seed_radius, make_numerics
+from cavex.problem import SphericalProblem
 
 CASE_KEYS = {"id", "velocity", "depth", "nu", "numerics", "error_target", "target",
              "projectile"}
@@ -137,8 +139,6 @@ class CaseBuilder:
         """The :class:`FECase` of a description; raises :class:`CavexInputError` (or
         ``KeyError``/``TypeError``/``ValueError`` for a malformed dict) if it is not a valid
         case."""
-        from cavex.verification.fedata.comparison import fe_problem
-
         check_keys(description, CASE_KEYS, "")
         target = self.target(description["target"])
         projectile = self.projectile(description["projectile"])
@@ -151,6 +151,17 @@ class CaseBuilder:
         check_seed_radius(numerics, problem.radius)
         return FECase(description, problem, numerics,
                       None if error_target is None else float(error_target))
+
+
+def fe_problem(target, projectile, depth, velocity, nu=None):
+    """The :class:`~cavex.problem.SphericalProblem` of the FE at nose-tip depth ``depth``
+    (:func:`cavex.analytic.geometry.spherical_problem`; cavity radius = shank radius), with
+    Poisson's ratio ``nu`` for every layer when given; checked as it is built
+    (plain: the commands check their cases with it before scikit-fem loads)."""
+    layers, interfaces = spherical_problem(target, projectile, depth)
+    if nu is not None:
+        layers = [replace(m, nu=nu) for m in layers]
+    return SphericalProblem(tuple(layers), interfaces, velocity, projectile.r)
 
 
 def _numerics(settings):

@@ -11,17 +11,15 @@ call together, where the numbers are kept (the FE table, the batch Dataset, ``ca
 :func:`comparison_record` puts both sides in one record.
 """
 
-from dataclasses import replace
-
 import numpy as np
 
 from cavex.analytic.cavity import cavity_solution
-from cavex.analytic.geometry import spherical_problem
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET, MAX_REFINEMENTS
 from cavex.fem.expansion import expand_problems
 from cavex.fem.output import write_result
 from cavex.fem.settings import make_numerics
-from cavex.problem import BOUNDARIES, SphericalProblem
+from cavex.problem import BOUNDARIES
+from cavex.verification.fedata.cases import fe_problem
 from cavex.verification.output.number_format import FE_DIGITS
 from cavex.verification.output.paths import check_output_dir
 
@@ -33,16 +31,6 @@ COMPARISON_KEYS = ("depth_m", "velocity_m_s", "cavity_radius_m", "layers", "inte
                    "relative_difference", "error_estimate", "refinements",
                    "fe_plastic_radius_m", "analytic_plastic_radius_m", "numerics",
                    "wall_time_s")
-
-
-def fe_problem(target, projectile, depth, velocity, nu=None):
-    """The :class:`~cavex.problem.SphericalProblem` of the FE at nose-tip depth ``depth``
-    (:func:`cavex.analytic.geometry.spherical_problem`; cavity radius = shank radius), with
-    Poisson's ratio ``nu`` for every layer when given; checked as it is built."""
-    layers, interfaces = spherical_problem(target, projectile, depth)
-    if nu is not None:
-        layers = [replace(m, nu=nu) for m in layers]
-    return SphericalProblem(tuple(layers), interfaces, velocity, projectile.r)
 
 
 def fe_records(depths, problems, numerics, error_target=DEFAULT_ERROR_TARGET):

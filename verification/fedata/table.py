@@ -38,7 +38,6 @@ from cavex.fem.estimate import DEFAULT_ERROR_TARGET
 from cavex.materials import MAX_VELOCITY
 from cavex.problem import BOUNDARIES
 from cavex.verification.fedata.cases import CaseBuilder, fe_cases, make_fe_cases
-from cavex.verification.fedata.comparison import closed_forms
 from cavex.verification.fedata.runner import run_cases
 from cavex.verification.output.cf_metadata import CONVENTIONS, UNITS, boolean_attrs, flag_attrs
 from cavex.verification.output.number_format import round_dataset
@@ -240,6 +239,8 @@ def analytic_grid(target, projectile, velocities, depths, boundaries=BOUNDARIES)
     """The closed forms on the grid, each cell once
     (:func:`cavex.verification.fedata.comparison.closed_forms`): ``{boundary: (sigma_r,
     plastic_radius)}``, arrays of shape ``(velocities, depths)``."""
+    from cavex.verification.fedata.comparison import closed_forms  # scikit-fem: not at the top
+
     columns = [spherical_problem(target, projectile, float(L)) for L in depths]
     problems = [(layers, interfaces, float(V), projectile.r)
                 for V in velocities for layers, interfaces in columns]

@@ -25,9 +25,8 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
 
-from cavex.analytic.penetration.resistance import model_label, parse_model_label
+from cavex.analytic.penetration.labels import model_label, parse_model_label
 from cavex.errors import CavexInputError, CavexNumericalError, check_keys, prefixed, require
 from cavex.input_files import in_file, read_toml
 from cavex.verification.output.number_format import round_significant
@@ -204,6 +203,8 @@ def _least_squares(shots, model, params, start, tables, progress):
     """The fitted mapping (parameters rounded to :data:`PARAMETER_DIGITS`), the number of
     residual evaluations and the parameters' standard errors (:func:`standard_errors`);
     :class:`ShotFailure` passes through."""
+    from scipy.optimize import least_squares  # not at the top: the checks run without scipy
+
     kind = FE_MODEL if model == FE_MODEL else "closed form"
     count = [0]
     began = time.monotonic()

@@ -38,20 +38,20 @@ from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.labels import (
     CONCRETE_LABEL,
     EMPIRICAL_LABEL,
     LI_CHEN_LABEL,
+    MODEL_LABELS,
     SPLIT_LABEL,
     VALIDATION_LABELS,
+    parse_model_label,
 )
+from cavex.analytic.penetration.labels import MODELS as CLOSED_FORMS
 from cavex.analytic.penetration.nose import nose_rule
-from cavex.analytic.penetration.resistance import MODEL_LABELS, make_resistance, parse_model_label
-from cavex.analytic.penetration.resistance import MODELS as CLOSED_FORMS
 from cavex.errors import CavexInputError, CavexNumericalError, require_choice
 from cavex.verification.output.number_format import FE_DIGITS, round_significant
-from cavex.verification.validation import concrete_model, empirical
+from cavex.verification.validation import empirical
 from cavex.verification.validation.concrete import Mapping, shot_target
 from cavex.verification.validation.regimes import regime_statistics
 from cavex.verification.validation.shots import shot_projectile
@@ -91,12 +91,16 @@ OUTLIER_FACTOR = 3.0
 
 def penetration_depth(target, projectile, resistance):
     """Final nose-tip depth (m) of the integrator (also where the crater stops it)."""
+    from cavex.analytic.penetration.integrator import penetrate
+
     return float(penetrate(target, projectile, resistance).depth[-1])
 
 
 def closed_form_depth(shot, resistance="derived", *, boundary=None, mapping=None):
     """Depth (m) of the closed form ``resistance`` ("derived" with ``boundary``, or "paper")
     for ``shot`` under ``mapping``."""
+    from cavex.analytic.penetration.resistance import make_resistance
+
     require_choice(resistance, CLOSED_FORMS, "resistance")
     target, projectile = shot_target(shot, mapping), shot_projectile(shot)
     return penetration_depth(target, projectile,
@@ -105,6 +109,8 @@ def closed_form_depth(shot, resistance="derived", *, boundary=None, mapping=None
 
 def table_depth(shot, table, mapping=None):
     """Depth (m) with the FE-tabulated resistance of ``table`` (built for the shot's target)."""
+    from cavex.analytic.penetration.resistance import make_resistance
+
     target, projectile = shot_target(shot, mapping), shot_projectile(shot)
     return penetration_depth(target, projectile,
                              make_resistance(target, projectile, "table", table=table))
@@ -115,6 +121,8 @@ def predict(shot, model, mapping=None, tables=None):
 
     ``tables`` (a :class:`TableCache`) gives the FE tables of the ``table`` model.
     """
+    from cavex.verification.validation import concrete_model
+
     if model == EMPIRICAL:
         return empirical.shot_depth(shot)
     if model == CONCRETE:
@@ -394,6 +402,8 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
 def _split_depth(shot, concrete_depth):
     """The recommended model's depth from the concrete model's (None where that failed and
     the shot needs it), rounded like every depth."""
+    from cavex.verification.validation import concrete_model
+
     if concrete_depth is None and shot.fc > concrete_model.SPLIT_STRENGTH:
         return None
     return round_significant(concrete_model.split_depth(shot, concrete_depth), DEPTH_DIGITS)
@@ -407,6 +417,7 @@ def concrete_predictions(shots, workers=None, progress=None):
     cavity table is built once; tasks run on ``workers`` local processes (default: the CPUs).
     """
     from cavex.verification.fedata.runner import Progress, process_pool, show_progress
+    from cavex.verification.validation import concrete_model  # noqa: F401 (before the fork)
 
     groups = {}
     for i, shot in enumerate(shots):
@@ -436,6 +447,8 @@ def concrete_predictions(shots, workers=None, progress=None):
 
 def concrete_group(shots):
     """``[(depth, flag, reason)]`` of the concrete model for ``shots`` (one concrete)."""
+    from cavex.verification.validation import concrete_model
+
     out = []
     for shot in shots:
         try:
