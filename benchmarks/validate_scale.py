@@ -5,7 +5,9 @@ Writes a shot file of ``--shots`` (default 1000) shots made from the development
 ``k mod 286`` with its ``f_c`` scaled by ``1 + 0.001 k`` and its ``V0`` by ``1 + 0.0005 k``, so
 that every shot has its own concrete (no cavity table is shared: the worst case for the
 concrete model, which tabulates one cavity solution per concrete) and its own velocity. Then
-times ``cavex validate --shots FILE --models concrete --no-figures --no-progress --workers W``
+times ``cavex validate --shots FILE --models li-chen-concrete --no-figures --no-progress
+--workers W`` (the recommended model, which runs the concrete model on every shot for the
+rigid-regime flags)
 as a user runs it (the whole process, cold: the concrete tables live in the process) over
 ``--runs`` runs and prints the median, min and max.
 
@@ -53,7 +55,7 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "shots.csv"
         shot_file(path, args.shots)
-        argv = [CAVEX, "validate", "--shots", str(path), "--models", "concrete",
+        argv = [CAVEX, "validate", "--shots", str(path), "--models", "li-chen-concrete",
                 "--no-figures", "--no-progress", "--workers", str(args.workers),
                 "--out", str(Path(folder) / "out")]
         times = []
@@ -63,7 +65,7 @@ def main(argv=None):
             times.append(time.perf_counter() - start)
             if done.returncode != 0:
                 raise SystemExit(f"exit {done.returncode}: {done.stderr}")
-        print(f"cavex validate, {args.shots} shots, --models concrete, --workers "
+        print(f"cavex validate, {args.shots} shots, --models li-chen-concrete, --workers "
               f"{args.workers}: median {statistics.median(times):.1f} s (min {min(times):.1f}, "
               f"max {max(times):.1f}, {len(times)} runs)")
         print(done.stdout.splitlines()[0])
