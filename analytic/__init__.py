@@ -4,7 +4,7 @@ The names below are imported on first use (PEP 562), so that importing one submo
 resistance vocabulary the command line's parser needs) does not compile or load the others
 (numba, scipy)."""
 
-import importlib
+from cavex.lazy import lazy_names
 
 #: public name -> the submodule that defines it
 _WHERE = {
@@ -23,15 +23,4 @@ _WHERE = {
 }
 
 __all__ = sorted(_WHERE)
-
-
-def __getattr__(name):
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted([*globals(), *_WHERE])
+__getattr__, __dir__ = lazy_names(__name__, _WHERE)

@@ -16,22 +16,11 @@ importing a plain submodule (``settings``, ``estimate``: what the commands check
 with) does not load scikit-fem, numba or scipy.
 """
 
-import importlib
+from cavex.lazy import lazy_names
 
 #: public name -> the submodule that defines it
 _WHERE = {"expand_cavities": "expansion", "expand_cavity": "expansion",
           "write_result": "output", "ExpansionResult": "result", "Numerics": "settings"}
 
 __all__ = sorted(_WHERE)
-
-
-def __getattr__(name):
-    if name not in _WHERE:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted([*globals(), *_WHERE])
+__getattr__, __dir__ = lazy_names(__name__, _WHERE)
