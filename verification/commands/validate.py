@@ -205,8 +205,8 @@ def verdict(summary, calibrations):
 
 #: why a model is recommended, in words (:func:`recommendation`)
 RECOMMENDATION_REASONS = {
-    SPLIT: f"`{LI_CHEN}` for f_c <= 100 MPa, the strength its constant was fitted at, "
-           f"`{CONCRETE}` above; no constant fitted by cavex",
+    SPLIT: f"`{LI_CHEN}` at normal strength, f_c <= 100 MPa, `{CONCRETE}` above, each where "
+           "it is the better on the development shots; no constant fitted by cavex",
     CONCRETE: "uncalibrated, every constant published, none fitted to shots"}
 
 
