@@ -196,8 +196,8 @@ def split_depth(shot, concrete_depth=None):
     (:data:`SPLIT_STRENGTH`), the concrete model's above (``concrete_depth`` if it is known,
     else :func:`model_depth`; None stays None).
 
-    Li and Chen's ``S = 72 f_c^-1/2`` was fitted to shots into normal-strength concrete; above,
-    on the development shots, it over-predicts depths threefold (bias +1.10), the concrete
+    Li and Chen fitted ``S = 72 f_c^-1/2`` to published shots; above 100 MPa, on the
+    development shots, it over-predicts depths threefold (bias +1.10), the concrete
     model, whose strength is capped at ``7 f_c`` from its correlations, twofold (+0.72), and
     the choice holds with any one reference left out (docs/validation.md)."""
     if shot.fc <= SPLIT_STRENGTH:
