@@ -9,7 +9,13 @@ from cf_check import ALLOWED_UNITS, check_cf, check_quantify
 
 from cavex.analytic.penetration.tabulated import load_table
 from cavex.config import load_config
-from cavex.verification.fedata.batch import _dataset, _description, parse_sweep, sweep_cases
+from cavex.verification.fedata.batch import (
+    _dataset,
+    _description,
+    parse_sweep,
+    sweep_cases,
+    write_sweep,
+)
 from cavex.verification.fedata.table import analytic_table, write_table
 from cavex.verification.output.cf_metadata import UNITS, decode_flags, flag_attrs, flag_word
 
@@ -61,7 +67,7 @@ def sweep(tmp_path_factory):
     results = {case["id"]: _result(case) for case in cases[:-1]}
     ds = _dataset(_description(parsed, cases), results)
     path = tmp_path_factory.mktemp("sweep") / "results.nc"
-    write_table(ds, path, reproducible=False)
+    write_sweep(ds, path)
     loaded = xr.load_dataset(path, engine="scipy")
     assert loaded.identical(ds)
     return loaded

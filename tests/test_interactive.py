@@ -117,6 +117,20 @@ def test_the_paper_model_loads_no_compiled_kernel():
     assert (code, err, loaded) == (0, "", "[]")
 
 
+
+def test_table_writes_without_xarray(tmp_path):
+    """``cavex table`` writes its netCDF without xarray (cavex.verification.output.netcdf3),
+    so neither xarray nor dask nor pandas is loaded by it (their import and xarray's probes
+    for dask cost ~1 s of CPU: benchmarks/table.py); the file reads back through xarray."""
+    out = tmp_path / "t.nc"
+    code, _, loaded = _loaded_after(["table", "--velocities", "0", "500", "--depths", "0.1",
+                                     "0.2", "--workers", "1", "-o", str(out)])
+    assert (code, loaded) == (0, "['numba', 'scipy', 'skfem']")
+    import xarray as xr
+
+    with xr.open_dataset(out, engine="scipy") as table:
+        assert table["sigma_r"].shape == (2, 2) and not bool(table["failed"].any())
+
 def test_the_program_leaves_its_objects_to_the_exit():
     """The installed ``cavex`` runs :func:`console`: :func:`main`'s exit code, with what the
     command left frozen (``gc.freeze``), so that the interpreter's final collections do not

@@ -29,8 +29,9 @@ def run(args, target, projectile):
 
 def job(target, projectile, velocities=None, depths=None, out_path="results/table.nc", *,
         nu=None, workers=None, scheduler=None, numerics=None, progress=None):
-    """Build the table: ``{"dataset", "seconds", "output", "store"}``; nothing is written but
-    the case store.
+    """Build the table: ``{"table", "seconds", "output", "store", "grid"}`` (a
+    :class:`~cavex.verification.fedata.table.Table`: no xarray in this command); nothing is
+    written but the case store.
 
     The output location, the grid, ``workers`` and ``scheduler`` are checked before any FE
     work; finished cells are kept in ``<out>.cases/`` while the table is built, so that a killed
@@ -40,9 +41,9 @@ def job(target, projectile, velocities=None, depths=None, out_path="results/tabl
     from cavex.verification.fedata.table import (
         DEFAULT_DEPTHS,
         DEFAULT_VELOCITIES,
-        build_table,
         check_grid,
         grid_depths,
+        tabulate,
     )
     from cavex.verification.output.paths import check_output_file
 
@@ -56,9 +57,9 @@ def job(target, projectile, velocities=None, depths=None, out_path="results/tabl
     if sys.stderr.isatty():  # said before the run, as the progress bar (the text says it too)
         print(f"cavex table: {grid_line(grid)}", file=sys.stderr, flush=True)
     start = time.perf_counter()
-    ds = build_table(target, projectile, velocities, depths, nu=nu, numerics=numerics,
+    table = tabulate(target, projectile, velocities, depths, nu=nu, numerics=numerics,
                      scheduler=scheduler, workers=workers, progress=progress, store=store)
-    return {"dataset": ds, "seconds": time.perf_counter() - start, "output": out_path,
+    return {"table": table, "seconds": time.perf_counter() - start, "output": out_path,
             "store": store, "grid": grid}
 
 
@@ -86,7 +87,7 @@ def write_outputs(job):
     path written."""
     from cavex.verification.fedata.table import write_table
 
-    written = write_table(job["dataset"], job["output"])
+    written = write_table(job["table"], job["output"])
     shutil.rmtree(job["store"], ignore_errors=True)
     return written
 
@@ -95,15 +96,16 @@ def summary(job, path):
     """What ``cavex table --json`` prints: FE cases (the grid plus the first layer alone),
     the grid's axes, failed cells, the largest error estimate (None: none estimated), the wall
     time and the file written."""
-    ds = job["dataset"]
-    estimate = float(np.nanmax(ds["error_estimate"])) if np.any(
-        np.isfinite(ds["error_estimate"])) else None
-    return {"cases": ds.sizes["velocity"] * (ds.sizes["depth"] + 1),
-            "velocities_m_s": [float(x) for x in ds["velocity"].values],
-            "depths_m": [float(x) for x in ds["depth"].values],
+    table = job["table"]
+    estimates = table["error_estimate"]
+    estimate = float(np.nanmax(estimates)) if np.any(np.isfinite(estimates)) else None
+    velocities, depths = table["velocity"], table["depth"]
+    return {"cases": velocities.size * (depths.size + 1),
+            "velocities_m_s": [float(x) for x in velocities],
+            "depths_m": [float(x) for x in depths],
             "depths_requested_m": job["grid"]["requested"],
             "depths_added_m": job["grid"]["added"],
-            "failed": int(ds["failed"].sum()) + int(ds["failed_first_layer"].sum()),
+            "failed": int(table["failed"].sum()) + int(table["failed_first_layer"].sum()),
             "max_error_estimate": estimate, "wall_time_s": float(job["seconds"]),
             "output": str(path)}
 

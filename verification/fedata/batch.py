@@ -30,9 +30,9 @@ from cavex.verification.fedata.cases import (
     numerics_names,
 )
 from cavex.verification.fedata.runner import check_execution, check_store, read_store, run_cases
-from cavex.verification.fedata.table import MAX_DEPTH, write_table
+from cavex.verification.fedata.table import MAX_DEPTH
 from cavex.verification.output.cf_metadata import CONVENTIONS, boolean_attrs
-from cavex.verification.output.files import write_text_atomic
+from cavex.verification.output.files import replaced_atomically, write_text_atomic
 from cavex.verification.output.paths import check_output_dir
 
 SECTIONS = ("sweep", "target", "grid", "numerics", "materials")
@@ -410,10 +410,18 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
                         chunk_size=chunk_size)
     results = with_closed_forms(results, {case["id"]: case.problem for case in cases})
     dataset = _dataset(description, {r["id"]: r for r in results})
-    # exactly as computed: the file mirrors the case store (it loads back identical to
-    # load_sweep) and holds the wall times, so it is not a reproducible result file anyway
-    write_table(dataset, os.path.join(out_dir, RESULTS_FILE), reproducible=False)
+    write_sweep(dataset, os.path.join(out_dir, RESULTS_FILE))
     return dataset
+
+
+def write_sweep(dataset, path):
+    """Write the sweep's Dataset as netCDF-3, atomically, exactly as computed: the file
+    mirrors the case store (it loads back identical to :func:`load_sweep`) and holds the wall
+    times, so it is not a reproducible result file anyway. xarray's own writer: the sweep has
+    text variables, which :mod:`cavex.verification.output.netcdf3` does not encode."""
+    with replaced_atomically(path) as tmp:
+        dataset.to_netcdf(tmp, engine="scipy")
+    return path
 
 
 def load_sweep(out_dir):

@@ -24,10 +24,9 @@ from :func:`cavex.verification.fedata.cases.make_fe_cases`.
 """
 
 import json
-import os
+from dataclasses import dataclass
 from datetime import UTC, datetime
 from importlib import metadata
-from pathlib import Path
 
 import numpy as np
 
@@ -40,7 +39,8 @@ from cavex.problem import BOUNDARIES
 from cavex.verification.fedata.cases import CaseBuilder, fe_cases, make_fe_cases
 from cavex.verification.fedata.runner import run_cases
 from cavex.verification.output.cf_metadata import CONVENTIONS, UNITS, boolean_attrs, flag_attrs
-from cavex.verification.output.number_format import round_dataset
+from cavex.verification.output.netcdf3 import write_netcdf3
+from cavex.verification.output.number_format import round_variable
 
 DEFAULT_VELOCITIES = tuple(np.linspace(0.0, 1200.0, 13))
 DEFAULT_DEPTHS = tuple(np.round(np.linspace(0.10, 1.30, 31), 6))
@@ -106,10 +106,17 @@ def check_grid(velocities, depths):
 
 # --- building ---------------------------------------------------------------------------------
 
-def build_table(target, projectile, velocities, depths, *, nu=None, numerics=None,
-                error_target=DEFAULT_ERROR_TARGET, scheduler=None, workers=None, store=None,
-                progress=None, refine=SWITCH_REFINEMENT):
-    """FE cavity-wall stress on the ``(velocity, depth)`` grid, as an :class:`xarray.Dataset`.
+def build_table(target, projectile, velocities, depths, **options):
+    """:func:`tabulate`'s table as an :class:`xarray.Dataset` (xarray loaded while the FE
+    workers compute: :func:`load_table_dataset`)."""
+    return tabulate(target, projectile, velocities, depths, while_running=load_table_dataset,
+                    **options).dataset()
+
+
+def tabulate(target, projectile, velocities, depths, *, nu=None, numerics=None,
+             error_target=DEFAULT_ERROR_TARGET, scheduler=None, workers=None, store=None,
+             progress=None, refine=SWITCH_REFINEMENT, while_running=None):
+    """FE cavity-wall stress on the ``(velocity, depth)`` grid, as a :class:`Table`.
 
     Parameters
     ----------
@@ -129,10 +136,13 @@ def build_table(target, projectile, velocities, depths, *, nu=None, numerics=Non
         Passed to :func:`cavex.verification.fedata.runner.run_cases`.
     refine : sequence of float
         Depths ``L_s - f r`` added above each switch depth (see :func:`grid_depths`).
+    while_running : callable, optional
+        Passed to :func:`~cavex.verification.fedata.runner.run_cases`: what to load while the
+        FE workers compute (default :func:`load_table_writer`, what :func:`write_table` needs).
 
     Returns
     -------
-    xarray.Dataset
+    Table
         See the module docstring; failed cells are NaN with ``failed`` True and their reasons
         in the ``failures`` attribute (JSON).
     """
@@ -148,7 +158,8 @@ def build_table(target, projectile, velocities, depths, *, nu=None, numerics=Non
     # issue grid: ~0.4 s of CPU less per worker)
     reference = analytic_grid(target, projectile, v, d)
     results = run_cases(fe_cases, grid + first, store=store, scheduler=scheduler,
-                        workers=workers, progress=progress, while_running=load_table_writer)
+                        workers=workers, progress=progress,
+                        while_running=while_running or load_table_writer)
     cells = _cells(results[:len(grid)], grid, v, d)
     crater = _cells(results[len(grid):], first, v, [FIRST_LAYER_DEPTH])
     return assemble_table(target, projectile, v, d, cells, crater,
@@ -156,14 +167,18 @@ def build_table(target, projectile, velocities, depths, *, nu=None, numerics=Non
 
 
 def load_table_writer():
-    """Import xarray and what it loads on the first dataset and netCDF write (dask and
-    dask.distributed, probed for chunked arrays and schedulers) by writing a one-value
-    dataset to memory: a fixed cost of every table command (~0.4-0.8 s, more than the FE of a
-    100-case grid takes on two workers; benchmarks/table.py), which :func:`build_table` has
-    done while the FE workers compute (``run_cases(while_running=...)``)."""
+    """Import what :func:`write_table` writes with (:mod:`scipy.io`, which loads all its
+    formats: ~0.1-0.2 s of CPU), done by :func:`tabulate` while the FE workers compute
+    (``run_cases(while_running=...)``)."""
+    import scipy.io  # noqa: F401
+
+
+def load_table_dataset():
+    """Import xarray and what it loads on the first dataset (dask, probed for chunked arrays):
+    ~0.5 s of CPU, which :func:`build_table` spends while the FE workers compute."""
     import xarray as xr
 
-    xr.Dataset({"warm": ("n", np.zeros(1))}).to_netcdf(engine="scipy")
+    xr.Dataset({"warm": ("n", np.zeros(1))})
 
 
 def table_cases(target, projectile, velocities, depths, nu, numerics,
@@ -232,7 +247,8 @@ def analytic_table(target, projectile, velocities, depths, boundary="dynamic",
                           cells(first, [FIRST_LAYER_DEPTH],
                                 analytic_grid(first, projectile, v, [FIRST_LAYER_DEPTH],
                                               (boundary,))),
-                          json.dumps({"analytic": boundary, "switch": "cavity"}), reference)
+                          json.dumps({"analytic": boundary, "switch": "cavity"}),
+                          reference).dataset()
 
 
 def analytic_grid(target, projectile, velocities, depths, boundaries=BOUNDARIES):
@@ -250,8 +266,8 @@ def analytic_grid(target, projectile, velocities, depths, boundaries=BOUNDARIES)
 
 
 def assemble_table(target, projectile, velocities, depths, cells, crater, settings, reference):
-    """The Dataset from grid arrays (see :func:`build_table`); ``reference`` holds the closed
-    forms on the grid (:func:`analytic_grid`)."""
+    """The :class:`Table` from grid arrays (see :func:`tabulate`); ``reference`` holds the
+    closed forms on the grid (:func:`analytic_grid`)."""
     v, d = np.asarray(velocities, dtype=float), np.asarray(depths, dtype=float)
     grid = ("velocity", "depth")
     names = target.layer_names()
@@ -282,13 +298,58 @@ def assemble_table(target, projectile, velocities, depths, cells, crater, settin
     coords = {"velocity": ("velocity", v, _attrs(UNITS["velocity"],
                                                  "cavity expansion velocity V")),
               "depth": ("depth", d, _attrs(UNITS["length"], "nose-tip depth L"))}
-    import xarray as xr  # not at the top: see load_table_writer
+    attrs = {**table_attrs(target, projectile, settings), "layer_names": json.dumps(names),
+             "failures": json.dumps(cells["failures"] + crater["failures"])}
+    return Table(data, coords, attrs)
 
-    ds = xr.Dataset(data, coords=coords)
-    ds.attrs.update(table_attrs(target, projectile, settings))
-    ds.attrs["layer_names"] = json.dumps(names)
-    ds.attrs["failures"] = json.dumps(cells["failures"] + crater["failures"])
-    return ds
+
+@dataclass(frozen=True)
+class Table:
+    """A table as plain arrays: ``data`` and ``coords`` map names to ``(dims, values, attrs)``
+    (as in :class:`xarray.Dataset`'s constructor), ``attrs`` are the global attributes.
+
+    What :func:`tabulate` returns and :func:`write_table` writes, without xarray (whose
+    import and first dataset cost ~0.5-1 s of CPU a process, more than the FE of a small
+    grid); :meth:`dataset` gives the :class:`xarray.Dataset`. ``table[name]`` is the values
+    of a data variable or coordinate.
+    """
+
+    data: dict
+    coords: dict
+    attrs: dict
+    order: tuple = ()  # names in the order written (default: data variables, then coordinates)
+
+    def __getitem__(self, name):
+        return np.asarray((self.data.get(name) or self.coords[name])[1])
+
+    def variables(self):
+        """Data variables and coordinates in one mapping, in the order written: xarray
+        defines the file's dimensions in the order its variables first use them."""
+        merged = {**self.data, **self.coords}
+        return {name: merged[name] for name in self.order or merged}
+
+    def dataset(self):
+        import xarray as xr
+
+        return xr.Dataset(self.data, coords=self.coords, attrs=self.attrs)
+
+    @classmethod
+    def from_dataset(cls, ds):
+        def plain(variables):
+            return {str(name): (variable.dims, variable.values, dict(variable.attrs))
+                    for name, variable in variables.items()}
+
+        return cls(plain(ds.data_vars), plain(ds.coords), dict(ds.attrs),
+                   tuple(str(name) for name in ds.variables))
+
+    def reproducible(self):
+        """The table as :func:`write_table` writes it by default: float data variables
+        rounded to :func:`~cavex.verification.output.number_format.variable_digits`, without
+        the attributes of :data:`UNREPRODUCIBLE_ATTRS`."""
+        data = {name: (dims, round_variable(name, values), attrs)
+                for name, (dims, values, attrs) in self.data.items()}
+        return Table(data, self.coords, {k: v for k, v in self.attrs.items()
+                                         if k not in UNREPRODUCIBLE_ATTRS}, self.order)
 
 
 def cells_first(crater, key):
@@ -328,26 +389,18 @@ def _version(name):
 UNREPRODUCIBLE_ATTRS = ("created", "source")
 
 
-def write_table(ds, path, *, reproducible=True):
-    """Write ``ds`` as netCDF3 (scipy engine) atomically: a temporary file, then ``os.replace``.
+def write_table(table, path, *, reproducible=True):
+    """Write ``table`` (a :class:`Table` or an :class:`xarray.Dataset` of one) as netCDF-3,
+    atomically (:func:`cavex.verification.output.netcdf3.write_netcdf3`: the file xarray's
+    scipy engine writes, without importing xarray); returns ``path``.
 
-    ``reproducible`` (default): the same table computed on another CPU gives the same file;
-    float data variables are rounded to the significant digits the numerics support
-    (:func:`cavex.verification.output.number_format.round_dataset`) and the attributes in
-    :data:`UNREPRODUCIBLE_ATTRS` are left out. ``ds`` itself is not changed. False: ``ds`` is
-    written exactly as it is.
+    ``reproducible`` (default): the same table computed on another CPU gives the same file
+    (:meth:`Table.reproducible`: float data variables rounded to the significant digits the
+    numerics support, the attributes in :data:`UNREPRODUCIBLE_ATTRS` left out). ``table``
+    itself is not changed. False: written exactly as it is.
     """
-    path = Path(path)
-    if path.parent != Path(""):
-        path.parent.mkdir(parents=True, exist_ok=True)
+    table = table if isinstance(table, Table) else Table.from_dataset(table)
     if reproducible:
-        ds = round_dataset(ds)
-        ds.attrs = {k: v for k, v in ds.attrs.items() if k not in UNREPRODUCIBLE_ATTRS}
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        ds.to_netcdf(tmp, engine="scipy")
-        os.replace(tmp, path)
-    finally:
-        if tmp.exists():
-            tmp.unlink()
-    return path
+        table = table.reproducible()
+    return write_netcdf3(path, table.variables(), table.attrs)
+

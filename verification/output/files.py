@@ -36,17 +36,28 @@ def write_columns_csv(path, columns):
     return path
 
 
-def save_figure(fig, path, **savefig):
-    """Save a matplotlib figure atomically (a temporary file, then ``os.replace``: a killed run
-    never leaves a partial PNG) and close it; returns ``path``. A figure made without pyplot
-    (:func:`agg_figure`) has nothing to close: pyplot is then not imported for it."""
-    tmp = os.fspath(path) + f".{os.getpid()}.tmp.png"
+@contextmanager
+def replaced_atomically(path, suffix=".tmp"):
+    """Yield a temporary path beside ``path`` (``<path>.<pid><suffix>``) for the caller to
+    write; on success it is ``os.replace``-d onto ``path``, on an exception removed: a killed
+    or failed run never leaves a partial file."""
+    tmp = os.fspath(path) + f".{os.getpid()}{suffix}"
     try:
-        fig.savefig(tmp, **savefig)
+        yield tmp
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)
+
+
+def save_figure(fig, path, **savefig):
+    """Save a matplotlib figure atomically (:func:`replaced_atomically`) and close it; returns
+    ``path``. A figure made without pyplot (:func:`agg_figure`) has nothing to close: pyplot
+    is then not imported for it."""
+    try:
+        with replaced_atomically(path, ".tmp.png") as tmp:
+            fig.savefig(tmp, **savefig)
+    finally:
         if "matplotlib.pyplot" in sys.modules:
             sys.modules["matplotlib.pyplot"].close(fig)
     return path

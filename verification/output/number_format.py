@@ -174,13 +174,21 @@ def variable_digits(name):
                  if fnmatch.fnmatchcase(name, pattern)), DEFAULT_DIGITS)
 
 
+def round_variable(name, values):
+    """``values`` of the data variable ``name`` rounded to :func:`variable_digits` if they
+    are floats (else, or if the variable is :data:`KEPT`, unchanged)."""
+    values = np.asarray(values)
+    digits = variable_digits(str(name))
+    if values.dtype.kind != "f" or digits is KEPT:
+        return values
+    return round_rule(values, digits).astype(values.dtype)
+
+
 def round_dataset(ds):
-    """A copy of ``ds`` with every float data variable rounded to :func:`variable_digits`;
+    """A copy of ``ds`` with every float data variable rounded (:func:`round_variable`);
     coordinates and non-float variables unchanged, attributes kept."""
     out = ds.copy()
     for name, variable in ds.data_vars.items():
-        digits = variable_digits(str(name))
-        if variable.dtype.kind == "f" and digits is not KEPT:
-            rounded = round_rule(variable.values, digits)
-            out[name] = variable.copy(data=rounded.astype(variable.dtype))
+        if variable.dtype.kind == "f":
+            out[name] = variable.copy(data=round_variable(name, variable.values))
     return out
