@@ -16,7 +16,6 @@ reads one mesh, not a series; docs/fem.md "Output files" shows the reader);
 
 from pathlib import Path
 
-import meshio
 import numpy as np
 
 HISTORY = (("time", "s"), ("radius", "m"), ("wall_stress", "Pa"), ("plastic_radius", "m"))
@@ -41,6 +40,8 @@ def write_result(result, path, digits=HISTORY_DIGITS):
     if result.history is None or "snapshots" not in result.fields:
         raise ValueError("write_result needs a recorded result (expand_cavity, or "
                          "expand_cavities(..., record=True))")
+    import meshio  # only here: not a cost of every FE run (~0.05 s per process)
+
     path = Path(path).with_suffix(".xdmf")
     path.parent.mkdir(parents=True, exist_ok=True)
     snapshots = result.fields["snapshots"]

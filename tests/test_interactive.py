@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from cavex.config import default_config_text, load_config
-from cavex.verification.cli import announce_compiling, build_parser, main
+from cavex.verification.cli import GC_THRESHOLDS, announce_compiling, build_parser, main
 
 HEAVY = ("numba", "scipy", "matplotlib", "skfem", "xarray", "dask", "pandas")
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
@@ -132,17 +132,19 @@ def test_table_writes_without_xarray(tmp_path):
         assert table["sigma_r"].shape == (2, 2) and not bool(table["failed"].any())
 
 def test_the_program_leaves_its_objects_to_the_exit():
-    """The installed ``cavex`` runs :func:`console`: :func:`main`'s exit code, with what the
-    command left frozen (``gc.freeze``), so that the interpreter's final collections do not
-    walk numba's and scipy's objects (the time: benchmarks/commands.py)."""
+    """The installed ``cavex`` runs :func:`console`: :func:`main`'s exit code, with the
+    collector at ``GC_THRESHOLDS`` and what the command left frozen (``gc.freeze``), so that
+    the collections do not walk numba's and scipy's objects again and again (the time:
+    benchmarks/commands.py)."""
     scripts = entry_points(group="console_scripts", name="cavex")
     assert [s.value for s in scripts] == ["cavex.verification.cli:console"]
     probe = ("import gc, sys; from cavex.verification.cli import console; "
              "sys.argv[1:] = ['stress', '--velocity', '-1', '--depth', '0.3']; "
-             "code = console(); print(code, gc.get_freeze_count() > 0)")
+             "code = console(); print(code, gc.get_freeze_count() > 0, gc.get_threshold())")
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                           timeout=120, check=True)
-    assert done.stdout.split() == ["2", "True"]
+    code, frozen, thresholds = done.stdout.strip().split(" ", 2)
+    assert (code, frozen, thresholds) == ("2", "True", str(GC_THRESHOLDS))
 
 
 def test_python_dash_m_cavex_is_the_command_line():

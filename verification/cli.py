@@ -284,16 +284,27 @@ def main(argv=None):
     return 0
 
 
+#: The cyclic garbage collector's thresholds while the program runs: the youngest generation
+#: collected every 70 000 net container allocations instead of Python's 700. Importing numba,
+#: scipy and scikit-fem makes about a million long-lived objects, and at the default
+#: thresholds the collector walks them again and again while they are made: 0.15-0.2 s of
+#: CPU per command (benchmarks/commands.md). Cycles are still collected; 70 000 young objects
+#: are a few MB.
+GC_THRESHOLDS = (70_000, 10, 10)
+
+
 def console():
     """The ``cavex`` program (its console script and ``python -m cavex``): :func:`main`; returns
     its exit code.
 
-    What the command leaves lives until the process ends: it is moved out of the cyclic
+    The collector runs at :data:`GC_THRESHOLDS` (worker processes forked by a command inherit
+    them). What the command leaves lives until the process ends: it is moved out of the cyclic
     garbage collector's reach (``gc.freeze``) before the interpreter exits, whose final
     collections would walk every object numba and scipy made (0.3-0.5 s of a ``cavex penetrate
     --no-figures``, benchmarks/commands.md). Functions registered with ``atexit`` or
     ``weakref.finalize`` still run; the tests call :func:`main`, which leaves the collector
     as it is."""
+    gc.set_threshold(*GC_THRESHOLDS)
     code = main()
     gc.freeze()
     return code
