@@ -119,7 +119,7 @@ def test_the_paper_model_loads_no_compiled_kernel():
 
 
 def test_table_writes_without_xarray(tmp_path):
-    """``cavex table`` writes its netCDF without xarray (cavex.verification.output.netcdf3),
+    """``cavex table`` writes its netCDF without xarray (cavex.netcdf3),
     so neither xarray nor dask nor pandas is loaded by it (their import and xarray's probes
     for dask cost ~1 s of CPU: benchmarks/table.py); the file reads back through xarray."""
     out = tmp_path / "t.nc"
@@ -130,6 +130,20 @@ def test_table_writes_without_xarray(tmp_path):
 
     with xr.open_dataset(out, engine="scipy") as table:
         assert table["sigma_r"].shape == (2, 2) and not bool(table["failed"].any())
+
+@pytest.mark.parametrize("command", ["penetrate", "trajectory"])
+def test_a_table_is_read_without_xarray(command, tmp_path):
+    """``--resistance table`` reads the table without xarray (``read_table``): neither
+    xarray, dask nor pandas is loaded (their import and probes: ~0.5 s of CPU)."""
+    from cavex.verification.fedata.table import analytic_table, write_table
+
+    target, projectile = load_config()
+    table = write_table(analytic_table(target, projectile, [0.0, 400.0, 800.0, 1200.0],
+                                       [0.05, 0.5, 1.0, 1.5, 3.5]), tmp_path / "t.nc")
+    code, err, loaded = _loaded_after([command, "--resistance", "table", "--table", str(table),
+                                       "--no-figures", "--out", str(tmp_path / "out")])
+    assert (code, loaded) == (0, "['numba', 'scipy']"), err
+
 
 def test_the_program_leaves_its_objects_to_the_exit():
     """The installed ``cavex`` runs :func:`console`: :func:`main`'s exit code, with the

@@ -4,7 +4,7 @@ read from the source with ``ast``) runs down or sideways within its floor, never
 Floors, bottom to top (README "Where things are"):
 
 - ``core/`` (``cavex``): errors, input files, materials, config, the spherical problem, lazy
-  package names; imports no other part of cavex;
+  package names, the netCDF-3 format; imports no other part of cavex;
 - ``analytic/`` and ``fem/`` side by side, each on ``core/`` only; inside ``analytic/`` the
   closed forms (``cavity``, ``paper_model``, ``geometry``) sit below the penetration feature
   (``analytic/penetration/``);
@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 FOLDERS = {"core": "cavex", "analytic": "cavex.analytic", "fem": "cavex.fem",
            "verification": "cavex.verification"}
 CORE = ("cavex.__init__", "cavex.errors", "cavex.input_files", "cavex.materials", "cavex.config",
-        "cavex.problem", "cavex.lazy")
+        "cavex.problem", "cavex.lazy", "cavex.netcdf3")
 V = "cavex.verification."
 
 # module prefix -> prefixes it may import (the first matching rule, longest prefix first)

@@ -57,10 +57,10 @@ def make_resistance(target, projectile, resistance="derived", boundary=None,
         return PlainLawResistance(target, projectile, law_A, law_B)
     if resistance != "table":
         return ClosedFormResistance(target, projectile, resistance, boundary, epsilon=epsilon)
-    from cavex.analytic.penetration.tabulated import TabulatedResistance, load_table
+    from cavex.analytic.penetration.tabulated import TabulatedResistance, read_table
 
     require(table is not None, "table", "given with resistance 'table'", table)
-    data = table if hasattr(table, "attrs") else load_table(table)
+    data = table if hasattr(table, "attrs") else read_table(table)
     return TabulatedResistance(data, target, projectile)
 
 @runtime_checkable

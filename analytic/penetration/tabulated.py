@@ -25,7 +25,6 @@ cells, or queried outside its depth or velocity range, with a one-line
 import json
 
 import numpy as np
-import xarray as xr
 from scipy.interpolate import PchipInterpolator
 
 from cavex.analytic.geometry import switch_depths, wall_layer
@@ -34,6 +33,7 @@ from cavex.analytic.penetration.nose import nose_rule
 from cavex.analytic.penetration.resistance import ClosedFormResistance, Resistance
 from cavex.config import fingerprint, fingerprint_data
 from cavex.errors import CavexInputError, require_choice
+from cavex.netcdf3 import read_netcdf3
 
 METHODS = ("pchip", "linear")
 NODE_TOLERANCE = 1e-6  # m: a switch node this close to a segment end belongs to both segments
@@ -45,8 +45,9 @@ class TabulatedResistance(Resistance):
 
     Parameters
     ----------
-    table : xarray.Dataset
-        From :func:`cavex.verification.fedata.table.build_table` or ``load_table``.
+    table : xarray.Dataset or cavex.netcdf3.PlainDataset
+        From :func:`cavex.verification.fedata.table.build_table` (``tabulate``),
+        :func:`load_table` or :func:`read_table`.
     target, projectile : Target, Projectile
         Must be those the table was built for (checked by fingerprint).
     depth_method, velocity_method : {"pchip", "linear"}
@@ -62,14 +63,14 @@ class TabulatedResistance(Resistance):
         check_fingerprint(table, target, projectile, self.name)
         self.target, self.projectile = target, projectile
         self.velocity_method = velocity_method
-        self.velocities = np.asarray(table["velocity"].values, dtype=float)
+        self.velocities = np.asarray(table["velocity"], dtype=float)
         self._v2 = self.velocities ** 2
-        self.depths = np.asarray(table["depth"].values, dtype=float)
+        self.depths = np.asarray(table["depth"], dtype=float)
         _check_table(table, self.name, switch_depths(target, projectile))
-        sigma = np.asarray(table["sigma_r"].values, dtype=float)  # (velocity, depth)
+        sigma = np.asarray(table["sigma_r"], dtype=float)  # (velocity, depth)
         self._bounds, self._pieces = _depth_pieces(self.depths, sigma.T, target, projectile,
                                                    depth_method)
-        self._first = np.asarray(table["sigma_r_first_layer"].values, dtype=float)
+        self._first = np.asarray(table["sigma_r_first_layer"], dtype=float)
         self._cosines, self._weights = nose_rule(projectile)
         last = switch_depths(target, projectile)
         self._last_layer_alone = not last or self.depths[-1] >= last[-1]
@@ -199,7 +200,7 @@ def _linear(x, y):
 
 def _check_table(table, name, switches):
     """Refuse tables that cannot be interpolated honestly."""
-    v, d = table["velocity"].values, table["depth"].values
+    v, d = np.asarray(table["velocity"]), np.asarray(table["depth"])
     if not (np.all(np.isfinite(v)) and np.all(np.isfinite(d))):
         raise CavexInputError(f"table '{name}' has non-finite velocity or depth coordinates")
     if v.size < 2 or v[0] != 0.0 or np.any(np.diff(v) <= 0):
@@ -213,9 +214,9 @@ def _check_table(table, name, switches):
         raise CavexInputError(f"table '{name}' lacks the wall-layer switch depth(s) "
                               f"{', '.join(f'{s:g}' for s in missing)} m; rebuild it with "
                               "build_table, which inserts them")
-    failed = int(table["failed"].sum()) + int(table["failed_first_layer"].sum())
-    values = np.concatenate([np.ravel(table["sigma_r"].values),
-                             np.ravel(table["sigma_r_first_layer"].values)])
+    failed = int(np.sum(table["failed"])) + int(np.sum(table["failed_first_layer"]))
+    values = np.concatenate([np.ravel(table["sigma_r"]),
+                             np.ravel(table["sigma_r_first_layer"])])
     missing = int(np.sum(~np.isfinite(values)))
     if failed or missing:
         raise CavexInputError(f"table '{name}' has {failed} failed FE cell(s) and {missing} "
@@ -256,7 +257,7 @@ def _differences(table, given, where=""):
 
 def penetrate_with_table(target, projectile, table_path, crater="nose-base"):
     """Trajectory through ``target`` with the FE-tabulated resistance read from ``table_path``."""
-    resistance = TabulatedResistance(load_table(table_path), target, projectile)
+    resistance = TabulatedResistance(read_table(table_path), target, projectile)
     return penetrate(target, projectile, resistance, crater=crater)
 
 
@@ -285,7 +286,7 @@ def compare_trajectories(target, projectile, table, crater="nose-base"):
 def comparison_runs(target, projectile, table, crater="nose-base"):
     """The trajectories :func:`compare_trajectories` summarises: ``{name: Trajectory}``."""
     if not hasattr(table, "attrs"):
-        table = load_table(table)
+        table = read_table(table)
     models = {
         "derived-quasi-static": ClosedFormResistance(target, projectile, "derived",
                                                      "quasi-static"),
@@ -310,18 +311,25 @@ def trajectory_summary(trajectory, target):
             "final_time_s": float(trajectory.t[-1]), "at_H1": at_h1}
 
 
-def load_table(path):
-    """Read a table written by :func:`write_table` (fully into memory; the file is closed)."""
+def read_table(path):
+    """Read a table written by ``write_table`` as a :class:`cavex.netcdf3.PlainDataset`
+    (fully into memory; the file is closed; no xarray), with its path in the attribute
+    ``source``; a file that is not a cavex table is refused (:class:`CavexInputError`)."""
     try:
-        ds = xr.load_dataset(path, engine="scipy")
+        table = read_netcdf3(path)
     except Exception as exc:  # a truncated or foreign file fails in many ways inside the reader
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise CavexInputError(f"table '{path}' cannot be read as a netCDF3 table: "
                               f"{reason}") from None
-    missing = [k for k in ("sigma_r", "sigma_r_first_layer", "wall_layer", "failed",
-                           "failed_first_layer") if k not in ds]
-    if missing or "fingerprint" not in ds.attrs:
+    missing = [k for k in ("velocity", "depth", "sigma_r", "sigma_r_first_layer",
+                           "wall_layer", "failed", "failed_first_layer") if k not in table]
+    if missing or "fingerprint" not in table.attrs:
         raise CavexInputError(f"'{path}' is not a cavex table (missing "
                               f"{', '.join(missing) or 'fingerprint attribute'})")
-    ds.attrs["source"] = str(path)
-    return ds
+    table.attrs["source"] = str(path)
+    return table
+
+
+def load_table(path):
+    """:func:`read_table` as an :class:`xarray.Dataset`."""
+    return read_table(path).dataset()

@@ -64,8 +64,8 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
                "tangency_psi": tangency_psi, "entry_crater": entry_crater,
                "crater": crater or "nose-base"}
     if table is not None:
-        from cavex.analytic.penetration.tabulated import load_table
-        options["table"] = load_table(table)
+        from cavex.analytic.penetration.tabulated import read_table
+        options["table"] = read_table(table)
     with _steps("runway", progress) as step:
         runs = {"runway": fly(target, projectile, strike, resistance, progress=step, **options)}
     check_answered("runway", runs["runway"])

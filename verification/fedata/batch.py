@@ -418,7 +418,7 @@ def write_sweep(dataset, path):
     """Write the sweep's Dataset as netCDF-3, atomically, exactly as computed: the file
     mirrors the case store (it loads back identical to :func:`load_sweep`) and holds the wall
     times, so it is not a reproducible result file anyway. xarray's own writer: the sweep has
-    text variables, which :mod:`cavex.verification.output.netcdf3` does not encode."""
+    text variables, which :mod:`cavex.netcdf3` does not encode."""
     with replaced_atomically(path) as tmp:
         dataset.to_netcdf(tmp, engine="scipy")
     return path

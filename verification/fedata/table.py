@@ -2,7 +2,9 @@
 
 The table holds the FE cavity-wall radial stress of the spherical problem at nose-tip depth
 ``L`` (:func:`cavex.analytic.geometry.spherical_problem`, ``switch="cavity"``) for expansion
-velocity ``V``, on a grid, as an :class:`xarray.Dataset`:
+velocity ``V``, on a grid, as a :class:`cavex.netcdf3.PlainDataset` (:func:`tabulate`, what
+``cavex table`` writes without importing xarray) or an :class:`xarray.Dataset`
+(:func:`build_table`), with:
 
 - coordinates ``velocity`` (m/s; must start at 0, see ``docs/verification.md``) and ``depth``
   (nose-tip depth, m); the depth grid always contains the wall-layer switch depths
@@ -24,9 +26,9 @@ from :func:`cavex.verification.fedata.cases.make_fe_cases`.
 """
 
 import json
-from dataclasses import dataclass
 from datetime import UTC, datetime
 from importlib import metadata
+from pathlib import Path
 
 import numpy as np
 
@@ -35,11 +37,12 @@ from cavex.config import config_text, fingerprint, fingerprint_data, projectile_
 from cavex.errors import require, require_choice
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
 from cavex.materials import MAX_VELOCITY
+from cavex.netcdf3 import PlainDataset, write_netcdf3
 from cavex.problem import BOUNDARIES
 from cavex.verification.fedata.cases import CaseBuilder, fe_cases, make_fe_cases
 from cavex.verification.fedata.runner import run_cases
 from cavex.verification.output.cf_metadata import CONVENTIONS, UNITS, boolean_attrs, flag_attrs
-from cavex.verification.output.netcdf3 import write_netcdf3
+from cavex.verification.output.files import replaced_atomically
 from cavex.verification.output.number_format import round_variable
 
 DEFAULT_VELOCITIES = tuple(np.linspace(0.0, 1200.0, 13))
@@ -116,7 +119,8 @@ def build_table(target, projectile, velocities, depths, **options):
 def tabulate(target, projectile, velocities, depths, *, nu=None, numerics=None,
              error_target=DEFAULT_ERROR_TARGET, scheduler=None, workers=None, store=None,
              progress=None, refine=SWITCH_REFINEMENT, while_running=None):
-    """FE cavity-wall stress on the ``(velocity, depth)`` grid, as a :class:`Table`.
+    """FE cavity-wall stress on the ``(velocity, depth)`` grid, as a
+    :class:`cavex.netcdf3.PlainDataset` (plain arrays: no xarray).
 
     Parameters
     ----------
@@ -142,7 +146,7 @@ def tabulate(target, projectile, velocities, depths, *, nu=None, numerics=None,
 
     Returns
     -------
-    Table
+    cavex.netcdf3.PlainDataset
         See the module docstring; failed cells are NaN with ``failed`` True and their reasons
         in the ``failures`` attribute (JSON).
     """
@@ -266,8 +270,8 @@ def analytic_grid(target, projectile, velocities, depths, boundaries=BOUNDARIES)
 
 
 def assemble_table(target, projectile, velocities, depths, cells, crater, settings, reference):
-    """The :class:`Table` from grid arrays (see :func:`tabulate`); ``reference`` holds the
-    closed forms on the grid (:func:`analytic_grid`)."""
+    """The table (a :class:`cavex.netcdf3.PlainDataset`) from grid arrays (see
+    :func:`tabulate`); ``reference`` holds the closed forms on the grid (:func:`analytic_grid`)."""
     v, d = np.asarray(velocities, dtype=float), np.asarray(depths, dtype=float)
     grid = ("velocity", "depth")
     names = target.layer_names()
@@ -300,56 +304,7 @@ def assemble_table(target, projectile, velocities, depths, cells, crater, settin
               "depth": ("depth", d, _attrs(UNITS["length"], "nose-tip depth L"))}
     attrs = {**table_attrs(target, projectile, settings), "layer_names": json.dumps(names),
              "failures": json.dumps(cells["failures"] + crater["failures"])}
-    return Table(data, coords, attrs)
-
-
-@dataclass(frozen=True)
-class Table:
-    """A table as plain arrays: ``data`` and ``coords`` map names to ``(dims, values, attrs)``
-    (as in :class:`xarray.Dataset`'s constructor), ``attrs`` are the global attributes.
-
-    What :func:`tabulate` returns and :func:`write_table` writes, without xarray (whose
-    import and first dataset cost ~0.5-1 s of CPU a process, more than the FE of a small
-    grid); :meth:`dataset` gives the :class:`xarray.Dataset`. ``table[name]`` is the values
-    of a data variable or coordinate.
-    """
-
-    data: dict
-    coords: dict
-    attrs: dict
-    order: tuple = ()  # names in the order written (default: data variables, then coordinates)
-
-    def __getitem__(self, name):
-        return np.asarray((self.data.get(name) or self.coords[name])[1])
-
-    def variables(self):
-        """Data variables and coordinates in one mapping, in the order written: xarray
-        defines the file's dimensions in the order its variables first use them."""
-        merged = {**self.data, **self.coords}
-        return {name: merged[name] for name in self.order or merged}
-
-    def dataset(self):
-        import xarray as xr
-
-        return xr.Dataset(self.data, coords=self.coords, attrs=self.attrs)
-
-    @classmethod
-    def from_dataset(cls, ds):
-        def plain(variables):
-            return {str(name): (variable.dims, variable.values, dict(variable.attrs))
-                    for name, variable in variables.items()}
-
-        return cls(plain(ds.data_vars), plain(ds.coords), dict(ds.attrs),
-                   tuple(str(name) for name in ds.variables))
-
-    def reproducible(self):
-        """The table as :func:`write_table` writes it by default: float data variables
-        rounded to :func:`~cavex.verification.output.number_format.variable_digits`, without
-        the attributes of :data:`UNREPRODUCIBLE_ATTRS`."""
-        data = {name: (dims, round_variable(name, values), attrs)
-                for name, (dims, values, attrs) in self.data.items()}
-        return Table(data, self.coords, {k: v for k, v in self.attrs.items()
-                                         if k not in UNREPRODUCIBLE_ATTRS}, self.order)
+    return PlainDataset(data, coords, attrs)
 
 
 def cells_first(crater, key):
@@ -389,18 +344,34 @@ def _version(name):
 UNREPRODUCIBLE_ATTRS = ("created", "source")
 
 
+def reproducible_table(table):
+    """``table`` (a :class:`~cavex.netcdf3.PlainDataset`) as :func:`write_table` writes it by
+    default: float data variables rounded to
+    :func:`~cavex.verification.output.number_format.variable_digits`, without the attributes
+    of :data:`UNREPRODUCIBLE_ATTRS`."""
+    data = {name: (dims, round_variable(name, values), attrs)
+            for name, (dims, values, attrs) in table.data.items()}
+    return PlainDataset(data, table.coords, {k: v for k, v in table.attrs.items()
+                                             if k not in UNREPRODUCIBLE_ATTRS}, table.order)
+
+
 def write_table(table, path, *, reproducible=True):
-    """Write ``table`` (a :class:`Table` or an :class:`xarray.Dataset` of one) as netCDF-3,
-    atomically (:func:`cavex.verification.output.netcdf3.write_netcdf3`: the file xarray's
-    scipy engine writes, without importing xarray); returns ``path``.
+    """Write ``table`` (a :class:`~cavex.netcdf3.PlainDataset` or an :class:`xarray.Dataset`)
+    as netCDF-3 (:func:`cavex.netcdf3.write_netcdf3`: the file xarray's scipy engine writes,
+    without importing xarray), atomically (a temporary file, then ``os.replace``); returns
+    ``path``.
 
     ``reproducible`` (default): the same table computed on another CPU gives the same file
-    (:meth:`Table.reproducible`: float data variables rounded to the significant digits the
+    (:func:`reproducible_table`: float data variables rounded to the significant digits the
     numerics support, the attributes in :data:`UNREPRODUCIBLE_ATTRS` left out). ``table``
     itself is not changed. False: written exactly as it is.
     """
-    table = table if isinstance(table, Table) else Table.from_dataset(table)
+    table = table if isinstance(table, PlainDataset) else PlainDataset.from_dataset(table)
     if reproducible:
-        table = table.reproducible()
-    return write_netcdf3(path, table.variables(), table.attrs)
-
+        table = reproducible_table(table)
+    path = Path(path)
+    if path.parent != Path(""):
+        path.parent.mkdir(parents=True, exist_ok=True)
+    with replaced_atomically(path) as tmp:
+        write_netcdf3(tmp, table.variables(), table.attrs)
+    return path
