@@ -35,19 +35,21 @@ def _added(default, **options):
 
 def test_added_turn_converges_under_the_held_contact(default):
     """Issue 20 item 4's 3 %: the velocity ramp's added turn moves 7.7 % between 0.01 and
-    0.003 m/s (the held couple creeps at a fraction of the ramp). Under the held contact,
-    refined by about 3 as the ramp was: 0.3486, 0.3424, 0.3333 deg at 3e-6, 1e-6, 3e-7 m
-    (rtol 1e-3; 0.3316 at 1e-7; at rtol 1e-4 0.3542, 0.3365, 0.3290, 0.3266), monotone, the
-    gap between 1e-6 and 3e-7 m 2.7 % (2.2 % at rtol 1e-4): within the 3 % asked. Its
-    limit, about 0.326-0.331 deg, and the ramp's (0.328 deg at 0.001 m/s, still falling:
-    docs) agree within 0.01 deg. The bound on the ramp comparison: the hold's value at
-    3e-7 m within 0.01 deg of the ramp's at 0.001 m/s (measured 0.005)."""
-    added = {hold: _added(default, contact_hold=hold) for hold in (3e-6, 1e-6, 3e-7)}
+    0.003 m/s (the held couple creeps at a fraction of the ramp). Under the held contact
+    refined by about 3, as the ramp was (rtol 1e-4, where the integrator's own spread is
+    below the gaps: at rtol 1e-3 the same depths move by up to 0.004 deg between two
+    versions of the round-off guard): 0.3543, 0.3365, 0.3290 deg at 3e-6, 1e-6, 3e-7 m,
+    monotone, the gap between 1e-6 and 3e-7 m 2.2 %: within the 3 % asked (bound: 3 %).
+    The limit, about 0.325 deg, and the velocity ramp's (0.332 deg at 0.001 m/s, 0.328 at
+    3e-4 m/s, about 0.326 in the limit: docs/oblique.md) agree; bound: the held value at
+    3e-7 m within 0.01 deg of the ramp's at 0.001 m/s (measured 0.003)."""
+    options = {"rtol": 1e-4, "atol": 1e-7}
+    added = {hold: _added(default, contact_hold=hold, **options) for hold in (3e-6, 1e-6, 3e-7)}
     print("added turn (deg) by hold depth:", added)
     values = list(added.values())
     assert np.all(np.diff(values) < 0)  # monotone
     assert abs(added[3e-7] / added[1e-6] - 1.0) < 0.03
-    ramp = _added(default, contact_ramp=0.001)
+    ramp = _added(default, contact_ramp=0.001, **options)
     print("ramp 0.001 m/s:", ramp)
     assert abs(added[3e-7] - ramp) < 0.01
 
@@ -80,21 +82,22 @@ def _work_mismatch(result):
 
 def test_held_work_is_the_kinetic_energy_lost(default):
     """Force, moment and power of the held kernel agree: the work of the surface forces
-    equals the kinetic energy lost (friction 0.1, spin, attack out of plane, concrete alone,
-    plain law; and the debonded runway), to the integrator's global error. Bounds: those of
-    the velocity ramp at rtol 1e-5 (tests/test_oblique.py, tests/test_interfaces.py: 5e-4);
-    measured: printed."""
+    equals the kinetic energy lost, to the integrator's global error: friction 0.1, spin,
+    attack out of plane, concrete alone, plain law, at rtol 1e-3 and 1e-5 (measured 3.4e-5,
+    4.9e-5; 5.8e-5 at 1e-4: flat, where the ramp's falls from 6.5e-4 to 5.6e-5,
+    tests/test_oblique.py), and the debonded runway at rtol 1e-3 (the zones open; 5.6e-7).
+    Bound: 4 x the largest measured, 2e-4."""
     target, projectile = default
     strike = Strike(700.0, 30.0, attack=3.0, attack_plane=40.0, spin=500.0)
-    friction = fly(target.single(0), replace(projectile, mu=0.1), strike, "law", law_A=2e8,
-                   law_B=2500.0, contact_hold=1e-6, rtol=1e-5, atol=1e-8)
-    debonded = fly(target.with_interfaces("debonded"), projectile, strike, contact_hold=1e-6,
-                   rtol=1e-5, atol=1e-8)
-    mismatch = [_work_mismatch(friction), _work_mismatch(debonded)]
-    print("work-energy mismatch (friction, debonded):", mismatch)
-    assert abs(friction.history["yaw_deg"]).max() > 0.1  # a genuinely 3-D shot
+    runs = [fly(target.single(0), replace(projectile, mu=0.1), strike, "law", law_A=2e8,
+                law_B=2500.0, contact_hold=1e-6, rtol=rtol, atol=1e-3 * rtol)
+            for rtol in (1e-3, 1e-5)]
+    debonded = fly(target.with_interfaces("debonded"), projectile, strike, contact_hold=1e-6)
+    mismatch = [_work_mismatch(r) for r in (*runs, debonded)]
+    print("work-energy mismatch (friction 1e-3, 1e-5; debonded):", mismatch)
+    assert abs(runs[0].history["yaw_deg"]).max() > 0.1  # a genuinely 3-D shot
     assert len(debonded.model.opened) >= 2
-    assert abs(mismatch[0]) < 5e-4 and abs(mismatch[1]) < 5e-4
+    assert all(abs(m) < 2e-4 for m in mismatch)
 
 
 def test_held_contact_carries_its_load_at_rest(default):

@@ -156,7 +156,7 @@ TRAJECTORY_BAD = [  # arguments, the parameter or option the one line names
     (["--spin", "-48001", "--velocity", "600"], "spin"),
     (["--contact-ramp", "100"], "contact_ramp"),
     (["--contact-ramp", "0.031"], "contact_ramp"),
-    (["--contact-hold", "2.9e-7"], "contact_hold"),
+    (["--contact-hold", "9e-8"], "contact_hold"),
     (["--contact-hold", "1.1e-5"], "contact_hold"),
     (["--contact-hold", "1e-6", "--contact-ramp", "0.01"], "contact_hold"),
     (["--contact-hold", "1e-6", "--tangency-psi", "3"], "contact_hold"),

@@ -202,7 +202,7 @@ def _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, scale, are
                damping, extra):
     """Element ``i`` under the held contact (module docstring, "Held contact"). Its elastic
     fraction ``phi = y[14 + i]`` moves at ``V_n / hold`` within ``[0, 1]`` (not at all where
-    ``V_n`` pushes out of them, or within the round-off guard ``|V_n| <= scale``): an elastic
+    ``V_n`` pushes out of them; ``|V_n|`` less the round-off guard ``scale``): an elastic
     spring of ``hold`` up to the element's capacity, then plastic flow (the wall is cut).
     With the dashpot of time constant ``hold_time`` the load is
     ``A_i w sigma_n(z, n_3, max(V_n, 0)) clip(phi + hold_time dphi/dt, 0, 1)``. Writes the
@@ -214,7 +214,7 @@ def _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, scale, are
     phi = y[14 + i]
     rate = 0.0
     if abs(vn) > scale and not ((phi >= 1.0 and vn > 0.0) or (phi <= 0.0 and vn < 0.0)):
-        rate = vn / hold
+        rate = (vn - scale if vn > 0.0 else vn + scale) / hold  # continuous at the guard
     extra[0] = rate
     raw = phi + hold_time * rate
     fraction = min(max(raw, 0.0), 1.0)

@@ -36,11 +36,11 @@ MIN_CONTACT_RAMP = 0.001
 # convergence table: +1.3e-4 at 0.03, +1.0e-3 at 0.1, +1.7e-3 at 0.3; 100 m/s gave 3x the depth;
 # tests/test_edges.py measures 0.03 against 0.001)
 MAX_CONTACT_RAMP = 0.03
-# m: the held contact's depth (--contact-hold, docs/oblique.md "Held contact"): from 1e-5 down
-# the added turn at the paper's debonded interface converges (0.399, 0.354, 0.337, 0.329,
-# 0.327 deg at 1e-5, 3e-6, 1e-6, 3e-7, 1e-7 m, rtol 1e-4); below 3e-7 a run's steps can jump
-# (46 564 for the bonded 600 m/s, 20 deg shot at 1e-7 against 809 at 3e-7)
-MIN_CONTACT_HOLD, MAX_CONTACT_HOLD = 3e-7, 1e-5
+# m: the held contact's depth (--contact-hold, docs/oblique.md "Held contact"): over it the
+# added turn at the paper's debonded interface converges (0.354, 0.337, 0.329, 0.327 deg at
+# 3e-6, 1e-6, 3e-7, 1e-7 m, rtol 1e-4; 0.387 deg at 1e-5, rtol 1e-3); its steps measured
+# there, not below
+MIN_CONTACT_HOLD, MAX_CONTACT_HOLD = 1e-7, 1e-5
 # integrator steps per run before it is stopped as a numerical failure: measured shots take
 # 300-7 000 (docs/oblique.md); the largest spin once accepted took 599 113 steps (272 s)
 MAX_STEPS = 100_000
