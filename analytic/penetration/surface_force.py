@@ -40,6 +40,14 @@ a stiff damper). With ``u = v - [p]_x omega_t`` its contribution to
 
 without the slow parts (``d sigma_n / d V_n``, the turning of ``t``, the gyroscopic term).
 
+Held contact (``hold`` = ``delta_r`` > 0, docs/oblique.md "Held contact"): instead of the
+ramp, each element carries an elastic fraction ``phi_i = y[14 + i]`` in ``[0, 1]`` with
+``dphi_i/dt = V_n / delta_r`` (``|V_n|`` less the round-off guard; 0 where ``V_n`` pushes it
+out of ``[0, 1]``: plastic beyond 1) and the load
+``P = A_i w sigma_n(z, n_3, max(V_n, 0)) clip(phi_i + tau dphi_i/dt, 0, 1)`` (``tau`` =
+``hold_time``, a dashpot in parallel): a held element keeps its load at ``V_n = 0``. The
+Jacobian rows of the elastic elements (:func:`derivative`) replace the damping block.
+
 Motion:
 
 .. math:: \dot{\mathbf x} = \mathbf v, \quad
