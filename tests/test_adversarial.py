@@ -83,7 +83,7 @@ for value in BAD_NUMBERS + ["-0.5"]:
     case(f"table-depths-{value or 'empty'}", ["table", "--velocities", "100", "--depths", value,
                                               "-o", "{tmp}/t.nc"], 2)
 for option in ("--velocity", "--obliquity", "--attack", "--attack-plane", "--spin",
-               "--contact-ramp"):
+               "--contact-ramp", "--contact-hold"):
     for value in BAD_NUMBERS:
         case(f"trajectory{option}-{value or 'empty'}",
              ["trajectory", option, value, "--no-figures", "--out", "{tmp}/o"], 2)
@@ -91,7 +91,8 @@ for option, value in (("--velocity", "0"), ("--velocity", "-600"), ("--velocity"
                       ("--obliquity", "90"), ("--obliquity", "-90"), ("--attack", "-1"),
                       ("--attack", "90"), ("--spin", "1e6"), ("--contact-ramp", "0"),
                       ("--contact-ramp", "0.0009"), ("--contact-ramp", "0.05"),
-                      ("--contact-ramp", "100")):
+                      ("--contact-ramp", "100"), ("--contact-hold", "0"),
+                      ("--contact-hold", "-1e-6"), ("--contact-hold", "1e-3")):
     case(f"trajectory{option}-{value}", ["trajectory", option, value, "--no-figures",
                                          "--out", "{tmp}/o"], 2)
 for option in ("--law-A", "--law-B"):

@@ -58,7 +58,7 @@ def _element_forces(y, surface, count):
     out = np.empty((count, 6))
     for i in range(count):
         one = i + 1
-        force, moment, _, status, _, _ = surface_loads(
+        force, moment, _, status, _, _, _ = surface_loads(
             y, points[i:one], normals[i:one], areas[i:one], sizes[i:one],
             np.zeros_like(partners[:1]), length, *surface[6:9], nose[i:one], *surface[10:])
         assert status == 0

@@ -146,6 +146,11 @@ def build_parser():
     trajectory.add_argument("--contact-ramp", dest="contact_ramp", type=float, default=None,
                             help="contact regularisation: the stress rises linearly over "
                             "0 < V_n < this (m/s; default 0.01; docs/oblique.md)")
+    trajectory.add_argument("--contact-hold", dest="contact_hold", type=float, default=None,
+                            help="held contact instead of the ramp: each element's load rises "
+                            "over this push into its wall, then it cuts (m in [1e-7, 1e-5]; "
+                            "not with --contact-ramp or --tangency-psi; default: off, the "
+                            "velocity ramp; docs/oblique.md)")
     trajectory.add_argument("--tunnel-wall", dest="tunnel_wall", type=float, default=None,
                             help="factor in [0, 1] on the shank's load in every layer (a "
                             "sensitivity setting, uncalibrated; default: each layer's "

@@ -63,6 +63,9 @@ STOPPED = "stopped"
 # it a shank sliding along the tunnel wall chatters (V_n changes sign every step) and the
 # adaptive integrator stalls. Its effect is measured in docs/oblique.md.
 CONTACT_RAMP = 0.01
+# the held contact's dashpot time constant (s): its spring of stiffness capacity / hold would
+# ring undamped (docs/oblique.md "Held contact")
+HOLD_TIME = 1e-4
 
 
 # ------------------------------------------------------------------------------------------
@@ -131,19 +134,22 @@ class Segment:
         h = self.t[k + 1] - self.t[k]
         s = (t - self.t[k]) / h if h > 0.0 else 1.0
         return hermite(s, h, self.y[:, k], self.f[:, k], self.y[:, k + 1], self.f[:, k + 1],
-                       np.empty(14))
+                       np.empty(self.y.shape[0]))
 
 
 class ObliqueModel:
     """Rigid projectile + stress law + layered target: right-hand side, events, integrator.
 
     State ``y``: centre of mass ``x`` (3), quaternion ``q`` (4, body to target), velocity ``v``
-    (3), body-frame angular velocity ``omega`` (3), work of the surface forces ``W`` (1).
+    (3), body-frame angular velocity ``omega`` (3), work of the surface forces ``W`` (1); with
+    the held contact (``contact_hold`` > 0, m) each element's load fraction ``phi_i`` after
+    them (docs/oblique.md "Held contact").
     """
 
     def __init__(self, target, projectile, law, *, body=None, bottom=None, rtol=RTOL,
                  atol=ATOL, method=METHOD, contact_ramp=None, crater="nose-base",
-                 tangency_psi=0.0, entry_crater=False):
+                 tangency_psi=0.0, entry_crater=False, contact_hold=0.0,
+                 hold_time=None):
         self.target, self.projectile, self.law = target, projectile, law
         self.body = body or build_body(projectile)
         self.bottom = bottom
@@ -152,6 +158,15 @@ class ObliqueModel:
         require(is_finite_number(contact_ramp) and 0.0 <= contact_ramp <= 100.0,
                 "contact_ramp", "in [0, 100] m/s", contact_ramp)
         self.contact_ramp = float(contact_ramp)
+        require(is_finite_number(contact_hold) and 0.0 <= contact_hold <= 0.01,
+                "contact_hold", "in [0, 0.01] m (0: the velocity ramp)", contact_hold)
+        self.contact_hold = float(contact_hold)
+        hold_time = HOLD_TIME if hold_time is None else hold_time
+        require(is_finite_number(hold_time) and 0.0 <= hold_time <= 1e-3, "hold_time",
+                "in [0, 1e-3] s", hold_time)
+        self.hold_time = float(hold_time)
+        require(not (self.contact_hold and tangency_psi), "tangency_psi",
+                "0 with the held contact (the attenuation is a velocity ramp)", tangency_psi)
         self.mu = float(projectile.mu)
         require(is_finite_number(tangency_psi) and 0.0 <= tangency_psi <= 30.0,
                 "tangency_psi", "in [0, 30] degrees", tangency_psi)
@@ -190,14 +205,14 @@ class ObliqueModel:
         self._surface = (b.points, b.normals, b.areas, b.sizes, b.partners, b.length, self.mu,
                          self.contact_ramp, np.inf if self.bottom is None else float(self.bottom),
                          b.nose, walls, self._walls, self._wall_depths, self.tangency,
-                         *self.law.data)
+                         self.contact_hold, self.hold_time, *self.law.data)
 
     # -- forces ---------------------------------------------------------------------------
     def loads(self, y, surface=None):
         """``(F, M_body, power, rotation)``: total surface force (target frame), moment about
         the centre of mass (body frame), power of the surface forces, rotation matrix
         (``surface``: the compiled surface arguments of a phase; None: the current ones)."""
-        force, moment, power, status, vn, _ = surface_loads(y, *(surface or self._surface))
+        force, moment, power, status, vn, _, _ = surface_loads(y, *(surface or self._surface))
         if status != OK:
             raise_for(status, vn)
         return force, moment, power, rotation_matrix(y[3:7])
@@ -216,7 +231,8 @@ class ObliqueModel:
         the two trajectories are mirrors to the last bit."""
         if strike.obliquity < 0.0:
             return mirror_state(self.initial_state(
-                replace(strike, obliquity=-strike.obliquity, spin=-strike.spin)))
+                replace(strike, obliquity=-strike.obliquity, spin=-strike.spin)),
+                self.body.partners)
         d, axis, e2, e3 = strike.initial_axes()
         rot = np.column_stack([axis, e2, e3])
         q = quaternion_from_matrix(rot)
@@ -229,7 +245,15 @@ class ObliqueModel:
             x[2] += strike.tip_depth
         v = strike.speed * d
         omega = np.array([strike.spin, 0.0, 0.0])
-        return np.concatenate([x, q, v, omega, [0.0]])
+        y = np.concatenate([x, q, v, omega, [0.0]])
+        if not self.contact_hold:
+            return y
+        # held contact: in free flight an element moving along its normal has been doing so
+        # for ever, so its fraction is at 1; the others at 0 (within the kernel's round-off
+        # guard of V_n)
+        rate = derivative(np.concatenate([y, np.full(self._p.shape[0], 0.5)]),
+                          self.body.mass, self._inertia, *self._surface)[0][14:]
+        return np.concatenate([y, np.where(rate > 0.0, 1.0, 0.0)])
 
     def energy(self, y):
         """Kinetic energy (J): translational plus rotational."""
@@ -325,7 +349,9 @@ class ObliqueModel:
         if status != OK:
             raise_for(status, vn)
         h = self._step or initial_step(y, f, self.rtol, self.atol, MAX_TIME)
-        ts, ys, fs = np.empty(CHUNK + 1), np.empty((CHUNK + 1, 14)), np.empty((CHUNK + 1, 14))
+        size = y.shape[0]
+        ts, ys, fs = (np.empty(CHUNK + 1), np.empty((CHUNK + 1, size)),
+                      np.empty((CHUNK + 1, size)))
         parts = []
         while True:
             status, steps, h, evaluations, event, vn = integrate(
@@ -435,12 +461,14 @@ class ObliqueModel:
 
 def fly(target, projectile, strike=None, resistance="derived", *, body=None, bottom=None,
         rtol=RTOL, atol=ATOL, method=METHOD, contact_ramp=None, progress=None,
-        tangency_psi=0.0, entry_crater=False, crater="nose-base", **law_options):
+        tangency_psi=0.0, entry_crater=False, crater="nose-base", contact_hold=0.0,
+        hold_time=None, **law_options):
     """One trajectory: :class:`Result` of ``strike`` (default: normal incidence at ``V0``);
     ``progress(t, y)`` is called after every integrator step; ``entry_crater``: the shank
     carries no load in the entry crater ``[0, L_c]`` (zones.open_zones; docs/oblique.md);
     ``crater``: where ``L_c`` of the entry and interface craters is measured from
-    (zones.crater_depth)."""
+    (zones.crater_depth); ``contact_hold`` (m, > 0): the held contact instead of the velocity
+    ramp (docs/oblique.md "Held contact")."""
     strike = strike or Strike(projectile.V0)
     require(resistance == "derived" or not target.debonded, "interfaces",
             "'bonded' unless the resistance is 'derived' (a debonded interface needs its "
@@ -449,7 +477,7 @@ def fly(target, projectile, strike=None, resistance="derived", *, body=None, bot
     model = ObliqueModel(target, projectile, law, body=body, bottom=bottom, rtol=rtol,
                          atol=atol, method=method, contact_ramp=contact_ramp,
                          tangency_psi=tangency_psi, entry_crater=entry_crater,
-                         crater=crater)
+                         crater=crater, contact_hold=contact_hold, hold_time=hold_time)
     return model.run(strike, progress=progress)
 
 

@@ -160,9 +160,81 @@ def _stage(matrix, f, out):
 
 
 @njit(cache=True, error_model="numpy")
+def _held_stage(matrix, jac, gh, partners, f, out):
+    """``(I - gamma h J)^-1 f`` with the held contact: ``J`` has the blocks ``D`` (the
+    dashpot's damping, ``jac[0:6]``), ``B_i`` (the ``(v, omega)`` rates by the fraction
+    ``phi_i``), ``C_i`` (its rate by ``(v, omega)``) and ``E_i`` (by itself) of
+    :func:`cavex.analytic.penetration.surface_force.derivative`; eliminating
+    ``k_phi_i = (f_phi_i + gamma h C_i k_v) / (1 - gamma h E_i)`` leaves
+    ``(I - gamma h D - (gamma h)^2 sum B_i C_i^T / (1 - gamma h E_i)) k_v
+    = f_v + gamma h sum B_i f_phi_i / (1 - gamma h E_i)``, ``matrix`` its left side
+    (:func:`_held_matrix`). The sums over the elements are taken in mirror pairs
+    (``partners``), as the loads are."""
+    n = partners.shape[0]
+    out[:] = f
+    rhs = np.zeros(6)
+    one = np.empty(6)
+    for i in range(n):
+        j = partners[i]
+        if j < i:
+            continue
+        w = f[14 + i] / (1.0 - gh * jac[6 + 2 * n + i, 0])
+        for r in range(6):
+            one[r] = jac[6 + i, r] * w
+        if j != i:
+            w = f[14 + j] / (1.0 - gh * jac[6 + 2 * n + j, 0])
+            for r in range(6):
+                one[r] += jac[6 + j, r] * w
+        rhs += one
+    for r in range(6):
+        rhs[r] = f[7 + r] + gh * rhs[r]
+    kv = _solve6(matrix, rhs)
+    out[7:13] = kv
+    for i in range(n):
+        coupling = 0.0
+        for r in range(6):
+            coupling += jac[6 + n + i, r] * kv[r]
+        out[14 + i] = (f[14 + i] + gh * coupling) / (1.0 - gh * jac[6 + 2 * n + i, 0])
+    return out
+
+
+@njit(cache=True, error_model="numpy")
+def _held_matrix(jac, gh, partners):
+    """The left side of :func:`_held_stage`'s ``(v, omega)`` system (pairs summed first)."""
+    n = partners.shape[0]
+    total = np.zeros((6, 6))
+    one = np.empty((6, 6))
+    for i in range(n):
+        j = partners[i]
+        if j < i:
+            continue
+        for second in range(2 if j != i else 1):
+            k = j if second else i
+            w = gh * gh / (1.0 - gh * jac[6 + 2 * n + k, 0])
+            for r in range(6):
+                wb = w * jac[6 + k, r]
+                for c in range(6):
+                    if second:
+                        one[r, c] += wb * jac[6 + n + k, c]
+                    else:
+                        one[r, c] = wb * jac[6 + n + k, c]
+        total += one
+    matrix = np.empty((6, 6))
+    for r in range(6):
+        for c in range(6):
+            matrix[r, c] = (1.0 if r == c else 0.0) - gh * jac[r, c] - total[r, c]
+    return matrix
+
+
+@njit(cache=True, error_model="numpy")
 def ros2_step(y, f, jac, h, rtol, atol, mass, inertia, surface, y1):
     """One ROS2 step of length ``h`` from ``y`` (``f = f(y)``, ``jac`` its damping block)
-    into ``y1``; returns ``(scaled error, status, V_n)`` (module docstring)."""
+    into ``y1``; returns ``(scaled error, status, V_n)`` (module docstring). With the held
+    contact (``jac`` taller than 6 rows) the stages are :func:`_held_stage`, the load
+    fractions of ``y1`` are clipped to ``[0, 1]`` (round-off) and left out of the error norm
+    (their error acts through the velocities, which are in it)."""
+    if jac.shape[0] > 6:
+        return _held_step(y, f, jac, h, rtol, atol, mass, inertia, surface, y1)
     matrix = np.empty((6, 6))
     for r in range(6):
         for c in range(6):
@@ -181,6 +253,32 @@ def ros2_step(y, f, jac, h, rtol, atol, mass, inertia, surface, y1):
         y1[k] = y[k] + h * (1.5 * k1[k] + 0.5 * k2[k])
         stage[k] = 0.5 * h * (k1[k] + k2[k])
     estimate = _stage(matrix, stage, np.empty(14))  # filtered: (I - gamma h J)^-1 e
+    return scaled_rms(estimate, y, y1, rtol, atol), OK, 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _held_step(y, f, jac, h, rtol, atol, mass, inertia, surface, y1):
+    """:func:`ros2_step` with the held contact."""
+    size = y.shape[0]
+    partners = surface[4]
+    gh = GAMMA * h
+    matrix = _held_matrix(jac, gh, partners)
+    k1 = _held_stage(matrix, jac, gh, partners, f, np.empty(size))
+    stage = np.empty(size)
+    for k in range(size):
+        stage[k] = y[k] + h * k1[k]
+    fstage, _, status, vn = derivative(stage, mass, inertia, *surface)
+    if status != OK:
+        return np.inf, status, vn
+    for k in range(size):
+        stage[k] = fstage[k] - 2.0 * k1[k]
+    k2 = _held_stage(matrix, jac, gh, partners, stage, np.empty(size))
+    for k in range(size):
+        y1[k] = y[k] + h * (1.5 * k1[k] + 0.5 * k2[k])
+        stage[k] = 0.5 * h * (k1[k] + k2[k])
+    for k in range(14, size):
+        y1[k] = min(max(y1[k], 0.0), 1.0)
+    estimate = _held_stage(matrix, jac, gh, partners, stage, np.empty(size))
     return scaled_rms(estimate, y, y1, rtol, atol), OK, 0.0
 
 
@@ -264,8 +362,8 @@ def integrate(t, y, f, jac, h, t_end, min_step, rtol, atol, max_steps, direction
     g0 = event_values(y, mass, inertia, event_args, np.empty(n_events))
     g1 = np.empty(n_events)
     gs = np.empty(n_events)
-    y1 = np.empty(14)
-    probe = np.empty(14)
+    y1 = np.empty(y.shape[0])
+    probe = np.empty(y.shape[0])
     ts[0] = t
     ys[0] = y
     fs[0] = f

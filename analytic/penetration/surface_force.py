@@ -40,6 +40,14 @@ a stiff damper). With ``u = v - [p]_x omega_t`` its contribution to
 
 without the slow parts (``d sigma_n / d V_n``, the turning of ``t``, the gyroscopic term).
 
+Held contact (``hold`` = ``delta_r`` > 0, docs/oblique.md "Held contact"): instead of the
+ramp, each element carries an elastic fraction ``phi_i = y[14 + i]`` in ``[0, 1]`` with
+``dphi_i/dt = V_n / delta_r`` (``|V_n|`` less the round-off guard; 0 where ``V_n`` pushes it
+out of ``[0, 1]``: plastic beyond 1) and the load
+``P = A_i w sigma_n(z, n_3, max(V_n, 0)) clip(phi_i + tau dphi_i/dt, 0, 1)`` (``tau`` =
+``hold_time``, a dashpot in parallel): a held element keeps its load at ``V_n = 0``. The
+Jacobian rows of the elastic elements (:func:`derivative`) replace the damping block.
+
 Motion:
 
 .. math:: \dot{\mathbf x} = \mathbf v, \quad
@@ -103,25 +111,30 @@ def _sum3(a, b, c):
     return (a + b) + c
 
 
-def mirror_state(y):
+def mirror_state(y, partners=None):
     """The state of the mirror-image shot (``x -> -x``): with the body mirror
     ``theta -> -theta`` the rotation becomes ``S R D`` (``S = diag(-1, 1, 1)``,
     ``D = diag(1, 1, -1)``), i.e. ``q -> (-q_2, -q_3, -q_0, -q_1)``, and the body angular
-    velocity (a pseudovector) ``omega -> (-omega_1, -omega_2, omega_3)``."""
+    velocity (a pseudovector) ``omega -> (-omega_1, -omega_2, omega_3)``. The held contact's
+    load fractions (``y[14:]``) are exchanged between mirror partners (``partners``, the
+    body's ``partners``; needed when ``y`` has them)."""
     m = np.array(y, dtype=float)
     m[0], m[7] = -y[0], -y[7]
     m[3:7] = -y[5], -y[6], -y[3], -y[4]
     m[10], m[11] = -y[10], -y[11]
+    if m.shape[0] > 14:
+        m[14:] = np.asarray(y)[14:][np.asarray(partners)]
     return m
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, contact_ramp, bottom,
-                  nose, open_zones, walls, wall_depths, tangency, kind, scalars, values, tables,
-                  counts, depths, radii, zones, out, damping):
+                  nose, open_zones, walls, wall_depths, tangency, hold, hold_time, kind,
+                  scalars, values, tables, counts, depths, radii, zones, out, damping, extra):
     """Force, moment about the centre of mass (target frame) and power of element ``i``
     into ``out[0:7]``, its contact damping ``kappa b a^T`` (module docstring, target frame)
-    into ``damping``; returns ``(status, V_n)``."""
+    into ``damping``; returns ``(status, V_n)``. With the held contact (``hold`` > 0)
+    :func:`_held_load` instead (``extra``: its rate and Jacobian rows)."""
     out[:] = 0.0
     damping[:, :] = 0.0
     p0 = rot[0, 0] * points[i, 0] + rot[0, 1] * points[i, 1] + rot[0, 2] * points[i, 2]
@@ -143,7 +156,7 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
             frac = min(frac, max(1.0 - inside / sizes[i], 0.0))
     if not nose[i] and walls.shape[0] > 0:  # the tunnel-wall factor of the element's layer
         frac *= walls[np.searchsorted(wall_depths, z, side="right")]
-    if frac <= 0.0:
+    if frac <= 0.0 and hold <= 0.0:  # (a held element's fraction moves outside too)
         return OK, 0.0
     n0 = rot[0, 0] * normals[i, 0] + rot[0, 1] * normals[i, 1] + rot[0, 2] * normals[i, 2]
     n1 = rot[1, 0] * normals[i, 0] + rot[1, 1] * normals[i, 1] + rot[1, 2] * normals[i, 2]
@@ -152,6 +165,10 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
     u1 = y[8] + omega[2] * p0 - omega[0] * p2
     u2 = y[9] + omega[0] * p1 - omega[1] * p0
     vn = u0 * n0 + u1 * n1 + u2 * n2
+    if hold > 0.0:
+        return _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, scale, areas,
+                          mu, hold, hold_time, kind, scalars, values, tables, counts, depths,
+                          radii, zones, out, damping, extra)
     if vn <= scale:
         return OK, 0.0
     sigma, status = element_stress(kind, scalars, values, tables, counts, depths,
@@ -187,15 +204,74 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
                 damping[r, c] = kb * a[c]
     return status, vn
 
+@njit(cache=True, error_model="numpy", inline="always")
+def _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, scale, areas, mu, hold,
+               hold_time, kind, scalars, values, tables, counts, depths, radii, zones, out,
+               damping, extra):
+    """Element ``i`` under the held contact (module docstring, "Held contact"). Its elastic
+    fraction ``phi = y[14 + i]`` moves at ``V_n / hold`` within ``[0, 1]`` (not at all where
+    ``V_n`` pushes out of them; ``|V_n|`` less the round-off guard ``scale``): an elastic
+    spring of ``hold`` up to the element's capacity, then plastic flow (the wall is cut).
+    With the dashpot of time constant ``hold_time`` the load is
+    ``A_i w sigma_n(z, n_3, max(V_n, 0)) clip(phi + hold_time dphi/dt, 0, 1)``. Writes the
+    force, moment and power into ``out``, ``extra = (dphi/dt, capacity b (6), a / hold (6),
+    0)`` (target frame; rows zero unless the element is elastic: neither its rate nor its
+    fraction clipped) and the dashpot's damping ``capacity hold_time / hold b a^T`` into
+    ``damping``."""
+    extra[:] = 0.0
+    phi = y[14 + i]
+    rate = 0.0
+    if abs(vn) > scale and not ((phi >= 1.0 and vn > 0.0) or (phi <= 0.0 and vn < 0.0)):
+        rate = (vn - scale if vn > 0.0 else vn + scale) / hold  # continuous at the guard
+    extra[0] = rate
+    raw = phi + hold_time * rate
+    fraction = min(max(raw, 0.0), 1.0)
+    elastic = rate != 0.0 and 0.0 < raw < 1.0
+    if frac <= 0.0 or not (fraction > 0.0 or elastic):
+        return OK, 0.0
+    sigma, status = element_stress(kind, scalars, values, tables, counts, depths,
+                                   max(z, 1e-12), n2, max(vn, 0.0), radii, zones)
+    if status == WALK_FAILED:
+        return status, vn
+    capacity = sigma * areas[i] * frac
+    d0, d1, d2 = n0, n1, n2  # the force's direction per unit load: n + mu t
+    if mu > 0.0:
+        t0, t1, t2 = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
+        tangential = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+        if tangential > 1e-12:
+            d0, d1, d2 = (d0 + mu * t0 / tangential, d1 + mu * t1 / tangential,
+                          d2 + mu * t2 / tangential)
+    load = capacity * fraction
+    f0, f1, f2 = -load * d0, -load * d1, -load * d2
+    out[0], out[1], out[2] = f0, f1, f2
+    out[3] = p1 * f2 - p2 * f1
+    out[4] = p2 * f0 - p0 * f2
+    out[5] = p0 * f1 - p1 * f0
+    out[6] = f0 * u0 + f1 * u1 + f2 * u2
+    a = (n0, n1, n2, p1 * n2 - p2 * n1, p2 * n0 - p0 * n2, p0 * n1 - p1 * n0)
+    b = (d0, d1, d2, p1 * d2 - p2 * d1, p2 * d0 - p0 * d2, p0 * d1 - p1 * d0)
+    if elastic:
+        kappa = capacity * hold_time / hold
+        for r in range(6):
+            extra[1 + r] = capacity * b[r]
+            extra[7 + r] = a[r] / hold
+            kb = kappa * b[r]
+            for c in range(6):
+                damping[r, c] = kb * a[c]
+    return status, vn
+
 
 @njit(cache=True, error_model="numpy")
 def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
-                  nose, open_zones, walls, wall_depths, tangency, kind, scalars, values, tables,
-                  counts, depths):
+                  nose, open_zones, walls, wall_depths, tangency, hold, hold_time, kind, scalars,
+                  values, tables, counts, depths):
     """``(F (3, target frame), M (3, body frame), power, status, V_n of a failed element,
-    C)`` of the surface forces in state ``y`` (module docstring; the law arrays are
+    C, H)`` of the surface forces in state ``y`` (module docstring; the law arrays are
     ``law.data``; ``C = diag(1, R^T) (sum kappa b a^T) diag(1, R)``, the contact damping
-    on ``(v, omega)``). Each element is added
+    on ``(v, omega)``, with the held contact (``hold`` > 0) the same sum of the stiffnesses
+    ``(capacity / hold) b a^T``; ``H`` (N, 13), empty without the held contact: each
+    element's ``dphi/dt``, ``capacity diag(1, R^T) b`` and ``diag(1, R^T) a / hold``, the
+    rows of the Jacobian in the state's frames). Each element is added
     together with its mirror image ``partners[i]`` (``theta -> -theta``) first, so that a
     shot and its mirror shot sum the same numbers in the same order: the mirrored trajectory
     is mirrored to the last bit."""
@@ -213,22 +289,35 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contac
     damping = np.zeros((6, 6))
     one_damping = np.empty((6, 6))
     other_damping = np.empty((6, 6))
+    held = np.zeros((areas.shape[0] if hold > 0.0 else 0, 14))
+    extra = np.empty(14)
     beyond = 0.0  # largest normal velocity beyond a table's range (0: none)
     for i in range(areas.shape[0]):
         j = partners[i]
         if j < i:
             continue
         for second in range(2 if j != i else 1):
-            status, vn = _element_load(j if second else i, y, rot, omega, scale, points,
+            k = j if second else i
+            status, vn = _element_load(k, y, rot, omega, scale, points,
                                        normals, areas, sizes, mu, contact_ramp, bottom, nose,
-                                       open_zones, walls, wall_depths, tangency, kind,
-                                       scalars, values, tables, counts, depths, radii, zones,
+                                       open_zones, walls, wall_depths, tangency, hold,
+                                       hold_time, kind, scalars, values, tables, counts,
+                                       depths, radii, zones,
                                        other if second else one,
-                                       other_damping if second else one_damping)
+                                       other_damping if second else one_damping, extra)
+            if hold > 0.0:  # the rate and the Jacobian rows, turned to the state's frames
+                held[k, 0:7] = extra[0:7]
+                held[k, 7:10] = extra[7:10]
+                held[k, 13] = extra[13]
+                for r in range(3):
+                    held[k, 4 + r] = (rot[0, r] * extra[4] + rot[1, r] * extra[5]
+                                      + rot[2, r] * extra[6])
+                    held[k, 10 + r] = (rot[0, r] * extra[10] + rot[1, r] * extra[11]
+                                       + rot[2, r] * extra[12])
             if status == BEYOND_TABLE:
                 beyond = max(beyond, vn)
             elif status != OK:
-                return total[0:3], total[3:6], total[6], status, vn, damping
+                return total[0:3], total[3:6], total[6], status, vn, damping, held
         if j != i:
             one += other
             one_damping += other_damping
@@ -248,21 +337,25 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contac
         for r in range(3):
             damping[r, c] = turned[r, c]
     if beyond > 0.0:
-        return total[0:3], moment, total[6], BEYOND_TABLE, beyond, damping
-    return total[0:3], moment, total[6], OK, 0.0, damping
+        return total[0:3], moment, total[6], BEYOND_TABLE, beyond, damping, held
+    return total[0:3], moment, total[6], OK, 0.0, damping, held
 
 
 @njit(cache=True, error_model="numpy")
 def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length, mu, contact_ramp,
-               bottom, nose, open_zones, walls, wall_depths, tangency, kind, scalars, values,
-               tables, counts, depths):
+               bottom, nose, open_zones, walls, wall_depths, tangency, hold, hold_time, kind,
+               scalars, values, tables, counts, depths):
     """``(dy/dt, D, status, V_n of a failed element)`` (module docstring; ``D`` the 6 x 6
-    contact damping block of the Jacobian)."""
-    force, moment, power, status, vn, damping = surface_loads(
+    contact damping block of the Jacobian; with the held contact, ``hold`` > 0, ``D`` is
+    ``(6 + 2 N) x 6``: rows 0-5 the product ``S = B C`` of the two blocks, rows ``6 + i``
+    the column ``B_i = d(dv/dt, d omega/dt)/d phi_i``, rows ``6 + N + i`` the row
+    ``C_i = d(dphi_i/dt)/d(v, omega)``)."""
+    force, moment, power, status, vn, damping, held = surface_loads(
         y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
-        nose, open_zones, walls, wall_depths, tangency, kind, scalars, values, tables, counts,
-        depths)
-    dy = np.empty(14)
+        nose, open_zones, walls, wall_depths, tangency, hold, hold_time, kind, scalars, values,
+        tables, counts, depths)
+    size = y.shape[0]
+    dy = np.empty(size)
     q0, q1, q2, q3 = y[3], y[4], y[5], y[6]
     w0, w1, w2 = y[10], y[11], y[12]
     dy[0:3] = y[7:10]
@@ -276,18 +369,25 @@ def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length
     dy[11] = (moment[1] - (w2 * i0 * w0 - w0 * i2 * w2)) / i1
     dy[12] = (moment[2] - (w0 * i1 * w1 - w1 * i0 * w0)) / i2
     dy[13] = power
-    jac = np.empty((6, 6))
+    n_held = held.shape[0]
+    jac = np.zeros((6 + 3 * n_held, 6)) if n_held else np.empty((6, 6))
     for r in range(6):
         scale = -1.0 / (mass if r < 3 else inertia[r - 3])
         for c in range(6):
             jac[r, c] = scale * damping[r, c]
+    for k in range(n_held):
+        dy[14 + k] = held[k, 0]
+        for r in range(6):
+            jac[6 + k, r] = -held[k, 1 + r] / (mass if r < 3 else inertia[r - 3])
+            jac[6 + n_held + k, r] = held[k, 7 + r]
+        jac[6 + 2 * n_held + k, 0] = held[k, 13]
     # an integrator stage may try a state whose normal velocities exceed a table's (stiff
     # contact): it gets the table's largest velocity; the accepted states are checked when the
     # history is sampled (surface_loads reports BEYOND_TABLE there)
     if status == BEYOND_TABLE:
         status = OK
     if status == OK:
-        for k in range(14):
+        for k in range(size):
             if not math.isfinite(dy[k]):
                 return dy, jac, NOT_FINITE, vn
     return dy, jac, status, vn

@@ -36,6 +36,11 @@ MIN_CONTACT_RAMP = 0.001
 # convergence table: +1.3e-4 at 0.03, +1.0e-3 at 0.1, +1.7e-3 at 0.3; 100 m/s gave 3x the depth;
 # tests/test_edges.py measures 0.03 against 0.001)
 MAX_CONTACT_RAMP = 0.03
+# m: the held contact's depth (--contact-hold, docs/oblique.md "Held contact"): over it the
+# added turn at the paper's debonded interface converges (0.354, 0.337, 0.329, 0.327 deg at
+# 3e-6, 1e-6, 3e-7, 1e-7 m, rtol 1e-4; 0.387 deg at 1e-5, rtol 1e-3); its steps measured
+# there, not below
+MIN_CONTACT_HOLD, MAX_CONTACT_HOLD = 1e-7, 1e-5
 # integrator steps per run before it is stopped as a numerical failure: measured shots take
 # 300-7 000 (docs/oblique.md); the largest spin once accepted took 599 113 steps (272 s)
 MAX_STEPS = 100_000
@@ -44,11 +49,12 @@ MAX_STEPS = 100_000
 def trajectory_job(target, projectile, strike, resistance="derived", *, boundary="dynamic",
                    epsilon="quasi-static", free_surface=True, table=None, law_A=None,
                    law_B=None, compare_homogeneous=False, contact_ramp=None, progress=False,
-                   tangency_psi=0.0, entry_crater=False, crater=None):
+                   tangency_psi=0.0, entry_crater=False, crater=None, contact_hold=None):
     """``{"runs": {"runway": Result, ["first layer only": Result]}, "settings": {...}}``;
     ``progress``: a tqdm bar per run on stderr (steps, simulated time, speed);
     ``contact_ramp`` None: the model's default
-    (:data:`~cavex.analytic.penetration.oblique.CONTACT_RAMP`)."""
+    (:data:`~cavex.analytic.penetration.oblique.CONTACT_RAMP`); ``contact_hold`` (m): the held
+    contact instead of the ramp (not with ``contact_ramp`` or ``tangency_psi``)."""
     # the command keeps the regularisation on: without it (or far below the default) an
     # oblique shot's sliding shank needs millions of steps (docs/oblique.md); above
     # MAX_CONTACT_RAMP the depth leaves the stated accuracy
@@ -56,6 +62,13 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
             and MIN_CONTACT_RAMP <= contact_ramp <= MAX_CONTACT_RAMP), "contact_ramp",
             f"in [{MIN_CONTACT_RAMP:g}, {MAX_CONTACT_RAMP:g}] m/s (final depth within 0.1 % "
             "of the V_r -> 0 limit)", contact_ramp)
+    require(contact_hold is None or (is_finite_number(contact_hold)
+            and MIN_CONTACT_HOLD <= contact_hold <= MAX_CONTACT_HOLD), "contact_hold",
+            f"in [{MIN_CONTACT_HOLD:g}, {MAX_CONTACT_HOLD:g}] m (the held contact's depth; the "
+            "added turn at a debonded interface converges there)", contact_hold)
+    require(contact_hold is None or (contact_ramp is None and not tangency_psi),
+            "contact_hold", "given without contact_ramp and tangency_psi (it replaces the "
+            "velocity ramp)", contact_hold)
     from cavex.analytic.penetration.oblique import CONTACT_RAMP, fly
 
     contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
@@ -63,6 +76,8 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
                "table": table, "law_A": law_A, "law_B": law_B, "contact_ramp": contact_ramp,
                "tangency_psi": tangency_psi, "entry_crater": entry_crater,
                "crater": crater or "nose-base"}
+    if contact_hold is not None:
+        options["contact_hold"] = contact_hold
     if table is not None:
         from cavex.analytic.penetration.tabulated import read_table
         options["table"] = read_table(table)
@@ -91,6 +106,9 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
         settings["tunnel_walls"] = list(target.tunnel_walls)
     if tangency_psi:
         settings["tangency_psi_deg"] = tangency_psi
+    if contact_hold is not None:  # the ramp is not used; the default's settings are unchanged
+        settings["contact_hold_m"] = contact_hold
+        del settings["contact_ramp_m_s"]
     if entry_crater:  # the runway's entry crater [top, bottom] (m); the default's settings
         settings["entry_crater_m"] = list(runs["runway"].model.zones[0])  # are unchanged
     if crater is not None:
@@ -335,8 +353,9 @@ def _title(job):
     s = job["settings"]
     law = s["resistance"] + (f"-{s['boundary']}" if s["resistance"] == "derived" else "")
     return (f"V0 = {s['speed_m_s']:g} m/s, obliquity {s['obliquity_deg']:g} deg, attack "
-            f"{s['attack_deg']:g} deg; resistance {law}, contact ramp "
-            f"{s['contact_ramp_m_s']:g} m/s"
+            f"{s['attack_deg']:g} deg; resistance {law}, "
+            + (f"contact ramp {s['contact_ramp_m_s']:g} m/s" if "contact_ramp_m_s" in s
+               else f"held contact {s['contact_hold_m']:g} m")
             + (f"; entry crater to {s['entry_crater_m'][1]:.3g} m" if "entry_crater_m" in s
                else ""))
 
@@ -585,6 +604,7 @@ def run(args, target, projectile):
                                  table=settings["table"], **laws,
                                  compare_homogeneous=args.compare_homogeneous,
                                  contact_ramp=args.contact_ramp,
+                                 contact_hold=args.contact_hold,
                                  tangency_psi=args.tangency_psi,
                                  entry_crater=args.entry_crater, crater=args.crater,
                                  progress=show_progress(args.progress))

@@ -1,0 +1,163 @@
+"""The held contact (``contact_hold``, ``cavex trajectory --contact-hold``): each element's
+load is regularised in its push into the wall, not in its normal velocity, so a held couple
+carries its load without creeping (issue 20 item 4; docs/oblique.md "Held contact")."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from cavex.analytic.penetration.oblique import ObliqueModel, Strike, fly
+from cavex.analytic.penetration.stress_laws import make_law
+from cavex.analytic.penetration.surface_force import mirror_state, surface_loads
+from cavex.config import load_config
+
+
+@pytest.fixture(scope="module")
+def default():
+    return load_config()
+
+
+def _turn_after(result, interface=1):
+    k = next(i for i, p in enumerate(result.phases)
+             if p["end_reason"].startswith(f"nose tip crossed interface {interface}"))
+    return result.phases[k + 1]["end_pitch_deg"] - result.phases[k]["end_pitch_deg"]
+
+
+def _added(default, **options):
+    """The added turn after the first debonded interface (600 m/s, 20 deg; debonded minus
+    bonded, pitch at the stop minus at the crossing), as tests/test_tunnel_wall.py."""
+    target, projectile = default
+    strike = Strike(600.0, 20.0)
+    return (_turn_after(fly(target.with_interfaces("debonded"), projectile, strike, **options))
+            - _turn_after(fly(target, projectile, strike, **options)))
+
+
+def test_added_turn_converges_under_the_held_contact(default):
+    """Issue 20 item 4's 3 %: the velocity ramp's added turn moves 7.7 % between 0.01 and
+    0.003 m/s (the held couple creeps at a fraction of the ramp). Under the held contact
+    refined by about 3, as the ramp was (rtol 1e-4, where the integrator's own spread is
+    below the gaps: at rtol 1e-3 the same depths move by up to 0.004 deg between two
+    versions of the round-off guard): 0.3543, 0.3365, 0.3290 deg at 3e-6, 1e-6, 3e-7 m,
+    monotone, the gap between 1e-6 and 3e-7 m 2.2 %: within the 3 % asked (bound: 3 %).
+    The limit, about 0.325 deg, and the velocity ramp's (0.332 deg at 0.001 m/s, 0.328 at
+    3e-4 m/s, about 0.326 in the limit: docs/oblique.md) agree; bound: the held value at
+    3e-7 m within 0.01 deg of the ramp's at 0.001 m/s (measured 0.003)."""
+    options = {"rtol": 1e-4, "atol": 1e-7}
+    added = {hold: _added(default, contact_hold=hold, **options) for hold in (3e-6, 1e-6, 3e-7)}
+    print("added turn (deg) by hold depth:", added)
+    values = list(added.values())
+    assert np.all(np.diff(values) < 0)  # monotone
+    assert abs(added[3e-7] / added[1e-6] - 1.0) < 0.03
+    ramp = _added(default, contact_ramp=0.001, **options)
+    print("ramp 0.001 m/s:", ramp)
+    assert abs(added[3e-7] - ramp) < 0.01
+
+
+def test_held_debonded_shot_mirrors_to_the_last_bit(default):
+    """The load fractions are exchanged between mirror partners (``mirror_state``); the
+    integrator sums their Jacobian blocks in mirror pairs: out of plane, spinning, with the
+    zones open, the mirror shot is the mirror image of every state at every step."""
+    target, projectile = default
+    debonded = target.with_interfaces("debonded")
+    a = fly(debonded, projectile, Strike(650.0, 25.0, attack=3.0, attack_plane=50.0,
+                                         spin=200.0), contact_hold=1e-6)
+    b = fly(debonded, projectile, Strike(650.0, -25.0, attack=3.0, attack_plane=50.0,
+                                         spin=-200.0), contact_hold=1e-6)
+    assert len(a.model.opened) >= 2
+    ya = np.concatenate([s.y for s in a.solutions], axis=1)
+    yb = np.concatenate([s.y for s in b.solutions], axis=1)
+    assert ya.shape == yb.shape and ya.shape[0] == 14 + a.model.body.areas.size
+    assert np.abs(ya[1]).max() > 1e-3  # genuinely out of plane
+    fractions = ya[14:]
+    assert np.any((fractions > 0.0) & (fractions < 1.0))  # elements on their spring
+    for k in range(ya.shape[1]):
+        assert np.array_equal(mirror_state(ya[:, k], a.model.body.partners), yb[:, k])
+
+
+def _work_mismatch(result):
+    y0, y1 = result.solutions[0].y[:, 0], result.solutions[-1].y[:, -1]
+    return -y1[13] / (result.model.energy(y0) - result.model.energy(y1)) - 1.0
+
+
+def test_held_work_is_the_kinetic_energy_lost(default):
+    """Force, moment and power of the held kernel agree: the work of the surface forces
+    equals the kinetic energy lost, to the integrator's global error: friction 0.1, spin,
+    attack out of plane, concrete alone, plain law, at rtol 1e-3 and 1e-5 (measured 3.4e-5,
+    4.9e-5; 5.8e-5 at 1e-4: flat, where the ramp's falls from 6.5e-4 to 5.6e-5,
+    tests/test_oblique.py), and the debonded runway at rtol 1e-3 (the zones open; 5.6e-7).
+    Bound: 4 x the largest measured, 2e-4."""
+    target, projectile = default
+    strike = Strike(700.0, 30.0, attack=3.0, attack_plane=40.0, spin=500.0)
+    runs = [fly(target.single(0), replace(projectile, mu=0.1), strike, "law", law_A=2e8,
+                law_B=2500.0, contact_hold=1e-6, rtol=rtol, atol=1e-3 * rtol)
+            for rtol in (1e-3, 1e-5)]
+    debonded = fly(target.with_interfaces("debonded"), projectile, strike, contact_hold=1e-6)
+    mismatch = [_work_mismatch(r) for r in (*runs, debonded)]
+    print("work-energy mismatch (friction 1e-3, 1e-5; debonded):", mismatch)
+    assert abs(runs[0].history["yaw_deg"]).max() > 0.1  # a genuinely 3-D shot
+    assert len(debonded.model.opened) >= 2
+    assert all(abs(m) < 2e-4 for m in mismatch)
+
+
+def test_held_contact_carries_its_load_at_rest(default):
+    """What the ramp cannot do: an element pushed into its wall keeps its load when it stops
+    (``V_n = 0``), and sheds it when it leaves. A state of the paper's shot mid-run with the
+    body's velocities set to zero: the ramp's loads vanish, the held contact's are the
+    fractions times the static capacities, element by element (linear in the fractions:
+    bound 1e-12 of the total)."""
+    target, projectile = default
+    law = make_law(target, projectile)
+    model = ObliqueModel(target, projectile, law, contact_hold=1e-6)
+    result = model.run(Strike(600.0, 20.0))
+    y = result.solutions[-1].y[:, result.solutions[-1].t.size // 2].copy()
+    y[7:13] = 0.0
+    ramp = ObliqueModel(target, projectile, law)
+    assert np.all(surface_loads(y[:14], *ramp._surface)[0] == 0.0)
+    held = surface_loads(y, *model._surface)
+    assert np.abs(held[0]).max() > 1e3  # N: the body is held
+    # each element alone at its fraction against each element alone at full fraction
+    areas = model.body.areas
+    full = y.copy()
+    full[14:] = 1.0
+    total = np.zeros(3)
+    for k in np.flatnonzero(y[14:] > 0.0):
+        one = list(model._surface)
+        one[2] = np.where(np.arange(areas.size) == k, areas, 0.0)
+        at_one = surface_loads(full, *one)[0]
+        total += y[14 + k] * at_one
+    assert np.allclose(held[0], total, rtol=0, atol=1e-12 * np.abs(held[0]).max())
+    assert np.all(held[6][:, 0] == 0.0)  # at rest the fractions do not move
+
+
+def test_held_normal_incidence_one_layer_is_the_1d_tunnel(default):
+    """tests/test_oblique.py's comparison with the 1-D tunnel phase (one layer, no free
+    surface, the nose started embedded), with the held contact: the nose elements move
+    along their normals from the start, so their fractions are 1 and stay there (the rate
+    is clipped), the shank's are 0 (its normal velocity is round-off, inside the guard): the
+    same loads as the ramp-free model. Compiled ROS2 at rtol 1e-6, the bound of the ramp-free
+    test (1e-6; measured: printed)."""
+    from cavex.analytic.penetration.body import build_body
+    from cavex.analytic.penetration.integrator import penetrate
+    from cavex.analytic.penetration.resistance import ClosedFormResistance
+
+    target, projectile = default
+    single = target.single(0)
+    body = build_body(projectile, shank_rings=8)
+    start = body.nose_length + 0.5 * body.sizes.max() + 1e-4
+    law = make_law(single, projectile, "derived", boundary="dynamic", free_surface=False)
+    model = ObliqueModel(single, projectile, law, body=body, rtol=1e-6, atol=1e-9,
+                         contact_hold=1e-6)
+    result = model.run(Strike(projectile.V0, tip_depth=start))
+    one_d = penetrate(single, projectile, ClosedFormResistance(single, projectile, "derived",
+                                                                "dynamic"), crater=None)
+    fractions = np.concatenate([s.y[14:] for s in result.solutions], axis=1)
+    assert np.all(fractions[body.nose] == 1.0) and np.all(fractions[~body.nose] == 0.0)
+    keep = one_d.velocity > 1e-3 * projectile.V0
+    depth_error = velocity_error = 0.0
+    for t, L, V in zip(one_d.t[keep], one_d.depth[keep], one_d.velocity[keep], strict=True):
+        y = result.state(t)
+        depth_error = max(depth_error, abs(model.tip(y)[2] - start - L) / one_d.depth[-1])
+        velocity_error = max(velocity_error, abs(np.linalg.norm(y[7:10]) - V) / projectile.V0)
+    print("depth error", depth_error, "velocity error", velocity_error)
+    assert depth_error < 1e-6 and velocity_error < 1e-6
