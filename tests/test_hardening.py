@@ -572,6 +572,36 @@ def test_ctrl_c_during_a_trajectory_run(tmp_path):
     assert not out.exists()
 
 
+def test_an_interrupt_wrapped_by_compiled_code_is_an_interrupt():
+    """numba wraps a Ctrl-C that arrives inside a compiled call (or the unpickling of one of
+    its constants) in SystemErrors, each the cause of the next (seen three deep in a run of
+    ``cavex trajectory`` interrupted at 0.95 s), Python in a RuntimeError inside
+    ``__set_name__``; any such chain counts as an interrupt, one without a KeyboardInterrupt
+    does not."""
+    from cavex.verification.cli import interrupted
+
+    def chain(depth, root):
+        exc = root
+        for _ in range(depth):
+            try:
+                raise SystemError("returned a result with an exception set") from exc
+            except SystemError as wrapped:
+                exc = wrapped
+        return exc
+
+    assert all(interrupted(chain(depth, KeyboardInterrupt())) for depth in range(5))
+    try:  # Python's wrapping of an interrupt raised in __set_name__ (seen in matplotlib)
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as exc:
+            raise RuntimeError("Error calling __set_name__") from exc
+    except RuntimeError as wrapped:
+        assert interrupted(wrapped)
+    assert not interrupted(chain(2, ValueError("no")))
+    assert not interrupted(SystemError("alone"))
+    assert not interrupted(ValueError("not a SystemError"))
+
+
 def test_a_run_that_reaches_the_time_limit_ends_there():
     from cavex.analytic.penetration.oblique import MAX_TIME, Strike, fly
 

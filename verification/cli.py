@@ -7,6 +7,7 @@ import gc
 import importlib
 import os
 import re
+import signal
 import sys
 
 from cavex import __version__
@@ -251,6 +252,23 @@ def _announce_on_terminal(command):
         _ANNOUNCED.append(announce_compiling(sys.stderr))
 
 
+INTERRUPTED = 130  # the exit code of a Ctrl-C (128 + SIGINT)
+
+
+def interrupted(exc):
+    """Whether ``exc`` comes of a Ctrl-C: a KeyboardInterrupt, or an exception that one
+    caused or arose while one was handled (numba wraps an interrupt that arrives inside a
+    compiled call, or inside the unpickling of one of its constants, in one or more
+    SystemErrors; Python wraps one raised inside ``__set_name__`` in a RuntimeError)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
 def main(argv=None):
     """Entry point; returns the exit code (0 ok, 1 numerical failure, 2 bad input)."""
     parser = build_parser()
@@ -276,11 +294,11 @@ def main(argv=None):
         print(f"cavex: error: cannot read or write {where}{exc.strerror or exc}",
               file=sys.stderr)
         return 2
-    except (KeyboardInterrupt, SystemError) as exc:  # Ctrl-C (numba: a SystemError around it)
-        if isinstance(exc, SystemError) and not isinstance(exc.__context__, KeyboardInterrupt):
+    except (KeyboardInterrupt, Exception) as exc:  # Ctrl-C, also wrapped (interrupted)
+        if not interrupted(exc):
             raise
         print("cavex: interrupted", file=sys.stderr)
-        return 130
+        return INTERRUPTED
     try:
         print(text)
         sys.stdout.flush()
@@ -307,10 +325,23 @@ def console():
     garbage collector's reach (``gc.freeze``) before the interpreter exits, whose final
     collections would walk every object numba and scipy made (0.3-0.5 s of a ``cavex penetrate
     --no-figures``, benchmarks/commands.md). Functions registered with ``atexit`` or
-    ``weakref.finalize`` still run; the tests call :func:`main`, which leaves the collector
-    as it is."""
+    ``weakref.finalize`` still run, except after an interrupt (exit code 130), where the
+    process ends at once (``os._exit``) once the command has cleaned up; the tests call
+    :func:`main`, which leaves the collector as it is."""
     gc.set_threshold(*GC_THRESHOLDS)
-    code = main()
+    try:
+        code = main()
+    except KeyboardInterrupt:  # raised again after main's report: reported once
+        code = INTERRUPTED
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the work is done: the exit is not cut short
+    if code == INTERRUPTED:
+        # the interrupt may have cut short objects being built (llvmlite's), whose finalisers
+        # then fail as the interpreter ends, and Python may have flagged it as unhandled and
+        # end by SIGINT instead (measured: 2-7 in 80 runs interrupted while writing): the
+        # command has cleaned up its outputs, so the process ends here, with 130
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(INTERRUPTED)
     gc.freeze()
     return code
 
