@@ -141,7 +141,7 @@ def _finish_point(P, Q, T00, T01, T10, T11, lam, tau, J, out):
     out[6] = c * abs(Q) / strength if strength > 0.0 else 1.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension,
                         out):
     """Mohr-Coulomb-only return; returns ``(plastic, needs_multi_surface)``."""
@@ -334,7 +334,7 @@ def _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, te
     return not elastic
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def return_point(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap, out):
     """Return map of one point from its total log strains; writes :data:`OUTPUTS` into
     ``out`` (length 9) and returns whether the point is plastic in this step.

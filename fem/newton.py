@@ -159,7 +159,9 @@ def newton(stack, w, params, dynamic, tol):
             stack.pressure_control, stack.outer_fixed, *gradients, f, band, resp.tau_r,
             resp.tau_t, resp.theta_p, resp.gamma_p, resp.plastic, resp.yield_ratio, folded,
             force_scale, a, r_free, jac, scale, r_max, du, status, iterations, evaluations)
-    reasons = np.array([FAILURES.get(int(code)) for code in status], dtype=object)
+    reasons = np.full(k, None, dtype=object)
+    for c in np.flatnonzero(status != 1):
+        reasons[c] = FAILURES.get(int(status[c]))
     iterations[status != 1] = 0
     return u, a, f, resp, iterations, reasons, evaluations
 

@@ -25,6 +25,7 @@ energy are evaluated on request.
 from types import SimpleNamespace
 
 import numpy as np
+from numba import njit
 
 from cavex.errors import CavexNumericalError
 from cavex.fem.newton import (
@@ -51,18 +52,82 @@ def failure_message(depth, t, wall_radius, load, dt, plain, line_searched):
             f"{line_searched}")
 
 
-def _store(state, names, rows, ok, new):
-    """``state[name][rows][ok] = new[name][ok]`` for every name; ``rows`` is ``slice(None)``
-    (the working stack is the whole stack: written in place, no index arrays) or an index
-    array (a subset)."""
-    if isinstance(rows, slice):
-        for name in names:
-            np.copyto(state[name], new[name], where=ok if state[name].ndim == 1
-                      else ok[:, None])
-        return
-    where = rows[ok]
-    for name in names:
-        state[name][where] = new[name][ok]
+@njit(cache=True, error_model="numpy")
+def commit_cases(ok, cases, dof_start, dof_count, el_start, el_count, root_dofs,
+                 root_elements, u, a, f, u0, v0, a0, f0, dt, theta_p0, gamma_p0, tau_r, tau_t,
+                 theta_p, gamma_p, plastic, yield_ratio, weights, wall_indptr, wall_indices,
+                 wall_data, dynamic, gamma, alpha_m, alpha_f, U, V, A, F, DU, THETA_P,
+                 GAMMA_P, EQ_P, PLASTIC, YIELD_RATIO, TAU_R, TAU_T, wall_force, work,
+                 dissipated):
+    r"""Accept step ``n -> n+1`` of every case ``c`` of a working stack with ``ok[c]``: its
+    trial state (``u, a, f`` per dof, the point response) is written into the solver's
+    state (upper-case arrays, rows ``root_dofs``/``root_elements`` of the working stack's
+    dofs/elements; per case row ``cases[c]``), with
+
+    - the Newmark velocity ``v = v_n + dt[(1 - gamma) a_n + gamma a]`` (dynamic; else 0) and
+      the increment ``du_prev = u - u_n``;
+    - the equivalent plastic strain ``eq_p += (2/3)|gamma_p - gamma_p,n|``;
+    - the wall reaction ``f_wall + (M a)_wall`` (dynamic; else ``f_wall``) and the wall work
+      ``F_mid (u_wall - u_wall,n)``, ``F_mid = (M[(1 - alpha_m) a + alpha_m a_n])_wall
+      + (1 - alpha_f) f_wall + alpha_f f_wall,n`` (quasi-static: ``(f_wall + f_wall,n)/2``);
+    - the dissipation ``sum W [-P (theta_p - theta_p,n) - (2/3) Q (gamma_p - gamma_p,n)]``
+      with ``P = -(tau_r + 2 tau_t)/3``, ``Q = tau_t - tau_r``.
+
+    ``wall_*`` are the CSR rows of the mass matrix at the wall dofs (one per case), summed in
+    their stored order as scipy's product does. The start-of-step arrays (``u0`` ...) may be
+    views of the state: each value is read before its row is written."""
+    nq = weights.shape[1]
+    for c in range(dof_start.size):
+        if not ok[c]:
+            continue
+        s0, s1 = dof_start[c], dof_start[c] + dof_count[c]
+        if dynamic:  # first: the start-of-step arrays may be views of the state written below
+            mid = 0.0
+            inertia = 0.0
+            for j in range(wall_indptr[c], wall_indptr[c + 1]):
+                col = wall_indices[j]
+                mid += wall_data[j] * ((1.0 - alpha_m) * a[col] + alpha_m * a0[col])
+                inertia += wall_data[j] * a[col]
+            mid_force = mid + ((1.0 - alpha_f) * f[s0] + alpha_f * f0[s0])
+            end_force = f[s0] + inertia
+        else:
+            mid_force = 0.5 * (f[s0] + f0[s0])
+            end_force = f[s0]
+        k = cases[c]
+        wall_force[k] = end_force
+        work[k] += mid_force * (u[s0] - u0[s0])
+        h = dt[c]
+        for i in range(s0, s1):
+            row = root_dofs[i]
+            DU[row] = u[i] - u0[i]
+            V[row] = v0[i] + h * ((1.0 - gamma) * a0[i] + gamma * a[i]) if dynamic else 0.0
+            U[row] = u[i]
+            A[row] = a[i]
+            F[row] = f[i]
+        total = 0.0
+        for e in range(el_start[c], el_start[c] + el_count[c]):
+            row = root_elements[e]
+            for q in range(nq):
+                P = -(tau_r[e, q] + 2.0 * tau_t[e, q]) / 3.0
+                Q = tau_t[e, q] - tau_r[e, q]
+                total += weights[e, q] * (-P * (theta_p[e, q] - theta_p0[e, q])
+                                          - (2.0 / 3.0) * Q * (gamma_p[e, q] - gamma_p0[e, q]))
+                EQ_P[row, q] += abs(gamma_p[e, q] - gamma_p0[e, q]) * (2.0 / 3.0)
+                THETA_P[row, q] = theta_p[e, q]
+                GAMMA_P[row, q] = gamma_p[e, q]
+                PLASTIC[row, q] = plastic[e, q]
+                YIELD_RATIO[row, q] = yield_ratio[e, q]
+                TAU_R[row, q] = tau_r[e, q]
+                TAU_T[row, q] = tau_t[e, q]
+        dissipated[k] += total
+
+
+def padded(rows):
+    """Per-case arrays of different lengths as one 2-D array (NaN beyond each one's end)."""
+    table = np.full((len(rows), max((len(r) for r in rows), default=0)), np.nan)
+    for c, row in enumerate(rows):
+        table[c, :len(row)] = row
+    return table
 
 
 class RadialSolver:
@@ -110,6 +175,8 @@ class RadialSolver:
         self.cases["dt_old"][:] = 1.0
         self.has_prev = np.zeros(k, dtype=bool)
         self.counters = {name: np.zeros(k, dtype=int) for name in COUNTERS}
+        self._rows = np.arange(root.ndof)  # the whole stack's rows of the state
+        self._point_rows = np.arange(shape[0])
 
     # ------------------------------------------------------------------ stepping
     def run(self, loads, times, observers=(), describe=None):
@@ -135,8 +202,10 @@ class RadialSolver:
         root = self.stack
         k = root.n_cases
         n_steps = np.array([len(x) for x in loads])
+        load_table, time_table = padded(loads), padded(times) if times is not None else None
         next_step = np.zeros(k, dtype=int)
         pending = [[] for _ in range(k)]
+        n_pending = np.zeros(k, dtype=int)      # len(pending[c])
         finished = np.zeros(k, dtype=bool)
         errors = [None] * k
         task_load, task_dt = np.zeros(k), np.zeros(k)
@@ -147,17 +216,18 @@ class RadialSolver:
         stack, cases = root, np.arange(k)
         dofs = elements = slice(None)  # the working stack's rows of the state: all of it
         while True:
-            for c in np.flatnonzero(~finished):
-                if pending[c]:
-                    task_load[c], task_dt[c], task_depth[c], task_search[c] = pending[c].pop()
-                elif next_step[c] == n_steps[c]:
-                    finished[c] = True
-                else:
-                    s = next_step[c]
-                    task_load[c] = loads[c][s]
-                    task_dt[c] = times[c][s] - t[c] if times is not None else 1.0
-                    task_depth[c], task_search[c] = 0, False
-                    next_step[c] += 1
+            resumed = ~finished & (n_pending > 0)   # a cut-back's next sub-step
+            for c in np.flatnonzero(resumed):
+                task_load[c], task_dt[c], task_depth[c], task_search[c] = pending[c].pop()
+            n_pending[resumed] -= 1
+            fresh = ~finished & ~resumed
+            finished |= fresh & (next_step == n_steps)
+            fresh &= ~finished                      # the next step of its list
+            s = next_step[fresh]
+            task_load[fresh] = load_table[fresh, s]
+            task_dt[fresh] = time_table[fresh, s] - t[fresh] if times is not None else 1.0
+            task_depth[fresh], task_search[fresh] = 0, False
+            next_step[fresh] += 1
             if finished.all():
                 return errors
             active = ~finished[cases]
@@ -185,8 +255,8 @@ class RadialSolver:
             self.counters["steps"][done] += 1
             self.counters["newton_iterations"][done] += iterations[ok]
             self.counters["line_search_steps"][done] += task_search[done]
-            for c in done:
-                if not pending[c]:
+            if observers:
+                for c in done[n_pending[done] == 0]:
                     for observer in observers:
                         observer(self, c, next_step[c] - 1)
             for i in np.flatnonzero(active & ~ok):
@@ -195,6 +265,7 @@ class RadialSolver:
                 if depth >= self.max_cutbacks and not task_search[c]:
                     plain_reason[c] = reasons[i]
                     pending[c].append((task_load[c], task_dt[c], depth, True))
+                    n_pending[c] += 1
                 elif depth >= self.max_cutbacks:
                     wall = root.R_dofs[root.wall[c]] + self.dofs["u"][root.wall[c]]
                     prefix = describe(c, next_step[c] - 1) + ": " if describe else ""
@@ -207,6 +278,7 @@ class RadialSolver:
                     half = 0.5 * task_dt[c]
                     pending[c].append((task_load[c], half, depth + 1, False))
                     pending[c].append((0.5 * (load[c] + task_load[c]), half, depth + 1, False))
+                    n_pending[c] += 2
 
     def _attempt(self, stack, w, active, search):
         """One Newton attempt of the active cases (the line-searched ones case by case).
@@ -225,43 +297,25 @@ class RadialSolver:
                 if reasons[i] is None:
                     u[sdofs], a[sdofs], f[sdofs] = su, sa, sf
                     replace_points(resp, selements, sresp)
-        ok = active & np.array([r is None for r in reasons])
+        ok = active & np.equal(reasons, None).astype(bool)
         return (u, a, f, resp), ok, iterations, reasons, evaluations
 
     def _commit(self, stack, cases, dofs, elements, ok, w, trial):
-        """Accept the converged cases ``ok`` of the working ``stack``: velocities, plastic
-        state, energies, wall reaction."""
+        """Accept the converged cases ``ok`` of the working ``stack`` (compiled:
+        :func:`commit_cases`): velocities, plastic state, energies, wall reaction."""
         u, a, f, resp = trial
         p = self.params
-        if self.dynamic:
-            dt_d = w.dt[stack.dof_case]
-            v = w.v0 + dt_d * ((1.0 - p.gamma) * w.a0 + p.gamma * a)
-            wall_mass = stack.wall_mass  # the wall rows of the mass matrix: the wall forces
-            mid = wall_mass @ ((1.0 - p.alpha_m) * a + p.alpha_m * w.a0)
-            mid_force = mid + ((1.0 - p.alpha_f) * f + p.alpha_f * w.f0)[stack.wall]
-            end_force = f[stack.wall] + wall_mass @ a
-        else:
-            v = np.zeros_like(u)
-            mid_force = 0.5 * (f[stack.wall] + w.f0[stack.wall])
-            end_force = f[stack.wall]
-        # energies: wall work (trapezoidal in the generalized-alpha sense) and dissipation
-        work = mid_force * (u[stack.wall] - w.u0[stack.wall])
-        P = -(resp.tau_r + 2.0 * resp.tau_t) / 3.0
-        Q = resp.tau_t - resp.tau_r
-        dissipation = stack.weights * (-P * (resp.theta_p - w.theta_p)
-                                       - (2.0 / 3.0) * Q * (resp.gamma_p - w.gamma_p))
-        ok_dofs, ok_elements = ok[stack.dof_case], ok[stack.element_case]
-        new = {"u": u, "v": v, "a": a, "f": f, "du_prev": u - w.u0}
-        _store(self.dofs, DOF_STATE, dofs, ok_dofs, new)
-        eq_p = (self.points["eq_p"][elements]
-                + np.abs(resp.gamma_p - w.gamma_p) * (2.0 / 3.0))
-        new = {"eq_p": eq_p, **{name: getattr(resp, name) for name in POINT_STATE
-                                if name != "eq_p"}}
-        _store(self.points, POINT_STATE, elements, ok_elements, new)
-        done = cases[ok]
-        self.cases["wall_force"][done] = end_force[ok]
-        self.cases["work"][done] += work[ok]
-        self.cases["dissipated"][done] += stack.per_case_sum(dissipation)[ok]
+        root_dofs = self._rows if isinstance(dofs, slice) else dofs
+        root_elements = self._point_rows if isinstance(elements, slice) else elements
+        wall_mass = stack.wall_mass  # the wall rows of the mass matrix: the wall forces
+        commit_cases(ok, cases, stack.dof_start, stack.dof_count, stack.el_start,
+                     stack.el_count, root_dofs, root_elements, u, a, f, w.u0, w.v0, w.a0,
+                     w.f0, w.dt, w.theta_p, w.gamma_p, resp.tau_r, resp.tau_t, resp.theta_p,
+                     resp.gamma_p, resp.plastic, resp.yield_ratio, stack.weights,
+                     wall_mass.indptr, wall_mass.indices, wall_mass.data, self.dynamic,
+                     p.gamma, p.alpha_m, p.alpha_f, *(self.dofs[name] for name in DOF_STATE),
+                     *(self.points[name] for name in POINT_STATE),
+                     *(self.cases[name] for name in ("wall_force", "work", "dissipated")))
 
     def start_under_load(self, load):
         """Consistent start for a wall pressure ``load`` applied suddenly at ``t = 0+``.
