@@ -66,6 +66,7 @@ import numpy as np
 from numba import njit
 
 TWO_THIRDS = 2.0 / 3.0
+NO_OUTPUTS = (0.0,) * 9  # the outputs of a return that hands over to another
 #: Per-point outputs of :func:`return_point`, in order (``out[i]``).
 OUTPUTS = ("tau_r", "tau_t", "C_rr", "C_rt", "C_tr", "C_tt", "yield_ratio", "theta_p",
            "gamma_p")
@@ -122,29 +123,25 @@ class PointMaterial:
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _finish_point(P, Q, T00, T01, T10, T11, lam, tau, J, out):
-    """Kirchhoff stresses ``tau_r, tau_t`` (tension positive), the tangent
-    ``d tau_i / d eps_j`` (from ``T = d(P, Q)/d(theta, gamma)``) and the yield ratio
-    (deviator over strength) into ``out[0..6]``."""
-    out[0] = -(P + 2.0 * Q / 3.0)
-    out[1] = -(P - Q / 3.0)
+def _finish_point(P, Q, T00, T01, T10, T11, lam, tau, J, theta_p, gamma_p):
+    """The point's :data:`OUTPUTS`: Kirchhoff stresses ``tau_r, tau_t`` (tension positive),
+    the tangent ``d tau_i / d eps_j`` (from ``T = d(P, Q)/d(theta, gamma)``), the yield ratio
+    (deviator over strength) and the plastic strains ``theta_p, gamma_p`` (given)."""
     a_t = -T00 - TWO_THIRDS * T10
     a_g = -T01 - TWO_THIRDS * T11
     b_t = -T00 + T10 / 3.0
     b_g = -T01 + T11 / 3.0
-    out[2] = a_t + a_g
-    out[3] = 2.0 * a_t - a_g
-    out[4] = b_t + b_g
-    out[5] = 2.0 * b_t - b_g
     c = 1.0 if Q >= 0.0 else (3.0 + lam) / 3.0
     strength = lam * P + tau * J
-    out[6] = c * abs(Q) / strength if strength > 0.0 else 1.0
+    return (-(P + 2.0 * Q / 3.0), -(P - Q / 3.0), a_t + a_g, 2.0 * a_t - a_g, b_t + b_g,
+            2.0 * b_t - b_g, c * abs(Q) / strength if strength > 0.0 else 1.0, theta_p,
+            gamma_p)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension,
-                        out):
-    """Mohr-Coulomb-only return; returns ``(plastic, needs_multi_surface)``."""
+def _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension):
+    """Mohr-Coulomb-only return; returns ``(plastic, needs_multi_surface, outputs)``
+    (:data:`OUTPUTS`; not to be used when the multi-surface return is needed)."""
     P = -K * (theta - theta_p)
     Q = -2.0 * G * (gamma - gamma_p)
     positive = Q >= 0.0
@@ -156,7 +153,7 @@ def _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_p
     f_tc = -sigma_3 - tension * J
     plastic = (f_mc > tol) or (f_tc > tol)
     if f_tc > tol:
-        return plastic, True
+        return plastic, True, NO_OUTPUTS
     c_psi = 1.0 if positive else 1.0 + lam_psi / 3.0
     d_P = -K * lam_psi                      # stress correction direction d = (d_P, d_Q)
     d_Q = 3.0 * G * c_psi * sign
@@ -166,16 +163,15 @@ def _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_p
     Q_new = Q - dl * d_Q
     s3 = P_new - Q_new / 3.0 if Q_new >= 0.0 else P_new + 2.0 * Q_new / 3.0
     if plastic and not (-s3 - tension * J <= 1e-12 * tau * J):
-        return plastic, True
-    out[7] = theta_p + dl * lam_psi
-    out[8] = gamma_p - dl * 1.5 * c_psi * sign
+        return plastic, True, NO_OUTPUTS
     # tangent d(P, Q)/d(theta, gamma) = E - d (a^T E - k J e_theta^T) / g on plastic points
     pl = (1.0 if plastic else 0.0) / g
     row_t = (lam * K - tau * J) * pl
     row_g = (-2.0 * G * c_mc * sign) * pl
-    _finish_point(P_new, Q_new, -K - d_P * row_t, -d_P * row_g, -d_Q * row_t,
-                  -2.0 * G - d_Q * row_g, lam, tau, J, out)
-    return plastic, False
+    return plastic, False, _finish_point(P_new, Q_new, -K - d_P * row_t, -d_P * row_g,
+                                         -d_Q * row_t, -2.0 * G - d_Q * row_g, lam, tau, J,
+                                         theta_p + dl * lam_psi,
+                                         gamma_p - dl * 1.5 * c_psi * sign)
 
 
 @njit(cache=True, error_model="numpy")
@@ -193,10 +189,9 @@ def _trial(theta, gamma, theta_p, gamma_p, K, G, lam, lam_psi):
 
 
 @njit(cache=True, error_model="numpy")
-def _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension,
-                         out):
+def _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension):
     """Multi-surface return (Mohr-Coulomb, tension cut-off or their corner); returns
-    ``plastic``."""
+    ``(plastic, outputs)``."""
     P_tr, Q_tr, pos, sign, c_mc, c_psi = _trial(theta, gamma, theta_p, gamma_p, K, G, lam,
                                                 lam_psi)
     # surface normals a_k, flow vectors g_k and stress corrections d_k = E g_k
@@ -241,18 +236,16 @@ def _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_
         T01 = -(d10 * (i00 * A01 + i01 * A11) + d20 * (i10 * A01 + i11 * A11))
         T10 = -(d11 * (i00 * A00 + i01 * A10) + d21 * (i10 * A00 + i11 * A10))
         T11 = E11 - (d11 * (i00 * A01 + i01 * A11) + d21 * (i10 * A01 + i11 * A11))
-    out[7] = theta_p + m1 * g10 + m2 * g20
-    out[8] = gamma_p + m1 * g11_ + m2 * g21_
-    _finish_point(P_tr - m1 * d10 - m2 * d20, Q_tr - m1 * d11 - m2 * d21, T00, T01, T10, T11,
-                  lam, tau, J, out)
-    return not elastic
+    return not elastic, _finish_point(P_tr - m1 * d10 - m2 * d20, Q_tr - m1 * d11 - m2 * d21,
+                                      T00, T01, T10, T11, lam, tau, J,
+                                      theta_p + m1 * g10 + m2 * g20,
+                                      gamma_p + m1 * g11_ + m2 * g21_)
 
 
 @njit(cache=True, error_model="numpy")
-def _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap,
-                  out):
+def _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap):
     """Three-surface return (Mohr-Coulomb, Tresca cap, tension cut-off; one surface or a
-    corner of two) from the trial state; returns ``plastic``.
+    corner of two) from the trial state; returns ``(plastic, outputs)``.
 
     The active set is the first of MC, cap, TC, MC+cap, MC+TC, cap+TC (single surfaces only
     where the trial state violates them) whose multipliers are positive and whose returned
@@ -326,35 +319,34 @@ def _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, te
                 T11 = E11 - (d1[i] * x1 + d1[j] * y1)
             if worst <= tol:
                 break
-    out[7] = theta_p + m[0] * g0[0] + m[1] * g0[1] + m[2] * g0[2]
-    out[8] = gamma_p + m[0] * g1[0] + m[1] * g1[1] + m[2] * g1[2]
-    _finish_point(P_tr - m[0] * d0[0] - m[1] * d0[1] - m[2] * d0[2],
-                  Q_tr - m[0] * d1[0] - m[1] * d1[1] - m[2] * d1[2], T00, T01, T10, T11,
-                  lam, tau, J, out)
-    return not elastic
+    return not elastic, _finish_point(P_tr - m[0] * d0[0] - m[1] * d0[1] - m[2] * d0[2],
+                                      Q_tr - m[0] * d1[0] - m[1] * d1[1] - m[2] * d1[2],
+                                      T00, T01, T10, T11, lam, tau, J,
+                                      theta_p + m[0] * g0[0] + m[1] * g0[1] + m[2] * g0[2],
+                                      gamma_p + m[0] * g1[0] + m[1] * g1[1] + m[2] * g1[2])
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def return_point(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap, out):
-    """Return map of one point from its total log strains; writes :data:`OUTPUTS` into
-    ``out`` (length 9) and returns whether the point is plastic in this step.
+def return_point(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap):
+    """Return map of one point from its total log strains: ``(plastic, outputs)``, whether the
+    point is plastic in this step and the tuple of its :data:`OUTPUTS`.
 
     ``cap`` is the Tresca cap ``tau_max`` (Pa) on ``|sigma_r - sigma_theta|``; ``inf`` (no
     cap) takes exactly the Mohr-Coulomb/tension code path (the cap tests are false)."""
     theta = eps_r + 2.0 * eps_t
     gamma = eps_r - eps_t
     J = math.exp(theta)
-    plastic, multi = _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
-                                         lam_psi, tension, out)
+    plastic, multi, out = _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam,
+                                              tau, lam_psi, tension)
     if multi:
-        plastic = _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
-                                       lam_psi, tension, out)
+        plastic, out = _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
+                                            lam_psi, tension)
     if cap < np.inf:
         capJ = cap * J
         tol = 1e-12 * tau * J
         trial_deviator = 2.0 * G * abs(gamma - gamma_p)
         if trial_deviator - capJ > tol or abs(out[1] - out[0]) - capJ > tol:
-            plastic = _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
-                                    lam_psi, tension, cap, out)
-        out[6] = max(out[6], abs(out[1] - out[0]) / capJ)
-    return plastic
+            plastic, out = _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
+                                         lam_psi, tension, cap)
+        out = out[:6] + (max(out[6], abs(out[1] - out[0]) / capJ),) + out[7:]
+    return plastic, out

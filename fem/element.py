@@ -53,7 +53,6 @@ def assemble_cases(u, Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_we
     """
     nb = element_dofs.shape[1]
     nq = R_points.shape[1]
-    out = np.empty(9)
     C = np.empty((4, nq))
     Br = np.empty((nb, nq))
     Bt = np.empty((nb, nq))
@@ -82,14 +81,13 @@ def assemble_cases(u, Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_we
         scale = 0.0
         for e in range(e0, e1):
             for q in range(nq):
-                plastic[e, q] = return_point(math.log1p(Gr[e, q]), math.log1p(Gt[e, q]),
-                                             theta_p[e, q], gamma_p[e, q], K[e, q], G[e, q],
-                                             lam[e, q], tau[e, q], lam_psi[e, q],
-                                             tension[e, q], cap[e, q], out)
+                plastic[e, q], out = return_point(
+                    math.log1p(Gr[e, q]), math.log1p(Gt[e, q]), theta_p[e, q], gamma_p[e, q],
+                    K[e, q], G[e, q], lam[e, q], tau[e, q], lam_psi[e, q], tension[e, q],
+                    cap[e, q])
                 tau_r[e, q] = out[0]
                 tau_t[e, q] = out[1]
-                for i in range(4):
-                    C[i, q] = out[2 + i]
+                C[0, q], C[1, q], C[2, q], C[3, q] = out[2], out[3], out[4], out[5]
                 yield_ratio[e, q] = out[6]
                 th_p_new[e, q] = out[7]
                 ga_p_new[e, q] = out[8]

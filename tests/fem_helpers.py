@@ -19,11 +19,11 @@ from cavex.fem.constitutive import OUTPUTS, PointMaterial, return_point
 @njit(cache=True, error_model="numpy")
 def _return_points(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap, out,
                    plastic):
-    row = np.empty(9)
     for i in range(eps_r.size):
-        plastic[i] = return_point(eps_r[i], eps_t[i], theta_p[i], gamma_p[i], K[i], G[i],
-                                  lam[i], tau[i], lam_psi[i], tension[i], cap[i], row)
-        out[:, i] = row
+        plastic[i], row = return_point(eps_r[i], eps_t[i], theta_p[i], gamma_p[i], K[i], G[i],
+                                       lam[i], tau[i], lam_psi[i], tension[i], cap[i])
+        for j in range(9):
+            out[j, i] = row[j]
 
 
 def return_map(eps_r, eps_t, theta_p, gamma_p, material):
