@@ -30,8 +30,11 @@ that is not counted, so numba's cache is warm) of
 
 and, for ``penetrate`` and ``trajectory``, the command's median with ``--no-figures``, the
 median of the same computation in one process and their difference (the issue's floor: at most
-0.4 s), and the time the figures add to each command (median with figures less median without:
-drawing, saving and importing matplotlib).
+0.4 s, read strictly: the computation timed with every import done and numba's kernels
+loaded), the command against the same job run through the API in a fresh process (the
+budget's parts summed: the issue's own yardstick, "the same job through the API in one Python
+process, imports included"), and the time the figures add to each command (median with
+figures less median without: drawing, saving and importing matplotlib).
 
 Run as ``python benchmarks/commands.py [--runs N] [--no-figure-runs]`` from the repository
 root; the figures measured on this machine are in benchmarks/commands.md.
@@ -253,6 +256,12 @@ def main():
         print(f"cavex {command} --no-figures: {total:.3f} s, in process {seconds:.3f} s, "
               f"difference {total - seconds:.3f} s (floor {FLOOR} s); over '{floor_name}' "
               f"({yardstick[floor_name]:.3f} s): {total - yardstick[floor_name]:.3f} s")
+    for command, b in budgets.items():
+        api = sum(b[name] for name in BUDGET_PARTS)
+        print(f"cavex {command} --no-figures over the same job through the API in a fresh "
+              f"process (imports and numba's kernels included, as the issue timed it): "
+              f"{b['the command']:.3f} s against {api:.3f} s, difference "
+              f"{b['the command'] - api:.3f} s (floor {FLOOR} s)")
     for command in computation if args.figures else ():
         extra = measured[command, "--figures"] - measured[command, "--no-figures"]
         print(f"cavex {command}: the figures add {extra:.3f} s (median with less median "
