@@ -108,13 +108,18 @@ def _element(e, Gr, Gt, C, tau_r, tau_t, element_dofs, dNdR, N, R_points, weight
         W = weights[e, q]
         inv_r = 1.0 / (1.0 + Gr[e, q])
         inv_t = 1.0 / (R_points[e, q] * (1.0 + Gt[e, q]))
+        c_rr = C[0, q] - tau_r[e, q]
+        c_rt = C[1, q]
+        c_tr = C[2, q]
+        c_tt = C[3, q] - tau_t[e, q]
+        W2 = 2.0 * W
         for b in range(nb):
             br = dNdR[e, b, q] * inv_r                     # d eps_r / d u_b
             bt = N[b, q] * inv_t                           # d eps_t / d u_b
             Br[b, q] = br
             Bt[b, q] = bt
-            X[b, q] = W * ((C[0, q] - tau_r[e, q]) * br + C[1, q] * bt)
-            Y[b, q] = 2.0 * W * (C[2, q] * br + (C[3, q] - tau_t[e, q]) * bt)
+            X[b, q] = W * (c_rr * br + c_rt * bt)
+            Y[b, q] = W2 * (c_tr * br + c_tt * bt)
     for a in range(nb):
         row = element_dofs[e, a]
         fe = 0.0
@@ -122,7 +127,8 @@ def _element(e, Gr, Gt, C, tau_r, tau_t, element_dofs, dNdR, N, R_points, weight
             fe += weights[e, q] * (tau_r[e, q] * Br[a, q] + 2.0 * tau_t[e, q] * Bt[a, q])
         f[row] += fe
         for b in range(nb):
+            col = element_dofs[e, b]
             k = 0.0
             for q in range(nq):
                 k += Br[a, q] * X[b, q] + Bt[a, q] * Y[b, q]
-            band[p + row - element_dofs[e, b], element_dofs[e, b]] += k
+            band[p + row - col, col] += k
