@@ -5,6 +5,7 @@ compiling is announced once (issue 21, item 1)."""
 
 import argparse
 import io
+import os
 import subprocess
 import sys
 from importlib.metadata import entry_points
@@ -146,19 +147,40 @@ def test_a_table_is_read_without_xarray(command, tmp_path):
 
 
 def test_the_program_leaves_its_objects_to_the_exit():
-    """The installed ``cavex`` runs :func:`console`: :func:`main`'s exit code, with the
-    collector at ``GC_THRESHOLDS`` and what the command left frozen (``gc.freeze``), so that
-    the collections do not walk numba's and scipy's objects again and again (the time:
+    """The installed ``cavex`` runs :func:`cavex.__main__.console`: :func:`main`'s exit code,
+    with the collector at ``GC_THRESHOLDS`` and what the command left frozen (``gc.freeze``),
+    so that the collections do not walk numba's and scipy's objects again and again (the time:
     benchmarks/commands.py)."""
     scripts = entry_points(group="console_scripts", name="cavex")
-    assert [s.value for s in scripts] == ["cavex.verification.cli:console"]
-    probe = ("import gc, sys; from cavex.verification.cli import console; "
+    assert [s.value for s in scripts] == ["cavex.__main__:console"]
+    probe = ("import gc, sys; from cavex.__main__ import console; "
              "sys.argv[1:] = ['stress', '--velocity', '-1', '--depth', '0.3']; "
              "code = console(); print(code, gc.get_freeze_count() > 0, gc.get_threshold())")
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                           timeout=120, check=True)
     code, frozen, thresholds = done.stdout.strip().split(" ", 2)
     assert (code, frozen, thresholds) == ("2", "True", str(GC_THRESHOLDS))
+
+
+@pytest.mark.parametrize("given, expected", [(None, "1"), ("2", "2")])
+def test_the_program_runs_openblas_without_its_threads(given, expected):
+    """The program sets ``OPENBLAS_NUM_THREADS`` to 1 before numpy loads (a user's setting
+    wins): numpy's and scipy's OpenBLAS then start no thread pool, which would only spin
+    beside the work (measured: benchmarks/commands.md); the process has one thread."""
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    if given is not None:
+        env["OPENBLAS_NUM_THREADS"] = given
+    probe = ("import os, sys; from cavex.__main__ import console; "
+             "sys.argv[1:] = ['stress', '--velocity', '500', '--depth', '0.3', '--json']; "
+             "code = console(); import scipy.linalg; "
+             "print(code, 'numpy' in sys.modules, os.environ['OPENBLAS_NUM_THREADS'], "
+             "len(os.listdir('/proc/self/task')), file=sys.stderr)")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          timeout=120, check=True, env=env)
+    code, loaded, threads, tasks = done.stderr.split()
+    assert (code, loaded, threads) == ("0", "True", expected)
+    if given is None and sys.platform.startswith("linux"):
+        assert tasks == "1"
 
 
 def test_python_dash_m_cavex_is_the_command_line():

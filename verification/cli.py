@@ -317,7 +317,8 @@ GC_THRESHOLDS = (70_000, 10, 10)
 
 
 def console():
-    """The ``cavex`` program (its console script and ``python -m cavex``): :func:`main`; returns
+    """The ``cavex`` program (its console script and ``python -m cavex`` run it through
+    :func:`cavex.__main__.console`, which first sets OpenBLAS's threads): :func:`main`; returns
     its exit code.
 
     The collector runs at :data:`GC_THRESHOLDS` (worker processes forked by a command inherit
