@@ -21,10 +21,10 @@ is not timed: the sampling competes with the run for the cores).
 Run it as a user's machine would: with Python writing its bytecode caches (an environment
 that sets ``PYTHONDONTWRITEBYTECODE`` compiles cavex's sources at every start).
 
-``--baseline PYTHON`` also runs ``PYTHON -m cavex.verification.cli table`` (another checkout's
-environment, e.g. the main branch's) in turn with this one, A B A B ..., and prints the median
-of the pairwise ratios: on a shared machine whose speed drifts, the ratio of neighbouring runs
-is steadier than either median.
+``--baseline PYTHON`` also runs ``PYTHON -m cavex table`` (the program as the ``cavex``
+command runs it, in another checkout's environment, e.g. the main branch's) in turn with this
+one, A B A B ..., and prints the median of the pairwise ratios: on a shared machine whose
+speed drifts, the ratio of neighbouring runs is steadier than either median.
 
 Run: ``python benchmarks/table.py [--repeats 3] [--workers N] [--grids issue 1200]
 [--baseline /path/to/other/venv/bin/python]``.
@@ -83,7 +83,7 @@ def run_once(velocities, depths, workers, out, python=sys.executable, sample_mem
     memory every 50 ms reads /proc for every process and competes with the run for the two
     cores (measured: ~10 % of the wall time of the issue grid); the peak memory comes from a
     separate run that is not timed."""
-    command = [python, "-m", "cavex.verification.cli", "table", "-o", out]
+    command = [python, "-m", "cavex", "table", "-o", out]
     if velocities is not None:
         command += ["--velocities", *map(str, velocities), "--depths", *map(str, depths)]
     if workers:
