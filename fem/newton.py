@@ -141,29 +141,40 @@ def newton(stack, w, params, dynamic, tol):
     to be used).
     """
     k = stack.n_cases
-    u = predict(stack, w, dynamic)
-    f, band, resp, folded, force_scale = stack.new_buffers()
-    a, r_free, du = np.zeros(stack.ndof), np.zeros(stack.ndof), np.zeros(stack.ndof)
-    jac = np.zeros_like(band)
-    scale, r_max = np.zeros(k), np.zeros(k)
+    u, f, band, resp, folded, force_scale, a, r_free, du, jac, scale, r_max, gradients = \
+        newton_buffers(stack)
     status = np.where(w.active, 0, 1).astype(np.int64)
     iterations, evaluations = np.zeros(k, dtype=np.int64), np.zeros(k, dtype=np.int64)
-    gradients = (np.zeros(stack.R_points.shape), np.zeros(stack.R_points.shape))
     m, p = stack.material, params
-    iterate(u, w.u0, w.v0, w.a0, w.f0, w.theta_p, w.gamma_p, w.load, w.dt, tol,
-            MAX_ITERATIONS, STALL_ITERATIONS, stack.element_dofs, stack.dNdR, stack.N,
-            stack.R_points, stack.weights, stack.force_weights, m.K, m.G, m.lam, m.tau,
-            m.lam_psi, m.tension, m.cap, stack.el_start, stack.el_count, stack.degree,
-            stack.mass_band, stack.dof_start, stack.dof_count, stack.free, stack.R_dofs,
-            stack.fixed_entries, stack.fixed_diagonal, p.alpha_m, p.alpha_f, p.beta, dynamic,
-            stack.pressure_control, stack.outer_fixed, *gradients, f, band, resp.tau_r,
-            resp.tau_t, resp.theta_p, resp.gamma_p, resp.plastic, resp.yield_ratio, folded,
-            force_scale, a, r_free, jac, scale, r_max, du, status, iterations, evaluations)
-    reasons = np.full(k, None, dtype=object)
-    for c in np.flatnonzero(status != 1):
-        reasons[c] = FAILURES.get(int(status[c]))
+    iterate(u, w.u0, w.v0, w.a0, w.f0, w.du_prev, w.theta_p, w.gamma_p, w.load, w.dt,
+            w.dt_old, w.has_prev, tol, MAX_ITERATIONS, STALL_ITERATIONS, stack.element_dofs,
+            stack.dNdR, stack.N, stack.R_points, stack.weights, stack.force_weights, m.K, m.G,
+            m.lam, m.tau, m.lam_psi, m.tension, m.cap, stack.el_start, stack.el_count,
+            stack.degree, stack.mass_band, stack.dof_start, stack.dof_count, stack.free,
+            stack.R_dofs, stack.fixed_entries, stack.fixed_diagonal, p.alpha_m, p.alpha_f,
+            p.beta, dynamic, stack.pressure_control, stack.outer_fixed, *gradients, f, band,
+            resp.tau_r, resp.tau_t, resp.theta_p, resp.gamma_p, resp.plastic,
+            resp.yield_ratio, folded, force_scale, a, r_free, jac, scale, r_max, du, status,
+            iterations, evaluations)
+    reasons = [FAILURES.get(code) for code in status.tolist()]
     iterations[status != 1] = 0
     return u, a, f, resp, iterations, reasons, evaluations
+
+
+def newton_buffers(stack):
+    """The arrays :func:`newton` works in, made once per stack and reused by every call on it
+    (every value a call returns is written by that call; the solver copies what it keeps
+    before the next call): ``(u, f, band, response, folded, force_scale, a, r_free, du, jac,
+    scale, r_max, gradients)``."""
+    if not hasattr(stack, "_newton_buffers"):
+        f, band, resp, folded, force_scale = stack.new_buffers()
+        shape = stack.R_points.shape
+        stack._newton_buffers = (np.zeros(stack.ndof), f, band, resp, folded, force_scale,
+                                 np.zeros(stack.ndof), np.zeros(stack.ndof),
+                                 np.zeros(stack.ndof), np.zeros_like(band),
+                                 np.zeros(stack.n_cases), np.zeros(stack.n_cases),
+                                 (np.zeros(shape), np.zeros(shape)))
+    return stack._newton_buffers
 
 
 @njit(cache=True, error_model="numpy")
@@ -180,21 +191,24 @@ def stalls(relative, best, stalled, c, limit):
 
 
 @njit(cache=True, error_model="numpy")
-def iterate(u, u0, v0, a0, f0, theta_p, gamma_p, load, dt, tol, max_iterations,
-            stall_iterations, element_dofs, dNdR, N, R_points, weights, force_weights, K, G,
-            lam, tau, lam_psi, tension, cap, el_start, el_count, p, mass_band, dof_start,
-            dof_count, free, R_dofs, fixed_entries, fixed_diagonal, alpha_m, alpha_f, beta,
-            dynamic, pressure, outer_fixed, Gr, Gt, f, band, tau_r, tau_t, th_p_new, ga_p_new,
-            plastic, yield_ratio, folded, force_scale, a, r_free, jac, scale, r_max, du,
-            status, iterations, evaluations):
+def iterate(u, u0, v0, a0, f0, du_prev, theta_p, gamma_p, load, dt, dt_old, has_prev, tol,
+            max_iterations, stall_iterations, element_dofs, dNdR, N, R_points, weights,
+            force_weights, K, G, lam, tau, lam_psi, tension, cap, el_start, el_count, p,
+            mass_band, dof_start, dof_count, free, R_dofs, fixed_entries, fixed_diagonal,
+            alpha_m, alpha_f, beta, dynamic, pressure, outer_fixed, Gr, Gt, f, band, tau_r,
+            tau_t, th_p_new, ga_p_new, plastic, yield_ratio, folded, force_scale, a, r_free,
+            jac, scale, r_max, du, status, iterations, evaluations):
     """Compiled body of :func:`newton`: the iterations of every case with ``status`` 0 from
-    the iterate ``u`` (updated in place, as every output). Per iteration: the kernel
+    the predictor (:func:`predict_cases`, written into ``u``, which is then updated in place,
+    as every output). Per iteration: the kernel
     (:func:`cavex.fem.element.assemble_cases`), the step equations (:func:`step_equations`),
     the rules (folded, non-finite, :func:`converged`, stall), the banded solve
     (:func:`cavex.fem.banded.solve_blocks`, fixed dofs as identity rows) and the update.
     ``status`` per case on return: 1 converged (``iterations`` = Newton solves), else the
     failure code of :data:`FAILURES`; ``evaluations`` is incremented per kernel pass."""
     k = dof_start.size
+    predict_cases(u, u0, v0, du_prev, load, dt, dt_old, has_prev, status == 0, dof_start,
+                  dof_count, free, dynamic, pressure)
     done = status != 0
     best = np.full(k, np.inf)
     stalled = np.zeros(k, dtype=np.int64)
@@ -266,6 +280,17 @@ def iterate(u, u0, v0, a0, f0, theta_p, gamma_p, load, dt, tol, max_iterations,
 
 
 def predict(stack, w, dynamic):
+    """First Newton iterate of every active case (:func:`predict_cases`), a new array."""
+    u = np.empty(stack.ndof)
+    predict_cases(u, w.u0, w.v0, w.du_prev, w.load, w.dt, w.dt_old, w.has_prev, w.active,
+                  stack.dof_start, stack.dof_count, stack.free, dynamic,
+                  stack.pressure_control)
+    return u
+
+
+@njit(cache=True, error_model="numpy")
+def predict_cases(u, u0, v0, du_prev, load, dt, dt_old, has_prev, active, dof_start, dof_count,
+                  free, dynamic, pressure):
     """First Newton iterate of every active case; the wall at its prescribed displacement
     under displacement control.
 
@@ -276,21 +301,30 @@ def predict(stack, w, dynamic):
     by ``dt / dt_old`` the predictor lags, and on the issue grid's quasi-static cases the wall
     ratio saves 41 % of the residual evaluations and three quarters of the cut-backs
     (docs/fem.md, "Time-step policy"). Dynamic, ``u0 + dt v0`` would save 8 % but excites the
-    spurious modes of an undamped run (``rho_inf = 1``)."""
-    dof_case = stack.dof_case
-    u0 = w.u0
-    u = u0.copy()
-    if not stack.pressure_control:
-        u[stack.wall] = w.load
-    if dynamic or stack.pressure_control:
-        ratio = w.dt / w.dt_old
-    else:
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = (w.load - u0[stack.wall]) / w.du_prev[stack.wall]
-        ratio = np.where(np.isfinite(ratio), ratio, 1.0)
-    guess = u0 + w.dt[dof_case] * w.v0 if dynamic else u0
-    predicted = np.where(w.has_prev[dof_case], u0 + ratio[dof_case] * w.du_prev, guess)
-    return np.where(stack.free & w.active[dof_case], predicted, u)
+    spurious modes of an undamped run (``rho_inf = 1``).
+
+    Written into ``u``; the prescribed dofs (and every dof of an inactive case) keep ``u0``,
+    the wall its prescribed displacement ``load`` under displacement control."""
+    for c in range(dof_start.size):
+        s0, m = dof_start[c], dof_count[c]
+        if dynamic or pressure:
+            ratio = dt[c] / dt_old[c]
+        else:
+            ratio = (load[c] - u0[s0]) / du_prev[s0]
+            if not np.isfinite(ratio):
+                ratio = 1.0
+        for i in range(s0, s0 + m):
+            if free[i] and active[c]:
+                if has_prev[c]:
+                    u[i] = u0[i] + ratio * du_prev[i]
+                elif dynamic:
+                    u[i] = u0[i] + dt[c] * v0[i]
+                else:
+                    u[i] = u0[i]
+            elif i == s0 and not pressure:
+                u[i] = load[c]
+            else:
+                u[i] = u0[i]
 
 
 def equations(stack, w, params, dynamic, u, f, band, force_scale, skip=None, out=None):

@@ -297,7 +297,7 @@ class RadialSolver:
                 if reasons[i] is None:
                     u[sdofs], a[sdofs], f[sdofs] = su, sa, sf
                     replace_points(resp, selements, sresp)
-        ok = active & np.equal(reasons, None).astype(bool)
+        ok = active & np.array([r is None for r in reasons])
         return (u, a, f, resp), ok, iterations, reasons, evaluations
 
     def _commit(self, stack, cases, dofs, elements, ok, w, trial):
