@@ -15,9 +15,9 @@ above an error target are policies of :mod:`cavex.fem.estimate`, applied here to
 alike.
 """
 
+import dataclasses
 import math
 import time
-from dataclasses import asdict
 
 import numpy as np
 
@@ -181,7 +181,9 @@ def _result(solver, c, problem, vertices, numerics, error, seconds, recorder):
     layers, interfaces, velocity, radius = problem.as_tuple()
     one = solver.case(c)
     disc = one.disc
-    settings = {"layers": [asdict(m) for m in layers], "interfaces": [float(h) for h in interfaces],
+    settings = {"layers": [{f.name: getattr(m, f.name) for f in dataclasses.fields(m)}
+                           for m in layers],
+                "interfaces": [float(h) for h in interfaces],
                 "velocity": float(velocity), "radius": float(radius),
                 "numerics": numerics.as_dict()}
     stats = {"elements": disc.n_elements, "dofs": disc.ndof,

