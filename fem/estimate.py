@@ -40,16 +40,24 @@ def richardson_error_from_finer(result, finer, order=ORDER, refinement=REFINEMEN
     return abs(result - finer) * q / (q - 1.0) / abs(result)
 
 
-def estimate_errors(problems, results, numerics, run):
+def estimate_errors(problems, results, numerics, run, known=None):
     """Set ``error_estimate`` and the companion's ``stats`` on every successful result.
 
     ``run(problems, numerics)`` runs problems without estimates (a list of results). A case
     whose companions both fail gets the companion's error; where neither companion is in the
     accepted numerics (a run at the finest settings accepted), the estimate stays None.
+    ``known`` (optional, per problem): a successful run at ``numerics.coarsened()`` already
+    made (the run a refinement starts from, :func:`refine_above`), used as the coarse
+    companion instead of running it again (the same bits: a case computes the same alone and
+    in any stack); None where there is none.
     """
+    known = [None] * len(problems) if known is None else known
     todo = [i for i, r in enumerate(results) if r.ok]
     if numerics.can_coarsen():
-        coarse = run([problems[i] for i in todo], numerics.coarsened())
+        missing = [i for i in todo if known[i] is None]
+        ran = dict(zip(missing, run([problems[i] for i in missing], numerics.coarsened())
+                       if missing else [], strict=True))
+        coarse = [known[i] if known[i] is not None else ran[i] for i in todo]
     else:
         coarse = [None] * len(todo)
     retry = [i for i, c in zip(todo, coarse, strict=True) if c is None or not c.ok]
@@ -65,7 +73,8 @@ def estimate_errors(problems, results, numerics, run):
         result = results[i]
         result.stats[f"{kind}_cavity_stress"] = companion.cavity_stress
         result.stats["error_companion"] = kind
-        result.stats["seconds"] += companion.stats["seconds"]
+        if companion is not known[i]:  # a known companion cost nothing here
+            result.stats["seconds"] += companion.stats["seconds"]
         if not companion.ok:
             result.error = companion.error
             result.cavity_stress = result.plastic_radius = float("nan")
@@ -84,14 +93,20 @@ def refined(numerics, factor=REFINEMENT):
 
 def refine_above(problems, results, numerics, target, max_refinements, run_estimated):
     """Re-run (in place in ``results``) the cases estimated above ``target`` at twice the
-    resolution, up to ``max_refinements`` times; ``stats["refinements"]`` counts them."""
+    resolution, up to ``max_refinements`` times; ``stats["refinements"]`` counts them.
+
+    ``run_estimated(problems, numerics, known)`` runs with error estimates; ``known`` are the
+    runs being refined, which are the refined runs' coarse companions (the refined settings
+    coarsened are the settings refined, to the bit: the factors are powers of 2)."""
     for refinement in range(1, max_refinements + 1):
         redo = [i for i, r in enumerate(results) if r.ok and r.error_estimate is not None
                 and r.error_estimate > target]
         if not redo or not numerics.can_coarsen(1.0 / REFINEMENT):
             return
-        numerics = refined(numerics)
-        for i, r in zip(redo, run_estimated([problems[i] for i in redo], numerics),
+        previous, numerics = numerics, refined(numerics)
+        companions = numerics.coarsened() == replace(previous, error_estimate=False)
+        known = [results[i] for i in redo] if companions else None
+        for i, r in zip(redo, run_estimated([problems[i] for i in redo], numerics, known),
                         strict=True):
             r.stats["refinements"] = refinement
             results[i] = r

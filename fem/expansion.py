@@ -305,11 +305,11 @@ def expand_problems(problems, numerics, *, batch_size=DEFAULT_BATCH, on_error="r
     def run(subset, numerics):
         return run_problems(subset, numerics, batch_size, record)
 
-    def run_estimated(subset, numerics):
+    def run_estimated(subset, numerics, known=None):
         results = run(subset, numerics)
         if numerics.error_estimate:
             estimate_errors(subset, results, numerics,
-                            lambda p, n: run_problems(p, n, batch_size))
+                            lambda p, n: run_problems(p, n, batch_size), known)
         return results
 
     results = run_estimated(problems, numerics)

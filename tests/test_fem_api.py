@@ -9,6 +9,7 @@ import pytest
 from cavex import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
 from cavex.fem import expand_cavity, write_result
+from cavex.fem.estimate import richardson_error
 from cavex.materials import Material
 from cavex.verification.fedata.comparison import compare_at_depth
 
@@ -170,3 +171,31 @@ def test_error_estimate_falls_back_to_a_finer_run_where_the_coarse_one_fails(mon
                            growth_per_step=0.0075, error_estimate=False)
     actual = abs(result.cavity_stress / finest.cavity_stress - 1.0)
     assert 0.5 * actual <= estimate <= 2.0 * actual
+
+
+def test_a_refinement_takes_the_run_it_refines_as_its_coarse_companion(monkeypatch):
+    """A case refined (estimate above the target) is run at twice the resolution; its coarse
+    companion is the run it refines, not run again: the runs made are the settings' (30
+    elements per decade), its companion (15) and the refined run (60), and the refined run's
+    estimate rests on the first run's wall stress, to the bit."""
+    from cavex.fem import expand_cavities, expansion
+
+    settings = []
+    run_problems = expansion.run_problems
+
+    def recorded(problems, numerics, *args, **kwargs):
+        if problems:  # (a finer companion for no case is an empty call)
+            settings.append(numerics.elements_per_decade)
+        return run_problems(problems, numerics, *args, **kwargs)
+
+    monkeypatch.setattr(expansion, "run_problems", recorded)
+    first = expand_cavity([CONCRETE], [], 500.0, 0.0125)
+    assert settings == [30.0, 15.0]
+    settings.clear()
+    [refined] = expand_cavities([([CONCRETE], [], 500.0, 0.0125)], error_target=1e-6,
+                                max_refinements=1)
+    assert settings == [30.0, 15.0, 60.0]
+    assert refined.stats["refinements"] == 1
+    assert refined.stats["error_companion"] == "coarse"
+    assert refined.stats["coarse_cavity_stress"] == first.cavity_stress
+    assert refined.error_estimate == richardson_error(refined.cavity_stress, first.cavity_stress)
