@@ -173,7 +173,7 @@ def fe_cases(chunk):
     fe_record`'s dict plus ``"id"``, or the exception the case failed with.
 
     The cases that share their numerics and error target run together
-    (:func:`~cavex.verification.fedata.comparison.fe_records`: stacks of the one FE solver); a
+    (:func:`~cavex.verification.fedata.fe_record.fe_records`: stacks of the one FE solver); a
     case computes the same bits in any chunk. The closed forms are not evaluated here: they
     are evaluated once where the results are kept
     (:func:`~cavex.verification.fedata.comparison.closed_forms`).
@@ -184,7 +184,7 @@ def fe_cases(chunk):
         Built cases (:func:`make_fe_cases`), or descriptions (module docstring), which are
         built here: a bad one fails alone.
     """
-    from cavex.verification.fedata.comparison import fe_records
+    from cavex.verification.fedata.fe_record import fe_records
 
     out = [None] * len(chunk)
     build = CaseBuilder()

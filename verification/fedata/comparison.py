@@ -3,7 +3,7 @@
 The FE side runs on the one solver of :mod:`cavex.fem` (all problems of a call in stacks), with
 the default error target: a problem whose estimated discretisation error exceeds
 :data:`cavex.fem.estimate.DEFAULT_ERROR_TARGET` is refined (up to twice) until it does not.
-Its record (:func:`fe_record`) is what an FE case returns.
+Its record (:func:`cavex.verification.fedata.fe_record.fe_record`) is what an FE case returns.
 
 The closed-form side (:func:`closed_forms`) is evaluated once per problem and convention
 through the array form of :func:`cavex.analytic.cavity.cavity_solution`, for all problems of a
@@ -20,47 +20,16 @@ from cavex.fem.output import write_result
 from cavex.fem.settings import make_numerics
 from cavex.problem import BOUNDARIES
 from cavex.verification.fedata.cases import fe_problem
+from cavex.verification.fedata.fe_record import fe_record
 from cavex.verification.output.number_format import FE_DIGITS
 from cavex.verification.output.paths import check_output_dir
 
-#: Numerics settings renamed in JSON output (their unit appended)
-NUMERICS_JSON_KEYS = {"seed_radius": "seed_radius_m", "tension_cutoff": "tension_cutoff_Pa"}
 #: Keys of a comparison record, in order (the FE record's and the closed forms')
 COMPARISON_KEYS = ("depth_m", "velocity_m_s", "cavity_radius_m", "layers", "interface_radii_m",
                    "interface_radii_final_m", "fe_sigma_r_Pa", "S", "analytic_sigma_r_Pa",
                    "relative_difference", "error_estimate", "refinements",
                    "fe_plastic_radius_m", "analytic_plastic_radius_m", "numerics",
                    "wall_time_s")
-
-
-def fe_records(depths, problems, numerics, error_target=DEFAULT_ERROR_TARGET):
-    """FE runs of checked ``problems`` (nose-tip ``depths``) with one
-    :class:`~cavex.fem.Numerics`: per problem its :func:`fe_record`, or the
-    :class:`~cavex.errors.CavexNumericalError` of a failed FE run."""
-    results = expand_problems(problems, numerics, error_target=error_target,
-                              max_refinements=MAX_REFINEMENTS)
-    return [fe_record(depth, problem, result) if result.ok else result.error
-            for depth, problem, result in zip(depths, problems, results, strict=True)]
-
-
-def fe_record(depth, problem, result):
-    """The JSON-able record of one FE result (the FE side of :func:`compare_at_depth`)."""
-    layers, interfaces, velocity, radius = problem.as_tuple()
-    fe = result.cavity_stress
-    return {
-        "depth_m": float(depth), "velocity_m_s": float(velocity),
-        "cavity_radius_m": float(radius),
-        "layers": [m.name or f"layer {i}" for i, m in enumerate(layers)],
-        "interface_radii_m": [float(h) for h in interfaces],
-        "interface_radii_final_m": [float(h) for h in result.interfaces_final],
-        "fe_sigma_r_Pa": float(fe),
-        "S": float(fe / layers[0].tau),
-        "error_estimate": None if result.error_estimate is None else float(result.error_estimate),
-        "refinements": int(result.stats["refinements"]),
-        "fe_plastic_radius_m": float(result.plastic_radius),
-        "numerics": numerics_json(result.numerics),
-        "wall_time_s": float(result.stats["seconds"]),
-    }
 
 
 def closed_forms(problems, boundaries=BOUNDARIES):
@@ -120,13 +89,6 @@ def with_closed_forms(records, problems):
     closed = closed_forms([problems[r["id"]].as_tuple() for r in ok])
     done = {id(r): comparison_record(r, closed, i) for i, r in enumerate(ok)}
     return [done.get(id(r), r) for r in records]
-
-
-def numerics_json(numerics):
-    """:class:`cavex.fem.Numerics` settings (a dict) with the JSON key convention: the
-    dimensional ones carry their unit (``seed_radius_m``, ``tension_cutoff_Pa``; README
-    "Commands"), the others are dimensionless (``dilatancy_deg`` already names its unit)."""
-    return {NUMERICS_JSON_KEYS.get(k, k): v for k, v in numerics.items()}
 
 
 def compare_at_depth(target, projectile, depth, velocity, nu=None,
