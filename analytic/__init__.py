@@ -17,9 +17,9 @@ _WHERE = {
     "paper_stress": "paper_model",
     "Trajectory": "penetration.integrator", "penetrate": "penetration.integrator",
     "nose_force": "penetration.nose", "ogive_coefficients": "penetration.nose",
-    "Strike": "penetration.oblique", "fly": "penetration.oblique",
+    "Strike": "penetration.oblique", "fly": "models",
     "ClosedFormResistance": "penetration.resistance",
-    "make_resistance": "penetration.resistance",
+    "make_resistance": "models", "make_law": "models",
 }
 
 __all__ = sorted(_WHERE)

@@ -25,9 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
+from cavex.analytic.models import make_law
 from cavex.analytic.penetration.body import AZIMUTHS, NOSE_POINTS, SHANK_RINGS, build_body
 from cavex.analytic.penetration.oblique import CONTACT_RAMP, RTOL, ObliqueModel, Strike
-from cavex.analytic.penetration.stress_laws import make_law
 from cavex.config import load_config
 
 STRIKE = Strike(800.0, obliquity=30.0)

@@ -344,6 +344,15 @@ class Projectile:
         require(is_finite_number(self.mu) and 0.0 <= self.mu <= MAX_FRICTION, "mu",
                 f"in [0, {MAX_FRICTION:g}]", self.mu)
 
+    @classmethod
+    def tangent_ogive(cls, mass, diameter, crh, V0):
+        """The projectile of a shot as published: mass (kg), shank ``diameter`` (m), a tangent
+        ogive of calibre-radius-head ``crh`` and ``V0`` (m/s): ``r = d/2``, ``R = crh d`` and
+        ``l`` the tangent ogive's nose length ``r sqrt(4 crh - 1)`` (it places the cavity
+        centre at the nose base)."""
+        r = 0.5 * diameter
+        return cls(r=r, l=r * math.sqrt(4.0 * crh - 1.0), m=mass, V0=V0, R=crh * diameter)
+
     @property
     def psi(self):
         """Calibre-radius-head ``psi = R / (2 r)``."""

@@ -1,4 +1,4 @@
-"""The predictive concrete model (verification/validation/concrete_model.py) and the committed
+"""The predictive concrete model (analytic/penetration/concrete_table.py) and the committed
 study (results/concrete, made by verification/studies/concrete_validation.py)."""
 
 import csv
@@ -9,18 +9,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cavex.verification.studies import concrete_validation as study
-from cavex.verification.validation import empirical
-from cavex.verification.validation.concrete_model import (
+from cavex.analytic import empirical
+from cavex.analytic.empirical import crater_calibres, li_chen_depth
+from cavex.analytic.penetration.concrete_table import (
     TableResistance,
     concrete_cavity,
-    crater_calibres,
-    li_chen_depth,
     model_depth,
-    rigid_flag,
     table_depth,
-    tensile_strength,
 )
+from cavex.concrete import tensile_strength
+from cavex.verification.studies import concrete_validation as study
+from cavex.verification.validation.regimes import rigid_flag
 from cavex.verification.validation.shots import read_shots, shot_projectile
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -7,8 +7,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from cavex.analytic.penetration.oblique import ObliqueModel, Strike, fly
-from cavex.analytic.penetration.stress_laws import make_law
+from cavex.analytic.models import fly, make_law
+from cavex.analytic.penetration.oblique import ObliqueModel, Strike
 from cavex.analytic.penetration.surface_force import mirror_state, surface_loads
 from cavex.config import load_config
 

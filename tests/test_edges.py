@@ -11,10 +11,10 @@ import tomllib
 
 import pytest
 
+from cavex.concrete import Mapping
 from cavex.config import default_config_text, toml_comment, toml_string
 from cavex.verification.cli import main
 from cavex.verification.validation.calibration import fit, read_calibration
-from cavex.verification.validation.concrete import Mapping
 from cavex.verification.validation.predict import predict
 from cavex.verification.validation.shots import parse_shots
 
@@ -304,8 +304,8 @@ def test_penetrate_gives_the_depth_where_the_crater_stops_the_projectile(tmp_pat
     """Once a numerical failure ("projectile stops inside the crater"); now the crater's K L
     force with K L_c = F(0) brings it to rest at sqrt(m V0^2 L_c / F(0)), to round-off, and the
     depth is continuous with the tunnel branch at the threshold (1e-6 relative apart there)."""
+    from cavex.analytic.models import make_resistance
     from cavex.analytic.penetration.integrator import STOPPED, crater_depth, penetrate
-    from cavex.analytic.penetration.resistance import make_resistance
     from cavex.config import load_config
 
     target, projectile = load_config()

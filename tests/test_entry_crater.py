@@ -12,7 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from cavex.analytic.penetration.oblique import Strike, fly
+from cavex.analytic.models import fly
+from cavex.analytic.penetration.oblique import Strike
 from cavex.analytic.penetration.surface_force import rotation_matrix, surface_loads
 from cavex.analytic.penetration.zones import crater_depth, open_zones
 from cavex.config import load_config

@@ -603,7 +603,8 @@ def test_an_interrupt_wrapped_by_compiled_code_is_an_interrupt():
 
 
 def test_a_run_that_reaches_the_time_limit_ends_there():
-    from cavex.analytic.penetration.oblique import MAX_TIME, Strike, fly
+    from cavex.analytic.models import fly
+    from cavex.analytic.penetration.oblique import MAX_TIME, Strike
 
     target, projectile = load_config()
     result = fly(target.single(0), projectile, Strike(1000.0), "law", law_A=0.0, law_B=0.0)

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import pytest
 
+from cavex.concrete import Mapping
 from cavex.config import default_config_text, load_config
 from cavex.verification.cli import main
 from cavex.verification.fedata.batch import parse_sweep
@@ -24,7 +25,6 @@ from cavex.verification.validation.calibration import (
     calibration_text,
     read_calibration,
 )
-from cavex.verification.validation.concrete import Mapping
 from cavex.verification.validation.shots import read_shots
 
 SHOTS = Path(__file__).resolve().parents[1] / "examples" / "shots_forrestal1994.csv"

@@ -10,9 +10,10 @@ import pytest
 from scipy.optimize import brentq
 
 from cavex.analytic.cavity import cavity_stress
+from cavex.analytic.models import make_resistance
 from cavex.analytic.penetration.integrator import crater_stage, penetrate
 from cavex.analytic.penetration.nose import nose_rule
-from cavex.analytic.penetration.resistance import ClosedFormResistance, make_resistance
+from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.analytic.penetration.zones import crater_depth, open_zones, scab_depth
 from cavex.config import config_text, default_config_text, fingerprint, load_config, parse_config
 from cavex.errors import CavexInputError
@@ -243,7 +244,8 @@ def test_derived_law_sees_the_open_faces_element_by_element(default, bottoms):
 
 @pytest.fixture(scope="module")
 def oblique_pair(debonded):
-    from cavex.analytic.penetration.oblique import Strike, fly
+    from cavex.analytic.models import fly
+    from cavex.analytic.penetration.oblique import Strike
 
     target, projectile = debonded
     runs = {}
@@ -305,7 +307,8 @@ def test_axial_overload_peaks_after_the_debonded_interface(oblique_pair, debonde
 
 
 def test_debonded_shot_mirrors_to_the_last_bit(debonded):
-    from cavex.analytic.penetration.oblique import Strike, fly
+    from cavex.analytic.models import fly
+    from cavex.analytic.penetration.oblique import Strike
     from cavex.analytic.penetration.surface_force import mirror_state
 
     target, projectile = debonded
@@ -324,7 +327,8 @@ def test_debonded_work_is_the_kinetic_energy_lost(debonded):
     """The zones switch the load at events, not inside a step: the work of the surface
     forces still balances the kinetic energy lost, to the integrator's global error (the
     bonded bound of tests/test_oblique.py at rtol 1e-5: 5e-4)."""
-    from cavex.analytic.penetration.oblique import Strike, fly
+    from cavex.analytic.models import fly
+    from cavex.analytic.penetration.oblique import Strike
 
     target, projectile = debonded
     result = fly(target, projectile, Strike(700.0, 30.0, attack=3.0, attack_plane=40.0,

@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 from cli_helpers import refused
 
-from cavex.analytic.penetration.oblique import Strike, fly
-from cavex.analytic.penetration.stress_laws import LayerPlainLaw, PlainLaw, make_law
+from cavex.analytic.models import fly, make_law
+from cavex.analytic.penetration.oblique import Strike
+from cavex.analytic.penetration.stress_laws import LayerPlainLaw, PlainLaw
 from cavex.config import config_text, default_config_text, fingerprint, load_config, parse_config
 from cavex.errors import CavexInputError
 from cavex.verification.cli import main

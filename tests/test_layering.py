@@ -6,8 +6,9 @@ Floors, bottom to top (README "Where things are"):
 - ``core/`` (``cavex``): errors, input files, materials, config, the spherical problem, lazy
   package names, the netCDF-3 format; imports no other part of cavex;
 - ``analytic/`` and ``fem/`` side by side, each on ``core/`` only; inside ``analytic/`` the
-  closed forms (``cavity``, ``paper_model``, ``geometry``) sit below the penetration feature
-  (``analytic/penetration/``);
+  closed forms (``cavity``, ``paper_model``, ``geometry``, ``concrete_cavity``,
+  ``empirical``) sit below the penetration feature (``analytic/penetration/``), and the model
+  registry (``analytic/models/``: one module a model) above both;
 - ``verification/``: ``output/`` (file formats) at the bottom, then ``fedata/`` (FE data
   production), then ``report/`` and ``validation/`` (which use ``fedata/`` but not each
   other), then ``studies/`` (which may use ``validation/``: a study of the validation data),
@@ -23,15 +24,20 @@ ROOT = Path(__file__).resolve().parents[1]
 FOLDERS = {"core": "cavex", "analytic": "cavex.analytic", "fem": "cavex.fem",
            "verification": "cavex.verification"}
 CORE = ("cavex.__init__", "cavex.errors", "cavex.input_files", "cavex.materials", "cavex.config",
-        "cavex.problem", "cavex.lazy", "cavex.netcdf3")
+        "cavex.problem", "cavex.lazy", "cavex.netcdf3", "cavex.concrete")
+#: analytic's floors below the model registry: the closed forms, then the penetration feature
+CLOSED_FORMS = ("cavex.analytic.cavity", "cavex.analytic.geometry", "cavex.analytic.paper_model",
+                "cavex.analytic.concrete_cavity", "cavex.analytic.empirical",
+                "cavex.analytic.states")
 V = "cavex.verification."
 
 # module prefix -> prefixes it may import (the first matching rule, longest prefix first)
 ALLOWED = {
     "cavex.analytic.__init__": CORE + ("cavex.analytic",),  # the floor's public API
-    "cavex.analytic.penetration": CORE + ("cavex.analytic",),
-    "cavex.analytic": CORE + ("cavex.analytic.cavity", "cavex.analytic.geometry",
-                              "cavex.analytic.paper_model"),
+    # the registry of models: one module a model, above the code it runs
+    "cavex.analytic.models": CORE + ("cavex.analytic",),
+    "cavex.analytic.penetration": CORE + CLOSED_FORMS + ("cavex.analytic.penetration",),
+    "cavex.analytic": CORE + CLOSED_FORMS,
     "cavex.fem": CORE + ("cavex.fem",),
     V + "output": CORE + (V + "output",),
     V + "fedata": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata"),
@@ -114,3 +120,63 @@ def test_the_rule_catches_an_upward_import(tmp_path):
     bad.write_text("def f():\n    from cavex.verification.fedata import table\n")
     prefixes = ALLOWED[rule("cavex.config")]
     assert not all(permitted(t, prefixes) for t in cavex_imports("cavex.config", bad))
+
+
+def import_graph(modules=MODULES):
+    """module -> the cavex modules it imports (function-level imports included)."""
+    return {module: cavex_imports(module, path) for module, path in modules}
+
+
+def import_circles(graph):
+    """The strongly connected components of ``graph`` with more than one module (or a module
+    that imports itself): every import circle (Tarjan's algorithm, iterative)."""
+    index, low, on_stack, stack, circles, counter = {}, {}, set(), [], [], [0]
+    for root in graph:
+        if root in index:
+            continue
+        work = [(root, iter(sorted(graph.get(root, ()))))]
+        index[root] = low[root] = counter[0]
+        counter[0] += 1
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is None:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    component = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        component.append(member)
+                        if member == node:
+                            break
+                    if len(component) > 1 or node in graph.get(node, ()):
+                        circles.append(sorted(component))
+                continue
+            if child not in graph:
+                continue
+            if child not in index:
+                index[child] = low[child] = counter[0]
+                counter[0] += 1
+                stack.append(child)
+                on_stack.add(child)
+                work.append((child, iter(sorted(graph[child]))))
+            elif child in on_stack:
+                low[node] = min(low[node], index[child])
+    return circles
+
+
+def test_no_import_circle():
+    """No module reaches itself through imports, function-level ones included (a lazy import
+    hides a circle from the interpreter, not from this walk)."""
+    assert import_circles(import_graph()) == []
+
+
+def test_the_walk_finds_a_circle():
+    """The checker itself: a -> b -> c -> a and d -> d are circles, e -> a is not."""
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"d"}, "e": {"a"}}
+    assert sorted(import_circles(graph)) == [["a", "b", "c"], ["d"]]

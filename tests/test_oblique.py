@@ -7,12 +7,13 @@ import numpy as np
 import pytest
 
 from cavex.analytic.cavity import cavity_stress
+from cavex.analytic.models import fly, make_law
 from cavex.analytic.penetration.body import build_body
 from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.nose import ogive_coefficients
-from cavex.analytic.penetration.oblique import ObliqueModel, Strike, fly
+from cavex.analytic.penetration.oblique import ObliqueModel, Strike
 from cavex.analytic.penetration.resistance import ClosedFormResistance
-from cavex.analytic.penetration.stress_laws import DerivedLaw, make_law
+from cavex.analytic.penetration.stress_laws import DerivedLaw
 from cavex.analytic.penetration.surface_force import rotation_matrix
 from cavex.config import load_config
 

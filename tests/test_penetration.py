@@ -21,6 +21,13 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.interpolate import BPoly
 
+from cavex.analytic.models import (
+    OLD_LABELS,
+    labels,
+    make_resistance,
+    model_label,
+    parse_model_label,
+)
 from cavex.analytic.paper_model import paper_coefficients, paper_phase_depths
 from cavex.analytic.penetration.integrator import (
     crater_depth,
@@ -30,15 +37,7 @@ from cavex.analytic.penetration.integrator import (
     penetrate,
 )
 from cavex.analytic.penetration.plain_law import PlainLawResistance
-from cavex.analytic.penetration.resistance import (
-    MODEL_LABELS,
-    OLD_LABELS,
-    ClosedFormResistance,
-    Resistance,
-    make_resistance,
-    model_label,
-    parse_model_label,
-)
+from cavex.analytic.penetration.resistance import ClosedFormResistance, Resistance
 from cavex.analytic.penetration.tabulated import TabulatedResistance
 from cavex.config import load_config
 from cavex.errors import CavexInputError
@@ -392,9 +391,9 @@ def test_paper_model_phases_follow_paper_phase_depths(default, epsilon):
 # --- the one resistance vocabulary (issue 18) ---------------------------------------------------
 
 def test_model_labels_round_trip_and_old_labels_name_the_new_one():
-    for label in MODEL_LABELS:
+    for label in labels(fits_mapping=True):
         assert model_label(*parse_model_label(label)) == label
-    assert [parse_model_label(label) for label in MODEL_LABELS] == [
+    assert [parse_model_label(label) for label in labels(fits_mapping=True)] == [
         ("derived", "quasi-static"), ("derived", "dynamic"), ("paper", None), ("table", None)]
     assert model_label("derived") == "derived-dynamic"  # the default boundary
     assert model_label("paper", "quasi-static") == "paper"

@@ -28,6 +28,7 @@ import numpy as np
 import pytest
 from cli_helpers import refused
 
+from cavex.analytic.models import fly, make_resistance
 from cavex.analytic.penetration import integrator
 from cavex.analytic.penetration.body import build_body
 from cavex.analytic.penetration.integrator import (
@@ -37,9 +38,8 @@ from cavex.analytic.penetration.integrator import (
     integrate,
     penetrate,
 )
-from cavex.analytic.penetration.oblique import Strike, fly
+from cavex.analytic.penetration.oblique import Strike
 from cavex.analytic.penetration.plain_law import PlainLawResistance
-from cavex.analytic.penetration.resistance import make_resistance
 from cavex.config import config_text, load_config
 from cavex.errors import CavexInputError
 from cavex.materials import Target

@@ -159,9 +159,10 @@ def test_quick_axes_reach_the_crater_and_the_striking_velocity(runway):
 
 def test_penetration_titles(runway, figures, tmp_path):
     target, projectile = runway
-    title = penetration_report.resistance_title
-    assert title("derived", "dynamic", "quasi-static") == "derived model, dynamic boundary"
-    paper = title("paper", "quasi-static", "cylindrical-sigma_c")
+    from cavex.analytic.models import get
+
+    assert get("derived").describe("dynamic", "quasi-static") == "derived model, dynamic boundary"
+    paper = get("paper").describe("quasi-static", "cylindrical-sigma_c")
     assert "boundary" not in paper and "cylindrical-sigma_c" in paper
     path = tmp_path / "a" / "very" / "long" / "folder" / "table.nc"
     write_table(analytic_table(target, projectile, [0.0, 300.0, 700.0, 1200.0],

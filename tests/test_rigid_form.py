@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cavex.analytic.empirical import li_chen_depth
 from cavex.verification.studies import rigid_form
-from cavex.verification.validation.concrete_model import li_chen_depth
 from cavex.verification.validation.shots import read_shots
 
 ROOT = Path(__file__).resolve().parents[1]

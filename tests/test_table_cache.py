@@ -17,9 +17,8 @@ from cavex.verification.fedata.table_cache import (
     max_bytes,
     prune,
 )
-from cavex.verification.validation.concrete import shot_target
 from cavex.verification.validation.predict import TableCache, table_velocities
-from cavex.verification.validation.shots import read_shots, shot_projectile
+from cavex.verification.validation.shots import read_shots, shot_projectile, shot_target
 
 SHOTS = Path(__file__).resolve().parents[1] / "examples" / "shots_forrestal1994.csv"
 

@@ -9,7 +9,8 @@ import matplotlib.image
 import numpy as np
 import pytest
 
-from cavex.analytic.penetration.oblique import Strike, fly
+from cavex.analytic.models import fly
+from cavex.analytic.penetration.oblique import Strike
 from cavex.config import load_config
 from cavex.verification.cli import main
 from cavex.verification.studies.oblique_study import RAMPS, findings, overload_peaks, table_csv

@@ -6,8 +6,8 @@ import tomllib
 import numpy as np
 import pytest
 
-from cavex.analytic.penetration.oblique import ObliqueModel, Strike, fly
-from cavex.analytic.penetration.stress_laws import make_law
+from cavex.analytic.models import fly, make_law
+from cavex.analytic.penetration.oblique import ObliqueModel, Strike
 from cavex.analytic.penetration.surface_force import surface_loads
 from cavex.config import config_text, default_config_text, fingerprint, load_config, parse_config
 from cavex.errors import CavexInputError

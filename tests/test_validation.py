@@ -20,20 +20,15 @@ import tomllib
 import numpy as np
 import pytest
 
+from cavex.analytic import empirical
 from cavex.analytic.penetration.integrator import crater_depth, penetrate
 from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.analytic.penetration.tabulated import TabulatedResistance
+from cavex.concrete import Mapping, aci_modulus, concrete_material
 from cavex.errors import CavexInputError
 from cavex.verification.cli import main
 from cavex.verification.fedata.table import analytic_table
-from cavex.verification.validation import empirical
 from cavex.verification.validation.calibration import fit, read_calibration
-from cavex.verification.validation.concrete import (
-    Mapping,
-    aci_modulus,
-    concrete_material,
-    shot_target,
-)
 from cavex.verification.validation.predict import (
     TABLE_DEPTHS,
     closed_form_depth,
@@ -41,7 +36,13 @@ from cavex.verification.validation.predict import (
     ratio_statistics,
     table_velocities,
 )
-from cavex.verification.validation.shots import Shot, parse_shots, read_shots, shot_projectile
+from cavex.verification.validation.shots import (
+    Shot,
+    parse_shots,
+    read_shots,
+    shot_projectile,
+    shot_target,
+)
 
 SHOTS = "examples/shots_forrestal1994.csv"
 COLUMNS = "id,mass_kg,diameter_m,length_m,crh,V0_m_s,fc_Pa,rho_kg_m3,depth_m"
@@ -411,11 +412,13 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
 def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
     """``--models concrete li-chen-concrete forrestal-1994``: those three columns and nothing
     else, in JSON, CSV and report; the concrete model's depths are
-    :func:`concrete_model.model_depth`'s, the recommended model's
-    :func:`concrete_model.split_depth`'s (Li and Chen up to 100 MPa, above the concrete
+    :func:`model_depth`'s, the recommended model's
+    :mod:`cavex.analytic.models.li_chen_concrete`'s (Li and Chen up to 100 MPa, above the concrete
     model's); the recommended model and its sentence are there."""
+    from cavex.analytic.empirical import li_chen_depth
+    from cavex.analytic.models.li_chen_concrete import SPLIT_STRENGTH
+    from cavex.analytic.penetration.concrete_table import model_depth
     from cavex.verification.commands.validate import recommendation
-    from cavex.verification.validation import concrete_model
 
     out_dir = tmp_path / "val"
     code, out, err = run(capsys, "validate", "--shots", SHOTS, "--models", "concrete",
@@ -430,11 +433,11 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
     shots = read_shots(SHOTS).shots
     for row, shot in zip(result["shots"], shots, strict=True):
         assert set(row["predicted_m"]) == {"concrete", "li-chen-concrete", "forrestal-1994"}
-        split = (concrete_model.li_chen_depth(shot) if shot.fc <= 100e6
+        split = (li_chen_depth(shot) if shot.fc <= SPLIT_STRENGTH
                  else row["predicted_m"]["concrete"])  # F94-41 and F94-46 are above
         assert row["predicted_m"]["li-chen-concrete"] == pytest.approx(split, rel=DIGITS_6)
         assert row["predicted_m"]["concrete"] == pytest.approx(
-            concrete_model.model_depth(shot), rel=DIGITS_6)
+            model_depth(shot), rel=DIGITS_6)
         assert row["predicted_m"]["forrestal-1994"] == pytest.approx(
             empirical.shot_depth(shot), rel=DIGITS_6)
     header = (out_dir / "predictions.csv").read_text().splitlines()[0].split(",")
@@ -450,9 +453,11 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
 def test_validate_reports_by_regime(capsys, tmp_path):
     """Every regime's statistics recomputed here from the per-shot JSON (the regime of a shot
     from its f_c, V0 and flag written beside it), Li and Chen's column equal to
-    :func:`concrete_model.li_chen_depth`, the flag equal to :func:`concrete_model.rigid_flag`,
+    :func:`li_chen_depth`, the flag equal to :func:`rigid_flag`,
     the regime table in the report and both regime figures written."""
-    from cavex.verification.validation import concrete_model
+    from cavex.analytic.empirical import li_chen_depth
+    from cavex.analytic.penetration.concrete_table import TableResistance
+    from cavex.verification.validation.regimes import rigid_flag
 
     out_dir = tmp_path / "val"
     code, out, err = run(capsys, "validate", "--shots", SHOTS, "--models", "concrete",
@@ -462,9 +467,9 @@ def test_validate_reports_by_regime(capsys, tmp_path):
     shots = read_shots(SHOTS).shots
     for row, shot in zip(result["shots"], shots, strict=True):
         assert row["predicted_m"]["li-chen-2003"] == pytest.approx(
-            concrete_model.li_chen_depth(shot), rel=DIGITS_6)
-        assert row["flag"] == concrete_model.rigid_flag(
-            shot, concrete_model.TableResistance(shot))
+            li_chen_depth(shot), rel=DIGITS_6)
+        assert row["flag"] == rigid_flag(
+            shot, TableResistance(shot))
     members = {"all": lambda r: True,
                "normal_strength": lambda r: r["fc_Pa"] <= 100e6 and r["V0_m_s"] <= 1000.0,
                "fast": lambda r: r["V0_m_s"] > 1000.0,

@@ -11,10 +11,15 @@ import signal
 import sys
 
 from cavex import __version__
-from cavex.analytic.penetration.labels import VALIDATION_LABELS
+from cavex.analytic.models import labels
 from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
-from cavex.verification.commands.options import add_interface_option, add_resistance_options
+from cavex.verification.commands.options import (
+    CLOSED_FORMS,
+    FLOWN,
+    add_interface_option,
+    add_resistance_options,
+)
 
 DEFAULT_PENETRATION_DIR = "results/penetration"
 
@@ -61,7 +66,7 @@ def build_parser():
     commands = parser.add_subparsers(dest="command", parser_class=_Parser, metavar="COMMAND")
     penetrate = commands.add_parser("penetrate", help="integrate the projectile through the target")
     _config(penetrate)
-    add_resistance_options(penetrate, ("derived", "paper", "table", "law"))
+    add_resistance_options(penetrate, FLOWN)
     add_interface_option(penetrate)
     penetrate.add_argument("--json", action="store_true", help="print JSON")
     penetrate.add_argument("--out", default=DEFAULT_PENETRATION_DIR, help="output folder")
@@ -70,7 +75,7 @@ def build_parser():
                            help="where the crater depth 4.5 r is measured from")
     stress = commands.add_parser("stress", help="cavity-wall stress at a nose depth")
     _config(stress)
-    add_resistance_options(stress, ("derived", "paper"), table=False)
+    add_resistance_options(stress, CLOSED_FORMS, table=False)
     stress.add_argument("--json", action="store_true", help="print JSON")
     stress.add_argument("--velocity", type=float, required=True, help="expansion velocity V (m/s)")
     stress.add_argument("--depth", type=float, required=True, help="nose-tip depth L (m)")
@@ -124,7 +129,7 @@ def build_parser():
                           help="calibration TOML file(s) from `cavex calibrate` (default: "
                           "none, the uncalibrated models only)")
     validate.add_argument("--models", nargs="+", action="extend", metavar="NAME",
-                          help="run only these models: " + ", ".join(VALIDATION_LABELS)
+                          help="run only these models: " + ", ".join(labels(predicts_shots=True))
                           + " (default: all; calibrations add their columns)")
     validate.add_argument("--json", action="store_true", help="print JSON")
     validate.add_argument("--out", help="output folder (default results/validation)")
@@ -142,7 +147,7 @@ def build_parser():
                             help="plane of the angle of attack about the velocity (deg; 0: "
                             "in the plane of obliquity toward +x)")
     trajectory.add_argument("--spin", type=float, default=0.0, help="spin about the axis (rad/s)")
-    add_resistance_options(trajectory, ("derived", "paper", "table", "law"))
+    add_resistance_options(trajectory, FLOWN)
     add_interface_option(trajectory)
     trajectory.add_argument("--contact-ramp", dest="contact_ramp", type=float, default=None,
                             help="contact regularisation: the stress rises linearly over "

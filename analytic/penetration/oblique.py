@@ -32,8 +32,8 @@ from cavex.analytic.penetration.rosenbrock import (
     initial_step,
     integrate,
 )
-from cavex.analytic.penetration.stress_laws import OK, make_law, raise_for
-from cavex.analytic.penetration.strike import Strike
+from cavex.analytic.penetration.stress_laws import OK, raise_for
+from cavex.analytic.penetration.strike import Strike  # noqa: F401 (re-exported)
 from cavex.analytic.penetration.surface_force import (
     derivative,
     mirror_state,
@@ -457,28 +457,6 @@ class ObliqueModel:
             history[f"moment_{c}_N_m"] = moments[:, j]
         history["work_J"] = Y[13]
         return history
-
-
-def fly(target, projectile, strike=None, resistance="derived", *, body=None, bottom=None,
-        rtol=RTOL, atol=ATOL, method=METHOD, contact_ramp=None, progress=None,
-        tangency_psi=0.0, entry_crater=False, crater="nose-base", contact_hold=0.0,
-        hold_time=None, **law_options):
-    """One trajectory: :class:`Result` of ``strike`` (default: normal incidence at ``V0``);
-    ``progress(t, y)`` is called after every integrator step; ``entry_crater``: the shank
-    carries no load in the entry crater ``[0, L_c]`` (zones.open_zones; docs/oblique.md);
-    ``crater``: where ``L_c`` of the entry and interface craters is measured from
-    (zones.crater_depth); ``contact_hold`` (m, > 0): the held contact instead of the velocity
-    ramp (docs/oblique.md "Held contact")."""
-    strike = strike or Strike(projectile.V0)
-    require(resistance == "derived" or not target.debonded, "interfaces",
-            "'bonded' unless the resistance is 'derived' (a debonded interface needs its "
-            "traction-free sphere)", "debonded")
-    law = make_law(target, projectile, resistance, bottom=bottom, **law_options)
-    model = ObliqueModel(target, projectile, law, body=body, bottom=bottom, rtol=rtol,
-                         atol=atol, method=method, contact_ramp=contact_ramp,
-                         tangency_psi=tangency_psi, entry_crater=entry_crater,
-                         crater=crater, contact_hold=contact_hold, hold_time=hold_time)
-    return model.run(strike, progress=progress)
 
 
 PEAK_RISE = 0.05  # of the peak's own value

@@ -34,7 +34,7 @@ import numpy as np
 
 from cavex.analytic.penetration.nose import QUADRATURE_POINTS, angle_rule, nose_rule
 from cavex.analytic.penetration.resistance import Resistance
-from cavex.analytic.penetration.stress_laws import make_law
+from cavex.analytic.penetration.stress_laws import plain_law
 from cavex.errors import CavexInputError, require
 
 SURFACE_NAME = "air"  # what the label calls the rings above the surface
@@ -60,7 +60,7 @@ class PlainLawResistance(Resistance):
                 "interface needs the derived closed form's traction-free sphere)", "debonded")
         require(isinstance(points, int) and points >= 1, "points", "an integer >= 1", points)
         self.target, self.projectile = target, projectile
-        self.law = make_law(target, projectile, "law", law_A=law_A, law_B=law_B)
+        self.law = plain_law(target, law_A, law_B)
         phi, _, _ = angle_rule(float(projectile.R), float(projectile.r), points)
         self._cosines, self._weights = nose_rule(projectile, points)
         # the rings' distances behind the tip, tip first (xi_k grows with phi_k)

@@ -21,47 +21,13 @@ import numpy as np
 from cavex.analytic.cavity import material_table, nose_walk, state_label
 from cavex.analytic.geometry import spherical_problem, surrounding
 from cavex.analytic.paper_model import PaperModel
-from cavex.analytic.penetration.labels import (  # noqa: F401 (the vocabulary, re-exported)
-    DEFAULT_BOUNDARY,
-    FLIGHT_RESISTANCES,
-    MODEL_LABELS,
-    MODELS,
-    OLD_LABELS,
-    PAPER_BOUNDARY,
-    PLAIN_LAW,
-    RESISTANCES,
-    check_model,
-    label_options,
-    model_boundary,
-    model_label,
-    parse_model_label,
-)
 from cavex.analytic.penetration.nose import nose_rule, ogive_coefficients
 from cavex.errors import CavexNumericalError, require, require_choice
+from cavex.problem import BOUNDARIES
 
 RECENT = 32  # (depth, velocity) answers kept
+CLOSED_FORMS = ("derived", "paper")  # the two closed forms this module evaluates
 
-
-def make_resistance(target, projectile, resistance="derived", boundary=None,
-                    epsilon="quasi-static", table=None, *, law_A=None, law_B=None):
-    """The 1-D resistance object for ``resistance`` (:data:`FLIGHT_RESISTANCES`):
-    :class:`ClosedFormResistance` for "derived" (``boundary``) and "paper" (``epsilon``),
-    :class:`~cavex.analytic.penetration.tabulated.TabulatedResistance` of ``table`` (a Dataset
-    or the path of a table file, built for this target) for "table",
-    :class:`~cavex.analytic.penetration.plain_law.PlainLawResistance` for "law" (the global
-    ``law_A`` Pa, ``law_B`` kg/m^3, or neither: each layer's ``law_A``, ``law_B`` keys)."""
-    require_choice(resistance, FLIGHT_RESISTANCES, "resistance")
-    if resistance == PLAIN_LAW:
-        from cavex.analytic.penetration.plain_law import PlainLawResistance
-
-        return PlainLawResistance(target, projectile, law_A, law_B)
-    if resistance != "table":
-        return ClosedFormResistance(target, projectile, resistance, boundary, epsilon=epsilon)
-    from cavex.analytic.penetration.tabulated import TabulatedResistance, read_table
-
-    require(table is not None, "table", "given with resistance 'table'", table)
-    data = table if hasattr(table, "attrs") else read_table(table)
-    return TabulatedResistance(data, target, projectile)
 
 @runtime_checkable
 class Resistance(Protocol):
@@ -117,18 +83,23 @@ class ClosedFormResistance(Resistance):
 
     def __init__(self, target, projectile, model="derived", boundary=None,
                  switch=None, epsilon="quasi-static"):
-        check_model(model, boundary)
-        require(model == "derived" or not target.debonded, "interfaces",
+        require_choice(model, CLOSED_FORMS, "model")
+        paper = model == "paper"
+        if boundary is not None:
+            require_choice(boundary, BOUNDARIES, "boundary")
+        require(not paper or boundary in (None, "quasi-static"), "boundary",
+                "'quasi-static' for the paper model", boundary)
+        require(not paper or not target.debonded, "interfaces",
                 "'bonded' for the paper model (a debonded interface needs the derived closed "
                 "form's traction-free sphere)", "debonded")
-        boundary = model_boundary(model, boundary)
+        boundary = boundary or ("quasi-static" if paper else "dynamic")
         self.target, self.projectile = target, projectile
         self.model, self.boundary, self.epsilon = model, boundary, epsilon
-        self.switch = switch or ("cavity" if model == "derived" else "nose-tip")
+        self.switch = switch or ("nose-tip" if paper else "cavity")
         spherical_problem(target, projectile, 0.0, self.switch)  # validates the switch
         self._single = None if target.layers[1:] == () else ClosedFormResistance(
             target.single(0), projectile, model, boundary, switch, epsilon)
-        self._paper = PaperModel(target, projectile, epsilon) if model == "paper" else None
+        self._paper = PaperModel(target, projectile, epsilon) if paper else None
         n = len(target.layers)
         # the layers the cavity in layer i sees: down to the first debonded interface below
         # (its radius is then a traction-free sphere), else all (docs/analytic.md)

@@ -36,7 +36,6 @@ import numpy as np
 from numba import njit
 
 from cavex.analytic.cavity import FAILED, _point, material_table
-from cavex.analytic.penetration.labels import FLIGHT_RESISTANCES
 from cavex.errors import (
     CavexInputError,
     CavexNumericalError,
@@ -50,7 +49,6 @@ HORIZONTAL = 1e-12  # |n_z| below which a normal counts as horizontal
 FAR = 1e6  # m: interface radius standing for "never met"
 DEPTH_QUADRATIC, TABLE, DERIVED, LAYER_QUADRATIC = range(4)
 OK, WALK_FAILED, BEYOND_TABLE, NOT_FINITE = range(4)
-RESISTANCES = FLIGHT_RESISTANCES  # the laws: "derived", "paper", "table", "law"
 _EMPTY1 = np.empty(0)
 _EMPTY2 = np.empty((0, 0))
 _EMPTY3 = np.empty((0, 0, 6))
@@ -300,20 +298,9 @@ class LayerPlainLaw(_Law):
                      np.asarray(target.interface_depths, dtype=float))
 
 
-def make_law(target, projectile, resistance="derived", *, boundary="dynamic",
-             free_surface=True, table=None, law_A=None, law_B=None, epsilon="quasi-static",
-             bottom=None):
-    """The stress law for ``resistance`` (see the module docstring)."""
-    require(resistance in RESISTANCES, "resistance", "one of " + ", ".join(RESISTANCES),
-            resistance)
-    if resistance == "derived":
-        return DerivedLaw(target, projectile.r, boundary, free_surface, bottom)
-    if resistance == "paper":
-        return PaperLaw(target, projectile, epsilon)
-    if resistance == "table":
-        require(table is not None, "table", "given for --resistance table", None)
-        from cavex.analytic.penetration.tabulated import TabulatedResistance
-        return TableLaw(TabulatedResistance(table, target, projectile))
+def plain_law(target, law_A=None, law_B=None):
+    """The plain law: the global ``sigma_n = A + B V_n^2`` (:class:`PlainLaw`, both given),
+    else each layer's own (:class:`LayerPlainLaw`, neither given)."""
     if law_A is None and law_B is None:  # each layer's own law_A, law_B
         return LayerPlainLaw(target)
     require(law_A is not None and law_B is not None, "law_A", "given with law_B for "

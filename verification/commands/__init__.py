@@ -2,7 +2,7 @@
 
 Imports: a command refuses bad input before it loads the numerical libraries. A command
 module imports at its top only what its parser-side checks need (the standard library, numpy,
-cavex's core, the resistance vocabulary ``analytic.penetration.labels``, the output helpers);
+cavex's core, the model registry ``analytic.models``, the output helpers);
 whatever loads scipy, numba, matplotlib, xarray, scikit-fem or dask is imported inside the
 function that computes or draws, after the checks; the modules the checks live in
 (``fedata.table``, ``fedata.batch``, ``fedata.cases``, ``validation.predict``,

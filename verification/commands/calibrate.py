@@ -56,7 +56,7 @@ def job(shots, *, resistance="derived", boundary=None, params=None, workers=None
 
 def command_line(shots_path, out_path, model, params, ids=None):
     """The ``cavex calibrate`` command that writes this file (its comment)."""
-    from cavex.analytic.penetration.resistance import label_options
+    from cavex.analytic.models import label_options
 
     words = ["cavex", "calibrate", "--shots", str(shots_path), "--out", str(out_path),
              *label_options(model).split(), "--params", *params,

@@ -1,12 +1,12 @@
 """The one choice "which resistance" on the command line, shared by every command that makes it.
 
 Options (``penetrate``, ``stress``, ``trajectory``, ``calibrate``): ``--resistance`` one of
-:data:`cavex.analytic.penetration.resistance.RESISTANCES` (``penetrate`` and ``trajectory`` also
-``law``, with ``--law-A``/``--law-B``; ``stress`` only the closed forms), ``--boundary
+the registry's models (:mod:`cavex.analytic.models`: ``penetrate`` and ``trajectory`` every
+flown model, ``law`` with ``--law-A``/``--law-B``; ``stress`` only the closed forms), ``--boundary
 {dynamic,quasi-static}`` (the derived model's convention; default dynamic; the paper model
 keeps its own quasi-static and refuses another), ``--table FILE`` with ``table``,
 ``--epsilon`` (the paper model's reading of epsilon). Together they name one model label
-(:func:`cavex.analytic.penetration.resistance.model_label`; the plain law's is ``law``).
+(:meth:`cavex.analytic.models.registry.Model.label`; the plain law's is ``law``).
 
 The earlier spellings (``--model derived|paper``, ``--resistance closed-form``, ``calibrate
 --model derived-dynamic|derived-quasi-static|paper|fe-table``) are refused with one line that
@@ -15,37 +15,29 @@ names the new options (exit code 2).
 
 import argparse
 
+from cavex.analytic.models import DEFAULT_BOUNDARY, OLD_LABELS, get, label_options, labels, names
 from cavex.analytic.paper_model import EPSILON_READINGS
-from cavex.analytic.penetration.labels import (
-    MODEL_LABELS,
-    MODELS,
-    OLD_LABELS,
-    PLAIN_LAW,
-    RESISTANCES,
-    check_model,
-    label_options,
-    model_boundary,
-)
 from cavex.errors import CavexInputError
 from cavex.materials import BONDINGS
 from cavex.problem import BOUNDARIES
 
-CLOSED_FORMS = MODELS  # the resistances that are closed forms
+FLOWN = names(flies=True)  # penetrate, trajectory: every model with a resistance
+CLOSED_FORMS = names(closed_form=True)  # stress: the closed forms of the wall stress
+FITTED = names(fits_mapping=True)  # calibrate: the models of the (f_c, rho) mapping
 NEW_OPTIONS = "--resistance derived|paper|table (with --boundary dynamic|quasi-static)"
 #: old values of --resistance and --model that are no label, with what replaced them
 OLD_VALUES = {"closed-form": "--resistance derived or --resistance paper",
               "derived": "--resistance derived"}
 
 
-def add_resistance_options(command, offered=RESISTANCES, table=True, epsilon=True):
+def add_resistance_options(command, offered=FITTED, table=True, epsilon=True):
     """``--resistance`` (one of ``offered``), ``--boundary``, ``--table`` (if ``table``),
-    ``--epsilon`` (if ``epsilon``) and the refused ``--model``."""
+    ``--epsilon`` (if ``epsilon``), ``--law-A/--law-B`` (where a model offered takes them)
+    and the refused ``--model``."""
+    models = [get(name) for name in offered]
+    phrases = [m.help + (" (--epsilon)" if m.takes_epsilon and epsilon else "") for m in models]
     command.add_argument("--resistance", default="derived", metavar="{" + ",".join(offered) + "}",
-                         help="the resistance: the derived closed form (--boundary), the "
-                         "paper's printed model" + (" (--epsilon)" if epsilon else "")
-                         + (", an FE table (--table)" if "table" in offered else "")
-                         + (", sigma_n = A + B V_n^2 (--law-A, --law-B)" if "law" in offered
-                            else ""))
+                         help="the resistance: " + ", ".join(phrases))
     command.add_argument("--boundary", choices=BOUNDARIES,
                          help="yield-at-boundary convention of the derived model (default: "
                          "dynamic; the paper model has its own, quasi-static)")
@@ -56,7 +48,7 @@ def add_resistance_options(command, offered=RESISTANCES, table=True, epsilon=Tru
         command.add_argument("--epsilon", choices=EPSILON_READINGS,
                              help="the paper model's reading of epsilon (docs/table2.md) "
                              "(default: quasi-static)")
-    if PLAIN_LAW in offered:
+    if any(m.takes_law for m in models):
         add_law_options(command)
     command.add_argument("--model", dest="old_model", help=argparse.SUPPRESS)
 
@@ -73,25 +65,25 @@ def add_law_options(command):
 
 def law_settings(args, target):
     """``{"law_A", "law_B"}`` of the parsed ``--law-A``/``--law-B`` (None: each layer's own),
-    checked: both or neither, only with ``--resistance law``; without them every layer of
-    ``target`` has its ``law_A``, ``law_B`` keys (the first without is named); no
-    ``--boundary`` with the law. The values' ranges are checked where the law is made
-    (:class:`cavex.analytic.penetration.stress_laws.PlainLaw`)."""
+    checked: both or neither, only with a model that takes them (``--resistance law``); with
+    that model and without them every layer of ``target`` has its ``law_A``, ``law_B`` keys
+    (the first without is named); no ``--boundary`` with the law. The values' ranges are
+    checked where the law is made (:class:`cavex.analytic.penetration.stress_laws.PlainLaw`)."""
     law = [args.law_A is not None, args.law_B is not None]
-    if any(law) and not (all(law) and args.resistance == PLAIN_LAW):
+    takes_law = get(args.resistance).takes_law
+    if any(law) and not (all(law) and takes_law):
         raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
                               "'--resistance law' (both, or neither: each layer's law_A, "
                               "law_B keys)")
-    if args.resistance == PLAIN_LAW and not any(law):
+    if takes_law and not any(law):
         missing = next((i for i, plain in enumerate(target.plain_laws) if plain is None), None)
         if missing is not None:
             raise CavexInputError("must be given on every layer for '--resistance law' without "
                                   "'--law-A PA --law-B KG_PER_M3' (the layer's plain law "
                                   "S = A + B rho V^2 / tau; docs/config.md)",
                                   f"layers[{missing}].law_A")
-    if args.resistance == PLAIN_LAW and args.boundary is not None:
-        raise CavexInputError("option '--boundary' goes with '--resistance derived' (or table); "
-                              "'--resistance law' has no boundary convention")
+    if takes_law:
+        get(args.resistance).check(args.boundary)
     return {"law_A": args.law_A, "law_B": args.law_B}
 
 
@@ -100,43 +92,44 @@ def replaced(value):
     if value in OLD_VALUES:
         return OLD_VALUES[value]
     label = OLD_LABELS.get(value, value)
-    return label_options(label) if label in MODEL_LABELS else None
+    return label_options(label) if label in labels(fits_mapping=True) else None
 
 
-def resistance_settings(args, offered=RESISTANCES):
+def resistance_settings(args, offered=FITTED):
     """``{"resistance", "boundary", "epsilon", "table"}`` of the parsed options, checked: no
-    old spelling, the resistance is one of ``offered``, ``--table FILE`` goes with
-    ``--resistance table`` (both or neither, where the command has ``--table``: ``calibrate``
-    builds its own tables), the paper model takes only its own boundary, ``--epsilon`` only
-    with the paper model (default quasi-static). ``boundary`` is
-    resolved (for a table or a law the derived model's default: the first layer alone, where
-    it is flown, is derived)."""
+    old spelling, the resistance is one of ``offered``, ``--table FILE`` goes with a model that
+    takes a table (both or neither, where the command has ``--table``: ``calibrate`` builds its
+    own tables), the model takes the boundary given, ``--epsilon`` only with the model that
+    reads it (default quasi-static). ``boundary`` is resolved (for a table the first layer's
+    model's; the derived model's default for a model with no convention: the law)."""
     if args.old_model is not None:
         hint = replaced(args.old_model)
         raise CavexInputError(f"option --model was replaced by {NEW_OPTIONS}"
                               + (f"; for '{args.old_model}' use {hint}" if hint else ""))
     resistance = args.resistance
     if resistance not in offered:
-        hint = None if resistance in (*RESISTANCES, "law") else replaced(resistance)
+        hint = None if resistance in names() else replaced(resistance)
         if hint:
             raise CavexInputError(f"option --resistance {resistance} was replaced by {hint}")
+        refused = get(resistance) if resistance in names() else None
         raise CavexInputError(f"option --resistance must be one of {', '.join(offered)} (got "
                               f"{resistance!r})" + ("; a table is no closed form: `cavex fem` "
                                                     "gives the FE wall stress"
-                                                    if resistance == "table" else ""))
+                                                    if refused and refused.takes_table else ""))
+    model = get(resistance)
     table = getattr(args, "table", None)
-    if "table" in args and (resistance == "table") != (table is not None):
+    if "table" in args and model.takes_table != (table is not None):
         raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
                               "neither)")
-    if resistance in CLOSED_FORMS:
-        check_model(resistance, args.boundary)
+    if not model.takes_law:
+        model.check(args.boundary)
     epsilon = getattr(args, "epsilon", None)
-    if epsilon is not None and resistance != "paper":
+    if epsilon is not None and not model.takes_epsilon:
         raise CavexInputError(f"option '--epsilon' goes with '--resistance paper' (the paper "
                               f"model's reading of epsilon; got --resistance {resistance})")
     return {"resistance": resistance,
-            "boundary": model_boundary(resistance if resistance in CLOSED_FORMS else "derived",
-                                       args.boundary),
+            # a model without a convention (the law) carries the derived model's default
+            "boundary": model.boundary(args.boundary) or DEFAULT_BOUNDARY,
             "epsilon": epsilon or "quasi-static", "table": table}
 
 
@@ -153,10 +146,10 @@ def interface_target(args, target, resistance):
     """``target`` with ``--interfaces`` applied, checked: a debonded interface needs the
     derived closed form (the traction-free sphere of its rear face)."""
     target = target.with_interfaces(getattr(args, "interfaces", None))
-    if target.debonded and resistance != "derived":
+    if target.debonded and not get(resistance).debonded:
         raise CavexInputError(f"option --interfaces debonded (or a layer's bottom = "
-                              f"\"debonded\") goes with --resistance derived (got "
-                              f"--resistance {resistance})")
+                              f"\"debonded\") goes with --resistance "
+                              f"{names(debonded=True)[0]} (got --resistance {resistance})")
     return target
 
 
@@ -169,12 +162,3 @@ def refuse_debonded(target, command):
         raise CavexInputError(f"is \"debonded\", which `cavex {command}` does not model (the "
                               "spherical problem is one bonded continuum): remove the key, or "
                               "use penetrate or trajectory", f"layers[{j}].bottom")
-
-
-def law_echo(target, law_A, law_B):
-    """The plain law as the JSON settings of ``penetrate`` and ``trajectory`` give it: the
-    global ``{"A_Pa", "B_kg_m3"}``, or each layer's ``{"layer", "law_A", "law_B"}``."""
-    if law_A is not None:
-        return {"A_Pa": law_A, "B_kg_m3": law_B}
-    return [{"layer": name, "law_A": A, "law_B": B}
-            for name, (A, B) in zip(target.layer_names(), target.plain_laws, strict=True)]

@@ -8,12 +8,8 @@ they are the same when regenerated on another CPU.
 import json
 from pathlib import Path
 
-from cavex.analytic.penetration.labels import (
-    FLIGHT_RESISTANCES,
-    PLAIN_LAW,
-    model_boundary,
-    model_label,
-)
+from cavex.analytic.models import get
+from cavex.analytic.models.plain_law import law_echo
 from cavex.analytic.penetration.zones import crater_depth, scab_depth
 from cavex.config import load_config
 from cavex.verification.output.files import (
@@ -30,12 +26,13 @@ def run(args, target, projectile):
     """``cavex penetrate``: fly, write every file or none (also on Ctrl-C or kill), return the
     text or JSON to print."""
     from cavex.verification.commands.options import (
+        FLOWN,
         interface_target,
         law_settings,
         resistance_settings,
     )
 
-    settings = resistance_settings(args, FLIGHT_RESISTANCES)
+    settings = resistance_settings(args, FLOWN)
     target = interface_target(args, target, settings["resistance"])
     laws = law_settings(args, target)
     folder = check_output_dir(args.out, "out")
@@ -50,9 +47,9 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
                     law_B=None):
     """Run the target and its first layer alone (the paper's Fig. 4 pair); nothing is written.
 
-    ``resistance`` is one of :data:`cavex.analytic.penetration.labels.FLIGHT_RESISTANCES`;
+    ``resistance`` is a flown model of the registry (:mod:`cavex.analytic.models`);
     ``boundary`` None is the default: dynamic for the derived model, the paper's own
-    quasi-static for the paper model (:func:`cavex.analytic.penetration.resistance.model_boundary`).
+    quasi-static for the paper model (:meth:`cavex.analytic.models.registry.Model.boundary`).
 
     With ``resistance="table"`` the runway uses the FE-tabulated resistance of ``table`` (the
     path of a table built for this target); the first layer alone keeps the derived closed
@@ -61,15 +58,14 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
     (:class:`~cavex.analytic.penetration.plain_law.PlainLawResistance`); it has no boundary
     convention (``boundary`` None).
     """
+    from cavex.analytic.models import make_resistance
     from cavex.analytic.penetration.integrator import penetrate
-    from cavex.analytic.penetration.resistance import make_resistance
-    from cavex.verification.commands.options import law_echo
 
-    law = resistance == PLAIN_LAW
-    model = PLAIN_LAW if law else model_label(resistance, boundary)
-    closed = "derived" if resistance == "table" else resistance
-    first = model if law else model_label(closed, boundary)
-    boundary = None if law else model_boundary(closed, boundary)
+    model = get(resistance)
+    first_model = get(model.first_layer or resistance)  # flies the first layer alone
+    law, closed = model.takes_law, first_model.name
+    label, first = model.label(boundary), first_model.label(boundary)
+    boundary = first_model.boundary(boundary)
     single = target.single(0)
     laws = {"law_A": law_A, "law_B": law_B}
     runs = {"runway": penetrate(target, projectile, make_resistance(
@@ -79,7 +75,7 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
                 single, projectile, closed, boundary, epsilon, **laws), crater=crater)}
     paper = (target.with_interfaces("bonded"), projectile) == load_config()
     settings = {"law": law_echo(target, law_A, law_B)} if law else {}
-    return {**settings, "model": model, "interfaces": interface_summary(target, projectile),
+    return {**settings, "model": label, "interfaces": interface_summary(target, projectile),
             "first_layer_model": first, "resistance": resistance,
             "boundary": boundary, "epsilon": epsilon,
             "table": None if table is None else str(table), "crater": crater,
@@ -88,8 +84,7 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
             "notes": crater_notes(target, projectile, crater),
             "debonded": bool(target.debonded),
             "interface_depths": target.interface_depths,
-            "title": resistance_title(resistance, boundary, epsilon, table,
-                                      settings.get("law")),
+            "title": model.describe(boundary, epsilon, table, settings.get("law")),
             "layer_names": target.layer_names()}
 
 
@@ -116,11 +111,9 @@ def summary(job, written=()):
 def text(summary):
     """The phase table, the rows beside the paper's Table 2 and the files written."""
     s = summary
-    settings = {"paper": f", epsilon {s['epsilon']}",
-                "table": f" ({s['table']}; first layer alone: {s['first_layer_model']})",
-                PLAIN_LAW: f" ({law_text(s['law'])})" if "law" in s else ""}
     debonded = [i for i in s["interfaces"] if i["bottom"] == "debonded"]
-    lines = [f"model {s['model']}{settings.get(s['resistance'], '')}, crater from {s['crater']}"]
+    lines = [f"model {s['model']}{get(s['resistance']).settings_text(s)}, crater from "
+             f"{s['crater']}"]
     if debonded:
         lines.append("debonded interfaces at " + ", ".join(
             f"{i['depth_m']:g} m (rear zone {i['rear_zone_m']:.4g} m)" for i in debonded))
@@ -159,30 +152,6 @@ def crater_notes(target, projectile, crater):
     return [f"the crater ({depth:.4g} m, 4.5 r from the {crater}) reaches below the first layer "
             f"({first:.4g} m thick); the crater stage uses the first layer's properties "
             "throughout"]
-
-
-def law_text(law):
-    """The plain law (:func:`~cavex.verification.commands.options.law_echo`) in words:
-    ``sigma_n = A + B V_n^2, A 2e+08 Pa, B 2500 kg/m^3`` (global) or ``sigma_n = tau_k A_k +
-    B_k rho_k V_n^2; concrete A 20, B 1; ...`` (each layer's keys, by the layer's name)."""
-    if isinstance(law, dict):
-        return f"sigma_n = A + B V_n^2, A {law['A_Pa']:g} Pa, B {law['B_kg_m3']:g} kg/m^3"
-    return "sigma_n = tau_k A_k + B_k rho_k V_n^2; " + "; ".join(
-        f"{k['layer']} A {k['law_A']:g}, B {k['law_B']:g}" for k in law)
-
-
-def resistance_title(resistance, boundary, epsilon, table=None, law=None):
-    """What the figures say about the resistance: the settings the closed form uses (the
-    paper's model has its own quasi-static boundary and an epsilon reading; the derived model
-    has a boundary convention), for a table (``resistance`` "table") only its file name, for
-    the plain law (``resistance`` "law") ``law`` in words (:func:`law_text`)."""
-    if resistance == PLAIN_LAW:
-        return "plain law " + law_text(law)
-    closed = (f"paper model (She 2020), epsilon: {epsilon}" if resistance == "paper"
-              else f"derived model, {boundary} boundary")
-    if resistance != "table":
-        return closed
-    return f"FE table {Path(str(table)).name} (first layer alone: {closed})"
 
 
 def phases_as_dicts(trajectory):

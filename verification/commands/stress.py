@@ -3,10 +3,8 @@
 import json
 import math
 
-from cavex.analytic.geometry import spherical_problem, wall_layer
-from cavex.analytic.paper_model import paper_coefficients
-from cavex.analytic.penetration.labels import check_model, model_boundary, model_label
-from cavex.analytic.states import state_meaning
+from cavex.analytic.geometry import spherical_problem
+from cavex.analytic.models import get, names
 from cavex.errors import CavexNumericalError, require
 from cavex.materials import MAX_VELOCITY
 
@@ -31,32 +29,15 @@ def run(args, target, projectile):
 def stress_at_depth(target, projectile, depth, velocity, *, resistance="derived", boundary=None,
                     epsilon="quasi-static"):
     """JSON-able description of the cavity-wall stress at nose depth ``depth`` (m) of the
-    closed form ``resistance`` ("derived" or "paper"); ``boundary`` None is the default
-    (dynamic for the derived model, see
-    :func:`cavex.analytic.penetration.resistance.model_boundary`)."""
+    closed form ``resistance`` (a model of the registry with ``closed_form``); ``boundary``
+    None is the model's default (:meth:`cavex.analytic.models.registry.Model.boundary`)."""
     require(math.isfinite(velocity) and 0.0 <= velocity <= MAX_VELOCITY, "velocity",
             f"in [0, {MAX_VELOCITY:g}] m/s", velocity)
-    check_model(resistance, boundary)
-    boundary = model_boundary(resistance, boundary)
-    layers, interfaces = spherical_problem(target, projectile, depth)  # checks the depth
-    if resistance == "paper":
-        return _finite(_paper(target, projectile, depth, velocity, epsilon))
-    # loaded once the input is checked: bad input answers before numba loads (and the paper
-    # model, plain numpy, never loads it)
-    from cavex.analytic.cavity import cavity_solution
-
-    state = cavity_solution(layers, interfaces, velocity, projectile.r, boundary=boundary)
-    index = wall_layer(target, projectile, depth)
-    return _finite({"model": model_label(resistance, boundary), "resistance": resistance,
-            "boundary": boundary, "depth_m": depth,
-            "velocity_m_s": velocity, "sigma_r_Pa": state.stress, "S": state.S,
-            "S_normalised_by": f"tau of {target.layer_name(index)}", "tau_Pa": layers[0].tau,
-            "response_state": state.state,
-            "response_state_meaning": state_meaning(state.state, target.layer_names()),
-            "plastic_radius_m": state.plastic_radius,
-            "wall_layer": target.layer_name(index), "interface_radii_m": list(interfaces),
-            "plastic_zones": [{"layer": target.layer_name(index + i), "r_inner_m": r0,
-                               "r_outer_m": r1} for i, r0, r1 in state.plastic_zones]})
+    model = get(resistance, offered=names(closed_form=True))
+    model.check(boundary)
+    spherical_problem(target, projectile, depth)  # checks the depth
+    return _finite(model.wall_stress(target, projectile, depth, velocity,
+                                     boundary=model.boundary(boundary), epsilon=epsilon))
 
 
 def summary(job):
@@ -72,7 +53,7 @@ def text(summary):
     MPa, lengths in mm, the response state spelled out (:func:`state_meaning`)."""
     s = summary
     g = _digits
-    model = s["model"] + (f", epsilon {s['epsilon']}" if s["resistance"] == "paper"
+    model = s["model"] + (f", epsilon {s['epsilon']}" if "epsilon" in s
                           else f" ({s['boundary']} boundary)")
     rows = [("model", model, ""), ("nose-tip depth L", g(s["depth_m"]), "m"),
             ("expansion velocity V", g(s["velocity_m_s"]), "m/s")]
@@ -81,7 +62,7 @@ def text(summary):
     rows += [("sigma_r at the wall", g(s["sigma_r_Pa"] / 1e6), "MPa"),
              ("S = sigma_r / tau", g(s["S"]), f"(tau = {g(s['tau_Pa'] / 1e6)} MPa, "
               f"{s['S_normalised_by']})")]
-    if s["resistance"] == "paper":
+    if "equation" in s:  # the paper's printed coefficients
         rows += [("A, B (S = A + B rho V^2/tau)", f"{g(s['A'])}, {g(s['B'])}",
                   f"(Eq. {s['equation']})")]
     rows.append(("response state", f"{s['response_state']}:", s["response_state_meaning"]))
@@ -112,13 +93,3 @@ def _finite(result):
                                       f"V = {result['velocity_m_s']:g} m/s, "
                                       f"L = {result['depth_m']:g} m")
     return result
-
-
-def _paper(target, projectile, depth, velocity, epsilon):
-    c = paper_coefficients(target, projectile, depth, epsilon=epsilon)
-    return {"model": "paper", "resistance": "paper", "epsilon": epsilon, "depth_m": depth,
-            "velocity_m_s": velocity,
-            "sigma_r_Pa": c.stress(velocity), "S": c.S(velocity),
-            "S_normalised_by": f"tau as the paper's Eq. {c.equation}", "tau_Pa": c.tau,
-            "A": c.A, "B": c.B, "equation": c.equation, "response_state": c.state,
-            "response_state_meaning": state_meaning(c.state, target.layer_names())}

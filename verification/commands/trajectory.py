@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from cavex.analytic.models import get
+from cavex.analytic.models.plain_law import law_echo
 from cavex.analytic.penetration.strike import Strike
 from cavex.errors import is_finite_number, require
 from cavex.verification.fedata.runner import show_progress
@@ -69,7 +71,8 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
     require(contact_hold is None or (contact_ramp is None and not tangency_psi),
             "contact_hold", "given without contact_ramp and tangency_psi (it replaces the "
             "velocity ramp)", contact_hold)
-    from cavex.analytic.penetration.oblique import CONTACT_RAMP, fly
+    from cavex.analytic.models import fly
+    from cavex.analytic.penetration.oblique import CONTACT_RAMP
 
     contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
     options = {"boundary": boundary, "epsilon": epsilon, "free_surface": free_surface,
@@ -86,11 +89,9 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
     check_answered("runway", runs["runway"])
     if compare_homogeneous and len(target.layers) > 1:
         single = target.single(0)
-        if resistance == "table":  # the table belongs to the runway; first layer by closed form
+        resistance_single = get(resistance).first_layer or resistance
+        if resistance_single != resistance:  # the table belongs to the runway
             options = {**options, "table": None}
-            resistance_single = "derived"
-        else:
-            resistance_single = resistance
         with _steps("first layer only", progress) as step:
             runs["first layer only"] = fly(single, projectile, strike, resistance_single,
                                            progress=step, **options)
@@ -113,9 +114,7 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
         settings["entry_crater_m"] = list(runs["runway"].model.zones[0])  # are unchanged
     if crater is not None:
         settings["crater"] = crater
-    if resistance == "law":
-        from cavex.verification.commands.options import law_echo
-
+    if get(resistance).takes_law:
         settings["law"] = law_echo(target, law_A, law_B)
     return {"runs": runs, "settings": settings, "target": target}
 
@@ -351,7 +350,7 @@ def side_view(job, path):
 
 def _title(job):
     s = job["settings"]
-    law = s["resistance"] + (f"-{s['boundary']}" if s["resistance"] == "derived" else "")
+    law = get(s["resistance"]).label(s["boundary"])
     return (f"V0 = {s['speed_m_s']:g} m/s, obliquity {s['obliquity_deg']:g} deg, attack "
             f"{s['attack_deg']:g} deg; resistance {law}, "
             + (f"contact ramp {s['contact_ramp_m_s']:g} m/s" if "contact_ramp_m_s" in s
@@ -560,15 +559,15 @@ def view_3d(job, path):
 def run(args, target, projectile):
     """``cavex trajectory``: checks, runs, writes (every file or none, also on Ctrl-C or
     kill), returns the text or JSON to print."""
-    from cavex.analytic.penetration.labels import FLIGHT_RESISTANCES
     from cavex.errors import CavexInputError, CavexNumericalError
     from cavex.verification.commands.options import (
+        FLOWN,
         interface_target,
         law_settings,
         resistance_settings,
     )
 
-    settings = resistance_settings(args, FLIGHT_RESISTANCES)
+    settings = resistance_settings(args, FLOWN)
     target = interface_target(args, target, settings["resistance"])
     if args.tunnel_wall is not None:
         require(is_finite_number(args.tunnel_wall) and 0.0 <= args.tunnel_wall <= 1.0,
@@ -577,7 +576,7 @@ def run(args, target, projectile):
     require(is_finite_number(args.tangency_psi) and 0.0 <= args.tangency_psi <= 30.0,
             "tangency-psi", "in [0, 30] degrees", args.tangency_psi)
     laws = law_settings(args, target)
-    if args.no_free_surface and args.resistance in ("law", "paper"):
+    if args.no_free_surface and not get(args.resistance).free_surface_option:
         raise CavexInputError(f"option '--no-free-surface' goes with '--resistance derived' (or "
                               f"table); '--resistance {args.resistance}' has no free-surface "
                               "reduction")

@@ -14,7 +14,7 @@ model's own material:
   incompressible elastic zone (``nu = 0.49``), no cracking, the closed form's hydrostat its
   elastic bulk modulus: every assumption of the closed form holds but small elastic strain;
 - ``capped, cracking``: the same with the tensile strength of fib MC2010
-  (:func:`cavex.verification.validation.concrete_model.tensile_strength`): the FE holds the
+  (:func:`cavex.concrete.tensile_strength`): the FE holds the
   hoop stress at ``-f_t`` in its cracked zone, the closed form's cracked zone carries none;
 - ``concrete model (nu = 0.2)``: the concrete model's elastic constants and cracking, its
   compaction left out of the closed form because the FE has none.
@@ -34,14 +34,13 @@ from pathlib import Path
 import numpy as np
 
 from cavex.analytic.concrete_cavity import ConcreteCavity, wall_stress
+from cavex.concrete import aci_modulus, tensile_strength
 from cavex.errors import CavexInputError, CavexNumericalError
 from cavex.fem import expand_cavity
 from cavex.materials import Material
 from cavex.verification.output.files import save_figure, write_text_atomic
 from cavex.verification.output.number_format import round_significant
 from cavex.verification.output.paths import check_output_dir
-from cavex.verification.validation.concrete import aci_modulus
-from cavex.verification.validation.concrete_model import tensile_strength
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_OUT = ROOT / "results" / "concrete"

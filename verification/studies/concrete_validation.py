@@ -6,10 +6,10 @@ r"""How well the concrete cavity-expansion model predicts measured depths (issue
 constants) and ``DIR/report.md`` (the tables). Default shots: ``examples/shots_compilation_dev.csv``
 (286 shots, 21 references), default folder ``results/concrete``.
 
-Models compared (:mod:`cavex.verification.validation.concrete_model`):
+Models compared (:mod:`cavex.analytic.penetration.concrete_table`):
 
 - ``concrete (published)``: the concrete cavity expansion with every constant at its published
-  value (:class:`~cavex.verification.validation.concrete_model.Constants`), no fit;
+  value (:class:`~cavex.concrete.Constants`), no fit;
 - ``concrete (fitted)``: ``S_max`` and ``p_l`` chosen on :data:`GRID` to minimise the mean
   ``|ln(predicted/measured)|`` over all shots (in-sample);
 - ``concrete (LORO)``: the same fit repeated with each reference left out in turn, its shots
@@ -32,19 +32,16 @@ from pathlib import Path
 
 import numpy as np
 
+from cavex.analytic import empirical
+from cavex.analytic.empirical import li_chen_depth
+from cavex.analytic.penetration.concrete_table import TableResistance, table_depth
+from cavex.concrete import Constants
 from cavex.errors import CavexInputError, CavexNumericalError
 from cavex.verification.output.files import write_text_atomic
 from cavex.verification.output.number_format import round_significant
 from cavex.verification.output.paths import check_output_dir
-from cavex.verification.validation import empirical
-from cavex.verification.validation.concrete_model import (
-    Constants,
-    TableResistance,
-    li_chen_depth,
-    rigid_flag,
-    table_depth,
-)
 from cavex.verification.validation.predict import predict
+from cavex.verification.validation.regimes import rigid_flag
 from cavex.verification.validation.shots import read_shots
 
 ROOT = Path(__file__).resolve().parents[2]

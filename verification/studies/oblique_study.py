@@ -26,7 +26,8 @@ import sys
 
 import numpy as np
 
-from cavex.analytic.penetration.oblique import CONTACT_RAMP, Strike, fly, overload_peaks, peaks
+from cavex.analytic.models import fly
+from cavex.analytic.penetration.oblique import CONTACT_RAMP, Strike, overload_peaks, peaks
 from cavex.config import load_config
 from cavex.verification.fedata.runner import run_cases
 from cavex.verification.output.files import save_figure, write_text_atomic
@@ -455,8 +456,8 @@ def interface_figures(folder, target, projectile):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from cavex.analytic.models import make_law
     from cavex.analytic.penetration.oblique import ObliqueModel
-    from cavex.analytic.penetration.stress_laws import make_law
     from cavex.analytic.penetration.zones import open_zones
     from cavex.materials import Target
 

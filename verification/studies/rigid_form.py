@@ -4,7 +4,7 @@ r"""What the rigid-projectile form can reach on the development shots (issue 19,
 ``DIR/rigid_form.csv`` (one row per family and fitting set) and ``DIR/rigid_form.md``; default
 shots ``examples/shots_compilation_dev.csv``, folder ``results/concrete``.
 
-Forrestal's closed form (:func:`cavex.verification.validation.empirical.penetration_calibres`:
+Forrestal's closed form (:func:`cavex.analytic.empirical.penetration_calibres`:
 a crater of ``k d`` with a linear force, then ``F = pi a^2 (S f_c + N* rho V^2)``) is what every
 rigid-projectile model cavex validates reduces to, with its own ``S``, dynamic coefficient and
 crater. Here its global constants are left free,
@@ -41,11 +41,10 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import minimize
 
+from cavex.analytic.empirical import LI_CHEN_COEFFICIENT, crater_calibres, penetration_calibres
 from cavex.verification.output.files import write_text_atomic
 from cavex.verification.output.number_format import round_significant
 from cavex.verification.studies.concrete_validation import source, study_inputs
-from cavex.verification.validation.concrete_model import LI_CHEN_COEFFICIENT, crater_calibres
-from cavex.verification.validation.empirical import penetration_calibres
 from cavex.verification.validation.regimes import REGIME_TITLES, REGIMES
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -2,11 +2,11 @@ r"""Fitting a model's free material parameters to measured depths, and calibrati
 
 ``fit`` minimises ``sum_i ln(predicted_i / measured_i)^2`` over the shots by
 :func:`scipy.optimize.least_squares` (trust-region reflective, bounds of
-:data:`cavex.verification.validation.concrete.BOUNDS`) in the variables ``lam``, ``ln
+:data:`cavex.concrete.BOUNDS`) in the variables ``lam``, ``ln
 strength_factor``,
 ``ln modulus_factor`` (the factors are scales: their logarithms make the problem better
 conditioned); the other parameters keep the starting mapping's values (default: the sources'
-mapping, :class:`cavex.verification.validation.concrete.Mapping`). The Jacobian is by forward
+mapping, :class:`cavex.concrete.Mapping`). The Jacobian is by forward
 differences: a step of 1e-6 for the closed forms (the integrator's ``rtol`` is 1e-9) and 2e-2
 for the FE table (its wall stresses carry a discretisation error of about 1e-3, so a smaller
 step would difference noise).
@@ -26,13 +26,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cavex.analytic.penetration.labels import model_label, parse_model_label
+from cavex.analytic.models import model_label, parse_model_label
+from cavex.concrete import BOUNDS, FREE_PARAMETERS, Mapping
 from cavex.errors import CavexInputError, CavexNumericalError, check_keys, prefixed, require
 from cavex.input_files import in_file, read_toml
 from cavex.verification.output.number_format import round_significant
-from cavex.verification.validation.concrete import BOUNDS, FREE_PARAMETERS, Mapping, shot_target
 from cavex.verification.validation.predict import FE_MODEL, OUTLIER_FACTOR, TableCache, predict
-from cavex.verification.validation.shots import shot_projectile
+from cavex.verification.validation.shots import shot_projectile, shot_target
 
 PARAMETER_DIGITS = 6
 DEFAULT_PARAMETERS = ("lam", "strength_factor")
@@ -48,7 +48,7 @@ CALIBRATION_REQUIRED = {"model", "params", "lam", "strength_factor", "modulus_fa
 
 @dataclass(frozen=True)
 class Calibration:
-    """A fitted model: its label (:data:`cavex.analytic.penetration.resistance.MODEL_LABELS`),
+    """A fitted model: its label (``labels(fits_mapping=True)`` of :mod:`cavex.analytic.models`),
     mapping, fitted parameter names and shot ids."""
 
     model: str
@@ -133,7 +133,7 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
     ----------
     shots : sequence of Shot
     resistance : {"derived", "paper", "table"}
-        :data:`cavex.analytic.penetration.resistance.RESISTANCES`.
+        the models that fit the mapping (:mod:`cavex.analytic.models`).
     boundary : {"dynamic", "quasi-static"}, optional
         The derived model's convention (default dynamic; the paper model has its own).
     params : sequence of str, optional

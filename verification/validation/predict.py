@@ -1,10 +1,10 @@
 """Predicted against measured penetration depth: every resistance cavex has, and Forrestal's.
 
 For each shot (:mod:`cavex.verification.validation.shots`) the target is one semi-infinite concrete
-layer from the shot's ``(f_c, rho)`` (:mod:`cavex.verification.validation.concrete`) and the
+layer from the shot's ``(f_c, rho)`` (:mod:`cavex.concrete`) and the
 projectile the shot's (:func:`~cavex.verification.validation.shots.shot_projectile`). The models
 (:data:`MODELS`, labelled as everywhere in cavex:
-:data:`cavex.analytic.penetration.resistance.MODEL_LABELS`):
+:mod:`cavex.analytic.models`, the registry):
 
 - ``derived-quasi-static``, ``derived-dynamic``, ``paper``: the closed forms
   (:class:`cavex.analytic.penetration.resistance.ClosedFormResistance`), incompressible;
@@ -13,13 +13,13 @@ projectile the shot's (:func:`~cavex.verification.validation.shots.shot_projecti
   :func:`cavex.verification.fedata.table.build_table` for the shot's target with the mapping's
   Poisson's ratio (0.2): compressible, finite strain, which no closed form gives;
 - ``concrete``: the concrete cavity-expansion model
-  (:mod:`cavex.verification.validation.concrete_model`, published constants, none fitted to the
+  (:mod:`cavex.analytic.penetration.concrete_table`, published constants, none fitted to the
   shots; its own crater and material, not the mapping), the recommended model
   (:data:`RECOMMENDED_MODEL`);
 - ``li-chen-2003``: Li and Chen's (2003) empirical formula (Forrestal's form with
   ``S = 72 f_c^-0.5`` and the crater ``0.707 + h/d`` calibres,
-  :func:`cavex.verification.validation.concrete_model.li_chen_depth`);
-- ``forrestal-1994``: the empirical model (:mod:`cavex.verification.validation.empirical`).
+  :func:`cavex.analytic.empirical.li_chen_depth`);
+- ``forrestal-1994``: the empirical model (:mod:`cavex.analytic.empirical`).
 
 cavex's models run the penetration integrator
 (:func:`cavex.analytic.penetration.integrator.penetrate`,
@@ -38,35 +38,23 @@ from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.penetration.labels import (
-    CONCRETE_LABEL,
-    EMPIRICAL_LABEL,
-    LI_CHEN_LABEL,
-    MODEL_LABELS,
-    SPLIT_LABEL,
-    VALIDATION_LABELS,
-    parse_model_label,
-)
-from cavex.analytic.penetration.labels import MODELS as CLOSED_FORMS
+from cavex.analytic.models import get, labels, names, parse_label
 from cavex.analytic.penetration.nose import nose_rule
+from cavex.concrete import Mapping
 from cavex.errors import CavexInputError, CavexNumericalError, require_choice
 from cavex.verification.output.number_format import FE_DIGITS, round_significant
-from cavex.verification.validation import empirical
-from cavex.verification.validation.concrete import Mapping, shot_target
-from cavex.verification.validation.regimes import regime_statistics
-from cavex.verification.validation.shots import shot_projectile
+from cavex.verification.validation.regimes import regime_statistics, rigid_flag
+from cavex.verification.validation.shots import shot_projectile, shot_target
 
-FE_MODEL = "table"
-EMPIRICAL = EMPIRICAL_LABEL
-CONCRETE = CONCRETE_LABEL
-LI_CHEN = LI_CHEN_LABEL
-SPLIT = SPLIT_LABEL
-CAVEX_MODELS = MODEL_LABELS  # the closed forms and the FE table: what a calibration can fit
-MODELS = VALIDATION_LABELS  # the cavex models, the concrete model, the empirical formula
-#: The model ``cavex validate`` recommends: Li and Chen (2003) at normal strength, the concrete
-#: model above (:func:`~cavex.verification.validation.concrete_model.split_depth`; no constant
-#: fitted to any shot, the split chosen on the development shots: docs/validation.md)
-RECOMMENDED_MODEL = SPLIT
+#: the labels of the models validate runs, in the order of its columns (the registry's)
+MODELS = labels(predicts_shots=True)
+CAVEX_MODELS = labels(fits_mapping=True)  # what a calibration can fit: the flown models
+FE_MODEL = names(takes_table=True)[0]  # the model that needs FE tables
+EMPIRICAL, CONCRETE, LI_CHEN, SPLIT = ("forrestal-1994", "concrete", "li-chen-2003",
+                                       "li-chen-concrete")  # the report's words about them
+#: The model ``cavex validate`` recommends (the registry's ``recommended`` model: Li and Chen
+#: (2003) at normal strength, the concrete model above; docs/validation.md)
+RECOMMENDED_MODEL = names(recommended=True)[0]
 DEPTH_DIGITS = FE_DIGITS  # predicted depths and statistics in the result files
 TABLE_VELOCITY_STEP = 50.0  # m/s between FE table velocities (interpolated by PCHIP in V^2)
 TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on depth
@@ -74,13 +62,6 @@ TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on dep
 # 95 FE tables of 25 velocities and 2 depths in ~90 s; a prediction 1.4-2.6 ms with a closed
 # form, 29 ms with an FE table (5000 shots: 12 min on a machine loaded ~2x)
 TABLE_CASES_PER_SECOND_PER_WORKER = 45.0
-PREDICTION_SECONDS = {"closed form": 2.5e-3, FE_MODEL: 3e-2, LI_CHEN: 0.0,
-                      # docs/concrete.md: the integrator 6.3 ms a shot, besides its table
-                      CONCRETE: 6.3e-3}
-# one concrete's cavity table (33 self-similar solutions): docs/concrete.md measured 15 s for
-# the 96 tables of the development shots (0.16 s each); benchmarks/validate_scale.py measured
-# about 0.56 CPU s each for 1000 concretes on a machine loaded ~2.5x
-CONCRETE_TABLE_SECONDS = 0.2
 # a shot every model misses by more than this factor (either way) is flagged as an outlier:
 # 21 of the 286 development shots (C133: 1.2 mm measured at 86 m/s, every model ~25 mm), none
 # of Forrestal's 17
@@ -99,21 +80,15 @@ def penetration_depth(target, projectile, resistance):
 def closed_form_depth(shot, resistance="derived", *, boundary=None, mapping=None):
     """Depth (m) of the closed form ``resistance`` ("derived" with ``boundary``, or "paper")
     for ``shot`` under ``mapping``."""
-    from cavex.analytic.penetration.resistance import make_resistance
-
-    require_choice(resistance, CLOSED_FORMS, "resistance")
-    target, projectile = shot_target(shot, mapping), shot_projectile(shot)
-    return penetration_depth(target, projectile,
-                             make_resistance(target, projectile, resistance, boundary))
+    model = get(resistance, offered=names(closed_form=True))
+    return model.shot_depth(shot, boundary=boundary, mapping=mapping)
 
 
 def table_depth(shot, table, mapping=None):
     """Depth (m) with the FE-tabulated resistance of ``table`` (built for the shot's target)."""
-    from cavex.analytic.penetration.resistance import make_resistance
+    from cavex.analytic.models.shots import flown_depth
 
-    target, projectile = shot_target(shot, mapping), shot_projectile(shot)
-    return penetration_depth(target, projectile,
-                             make_resistance(target, projectile, "table", table=table))
+    return flown_depth(get(FE_MODEL), shot, mapping, table=table)
 
 
 def predict(shot, model, mapping=None, tables=None):
@@ -121,21 +96,10 @@ def predict(shot, model, mapping=None, tables=None):
 
     ``tables`` (a :class:`TableCache`) gives the FE tables of the ``table`` model.
     """
-    from cavex.verification.validation import concrete_model
-
-    if model == EMPIRICAL:
-        return empirical.shot_depth(shot)
-    if model == CONCRETE:
-        return concrete_model.model_depth(shot)
-    if model == LI_CHEN:
-        return concrete_model.li_chen_depth(shot)
-    if model == SPLIT:
-        return concrete_model.split_depth(shot)
-    resistance, boundary = parse_model_label(model)
-    if resistance == "table":
+    chosen, boundary = parse_label(model, "models", MODELS)
+    if chosen.takes_table:
         tables = tables or TableCache()
-        return table_depth(shot, tables.table(shot, mapping), mapping)
-    return closed_form_depth(shot, resistance, boundary=boundary, mapping=mapping)
+    return chosen.shot_depth(shot, boundary=boundary, mapping=mapping, tables=tables)
 
 
 # --- FE tables --------------------------------------------------------------------------------
@@ -255,18 +219,18 @@ class TableCache:
 def run_estimate(shots, models, tables, workers):
     """One line: the size of a run of ``models`` (column -> ``(model, mapping)``) over
     ``shots`` and its time, from :data:`TABLE_CASES_PER_SECOND_PER_WORKER` and
-    :data:`PREDICTION_SECONDS` (the empirical model costs nothing)."""
+    each model's ``prediction_seconds`` and ``concrete_table_seconds`` (the registry's)."""
     tables.velocities_for(shots)
     table_mappings = [mapping or Mapping() for model, mapping in models.values()
                       if model == FE_MODEL]
     build, reused = tables.plan(shots, table_mappings) if table_mappings else (0, 0)
     cases = build * len(tables._velocities) * len(TABLE_DEPTHS)
-    per_shot = sum(PREDICTION_SECONDS.get(model, PREDICTION_SECONDS["closed form"])
-                   for model, _ in models.values() if model != EMPIRICAL)
-    concretes = len({(s.fc, s.rho) for s in shots}) if any(
-        model == CONCRETE for model, _ in models.values()) else 0
+    chosen = [parse_label(model, "models", MODELS)[0] for model, _ in models.values()]
+    per_shot = sum(model.prediction_seconds for model in chosen)
+    table_seconds = max((model.concrete_table_seconds for model in chosen), default=0.0)
+    concretes = len({(s.fc, s.rho) for s in shots}) if table_seconds else 0
     seconds = (cases / (TABLE_CASES_PER_SECOND_PER_WORKER * max(1, workers))
-               + len(shots) * per_shot + concretes * CONCRETE_TABLE_SECONDS / max(1, workers))
+               + len(shots) * per_shot + concretes * table_seconds / max(1, workers))
     when = ("under a minute" if seconds < 60.0 else f"about {seconds / 60.0:.0f} min"
             if seconds < 3600.0 else f"about {seconds / 3600.0:.1f} h")
     return (f"{len(shots)} shots x {len(models)} models = {len(shots) * len(models)} "
@@ -347,7 +311,7 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         Each adds the column ``"<model> calibrated"`` (its model with its fitted mapping).
     tables : TableCache, optional
     mapping : Mapping, optional
-        The uncalibrated mapping (default :class:`~cavex.verification.validation.concrete.Mapping`).
+        The uncalibrated mapping (default :class:`~cavex.concrete.Mapping`).
     models : sequence of str, optional
         The uncalibrated models to run (labels of :data:`MODELS`; default all).
 
@@ -364,7 +328,8 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     columns = validation_columns(calibrations, mapping, models)
     tables = tables or TableCache()
     tables.velocities_for(shots)
-    concrete = [name for name, (model, _) in columns.items() if model in (CONCRETE, SPLIT)]
+    concrete = [name for name, (model, _) in columns.items()
+                if parse_label(model, "models", MODELS)[0].concrete_table_seconds]
     ids = [shot.id for shot in shots]
     depths, failures = predictions(
         shots, {k: v for k, v in columns.items() if k not in concrete}, tables, progress)
@@ -374,7 +339,7 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
                                                                          progress)
         for name in concrete:
             depths[name], failed = concrete_depths, concrete_failures
-            if columns[name][0] == SPLIT:
+            if parse_label(columns[name][0], "models", MODELS)[0].parts:
                 depths[name] = [_split_depth(shot, depth)
                                 for shot, depth in zip(shots, concrete_depths, strict=True)]
                 failed = {i: reason for i, reason in concrete_failures.items()
@@ -402,22 +367,21 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
 def _split_depth(shot, concrete_depth):
     """The recommended model's depth from the concrete model's (None where that failed and
     the shot needs it), rounded like every depth."""
-    from cavex.verification.validation import concrete_model
-
-    if concrete_depth is None and shot.fc > concrete_model.SPLIT_STRENGTH:
-        return None
-    return round_significant(concrete_model.split_depth(shot, concrete_depth), DEPTH_DIGITS)
+    part = get(RECOMMENDED_MODEL).part(shot)
+    if not part.concrete_table_seconds:
+        return round_significant(part.shot_depth(shot), DEPTH_DIGITS)
+    return None if concrete_depth is None else round_significant(concrete_depth, DEPTH_DIGITS)
 
 
 def concrete_predictions(shots, workers=None, progress=None):
     """The concrete model's ``(depths, flags, failures)`` for ``shots``: per shot the depth
     (rounded like every depth, None if it failed), the rigid-regime flag
-    (:func:`~cavex.verification.validation.concrete_model.rigid_flag`, None if it failed) and
+    (:func:`~cavex.verification.validation.regimes.rigid_flag`, None if it failed) and
     ``{shot id: reason}``. The shots of one concrete (``f_c``, ``rho``) go to one task, so its
     cavity table is built once; tasks run on ``workers`` local processes (default: the CPUs).
     """
+    from cavex.analytic.penetration import concrete_table  # noqa: F401 (before the fork)
     from cavex.verification.fedata.runner import Progress, process_pool, show_progress
-    from cavex.verification.validation import concrete_model  # noqa: F401 (before the fork)
 
     groups = {}
     for i, shot in enumerate(shots):
@@ -447,15 +411,14 @@ def concrete_predictions(shots, workers=None, progress=None):
 
 def concrete_group(shots):
     """``[(depth, flag, reason)]`` of the concrete model for ``shots`` (one concrete)."""
-    from cavex.verification.validation import concrete_model
+    from cavex.analytic.penetration.concrete_table import TableResistance, table_depth
 
     out = []
     for shot in shots:
         try:
-            resistance = concrete_model.TableResistance(shot)
-            depth = round_significant(concrete_model.table_depth(shot, resistance),
-                                      DEPTH_DIGITS)
-            out.append((depth, concrete_model.rigid_flag(shot, resistance), None))
+            resistance = TableResistance(shot)
+            depth = round_significant(table_depth(shot, resistance), DEPTH_DIGITS)
+            out.append((depth, rigid_flag(shot, resistance), None))
         except (CavexInputError, CavexNumericalError) as exc:
             out.append((None, None, str(exc).splitlines()[0]))
     return out

@@ -8,7 +8,7 @@ A shot's regime follows from its inputs only (never from a measured depth):
 - ``fast``: ``V0 > 1000`` m/s;
 - ``high_strength``: ``f_c > 100`` MPa (high- and ultra-high-strength concrete);
 - ``not_flagged``: the shots the rigid-regime rule keeps
-  (:func:`cavex.verification.validation.concrete_model.rigid_flag`: the concrete model's mean
+  (:func:`cavex.verification.validation.regimes.rigid_flag`: the concrete model's mean
   nose pressure at impact at most the projectile's listed yield strength, or no yield listed).
 
 Per regime and model: ``n``, the mean ``|ln(predicted/measured)|`` and the bias, the mean
@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from cavex.errors import require
 from cavex.verification.output.number_format import round_significant
 
 NORMAL_STRENGTH = 100e6  # Pa
@@ -59,3 +60,20 @@ def regime_statistics(rows, columns, digits):
             out[name] = {c: log_statistics([row["ratio"][c] for row in chosen], digits)
                          for c in columns}
     return out
+
+
+def nose_pressure(shot, resistance):
+    """Mean nose pressure at impact ``F(V0)/(pi a^2)`` (Pa)."""
+    return resistance.force(0.0, shot.V0) / (math.pi * 0.25 * shot.diameter ** 2)
+
+
+def rigid_flag(shot, resistance):
+    """``"non-rigid"`` when the mean nose pressure at impact exceeds the projectile's listed
+    yield strength (column ``proj_yield_MPa``), ``""`` otherwise or when it is not listed."""
+    text = shot.extra.get("proj_yield_MPa", "")
+    try:
+        strength = float(text) * 1e6
+    except ValueError:
+        return ""
+    require(strength > 0.0, "proj_yield_MPa", "a positive strength in MPa", text)
+    return "non-rigid" if nose_pressure(shot, resistance) > strength else ""

@@ -12,7 +12,7 @@ column, e.g. ``'x.csv': line 12 (shot 'F94-45'), column fc_Pa must be a compress
 Pa in [1e+06, 1e+09] (is it in MPa?) (got '35.4')``.
 
 From a shot to cavex's objects: :func:`shot_projectile` (the ``[projectile]`` table) here, the
-concrete in :mod:`cavex.verification.validation.concrete`.
+concrete in :mod:`cavex.concrete`.
 """
 
 import csv
@@ -20,9 +20,10 @@ import io
 import math
 from dataclasses import dataclass, field
 
+from cavex.analytic.models.shots import shot_projectile, shot_target  # noqa: F401 (re-exported)
 from cavex.errors import CavexInputError
 from cavex.input_files import in_file, read_text
-from cavex.materials import MASS_RANGE, MAX_CRH, MAX_VELOCITY, RADIUS_RANGE, Projectile
+from cavex.materials import MASS_RANGE, MAX_CRH, MAX_VELOCITY, RADIUS_RANGE
 
 REQUIRED_COLUMNS = ("id", "mass_kg", "diameter_m", "crh", "V0_m_s", "fc_Pa", "rho_kg_m3",
                     "depth_m")
@@ -211,17 +212,3 @@ def _number(text):
         return float(text)
     except ValueError:
         return math.nan
-
-
-def nose_length(shot):
-    """Length of the tangent-ogive nose, ``r sqrt(4 crh - 1)`` (m), ``r = d/2``."""
-    return 0.5 * shot.diameter * math.sqrt(4.0 * shot.crh - 1.0)
-
-
-def shot_projectile(shot):
-    """cavex's projectile for a shot: ``r = d/2``, ``R = crh d``, ``l`` = the tangent ogive's
-    nose length (:func:`nose_length`; it places the cavity centre at the nose base), ``m``,
-    ``V0``. The overall length does not enter a rigid-projectile model."""
-    r = 0.5 * shot.diameter
-    return Projectile(r=r, l=nose_length(shot), m=shot.mass, V0=shot.V0,
-                      R=shot.crh * shot.diameter)

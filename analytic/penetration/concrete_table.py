@@ -37,57 +37,20 @@ covers); flagged shots stay in every table.
 """
 
 import math
-from dataclasses import dataclass, fields, replace
 from functools import lru_cache
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
 from cavex.analytic.concrete_cavity import ConcreteCavity, fit_AB, wall_stress
+from cavex.analytic.empirical import crater_calibres
 from cavex.analytic.penetration.integrator import crater_exit, penetrate
 from cavex.analytic.penetration.nose import nose_rule
-from cavex.errors import require
+from cavex.concrete import Constants, aci_modulus, mohr_coulomb_lambda, tensile_strength
 from cavex.materials import Material, Projectile, Target
-from cavex.verification.validation import empirical
-from cavex.verification.validation.concrete import DEFAULT_NU, aci_modulus, mohr_coulomb_lambda
-from cavex.verification.validation.shots import shot_projectile
 
-LI_CHEN_COEFFICIENT = 72.0  # S = 72 f_c^-0.5, f_c in MPa (Li and Chen 2003)
 TABLE_POINTS = 33
 PHI_TOP = 16.0  # smallest table top (rho V^2/f_c)
-
-
-@dataclass(frozen=True)
-class Constants:
-    """The global constants of the mapping (defaults: the published values in the docstring).
-
-    ``cap`` is ``S_max = tau_max/f_c``, ``lock_pressure`` ``p_l`` (Pa), ``lock_strain`` HJC's
-    ``mu_l``, ``locked_modulus`` ``K_1`` (Pa), ``confinement`` Richart's ``k``.
-    """
-
-    cap: float = 7.0
-    lock_pressure: float = 0.8e9
-    lock_strain: float = 0.1
-    locked_modulus: float = 85e9
-    confinement: float = 4.1
-    nu: float = DEFAULT_NU
-    power_B: float = math.nan
-    power_N: float = 1.0
-
-    def with_values(self, names, values):
-        return replace(self, **{n: float(v) for n, v in zip(names, values, strict=True)})
-
-    def as_dict(self):
-        return {item.name: getattr(self, item.name) for item in fields(self)}
-
-
-def tensile_strength(fc):
-    """fib Model Code 2010 mean tensile strength (Pa) of a concrete of mean strength ``fc`` (Pa):
-    ``0.3 (f_c - 8)^(2/3)`` MPa up to 58 MPa, ``2.12 ln(1 + f_c/10)`` MPa above."""
-    f = fc / 1e6
-    if f <= 58.0:
-        return 0.3 * max(f - 8.0, 1.0) ** (2.0 / 3.0) * 1e6
-    return 2.12 * math.log(1.0 + 0.1 * f) * 1e6
 
 
 def concrete_cavity(fc, rho, constants=None):
@@ -99,11 +62,6 @@ def concrete_cavity(fc, rho, constants=None):
                           bulk=c.lock_pressure / eta_lock / fc, eta_lock=eta_lock,
                           bulk_locked=c.locked_modulus / fc, tensile=tensile_strength(fc) / fc,
                           power_B=c.power_B, power_N=c.power_N)
-
-
-def crater_calibres(crh):
-    """Li and Chen's (2003) crater depth ``k = 0.707 + h/d``, ``h/d = sqrt(4 CRH - 1)/2``."""
-    return 0.707 + 0.5 * np.sqrt(4.0 * crh - 1.0)  # numbers or arrays
 
 
 def table_top(phi):
@@ -139,7 +97,8 @@ class TableResistance:
         used = max(3, int(np.searchsorted(phi, self.phi_max, side="right")))
         self.A, self.B = fit_AB(phi[:used], self.S[:used])
         self._stress = PchipInterpolator(np.sqrt(phi * shot.fc / shot.rho), shot.fc * self.S)
-        self._cosines, self._weights = nose_rule(shot_projectile(shot))
+        self._cosines, self._weights = nose_rule(
+            Projectile.tangent_ogive(shot.mass, shot.diameter, shot.crh, shot.V0))
 
     def wall_stress(self, velocity):
         """``sigma_r`` (Pa) at expansion velocity ``velocity`` (<= V0; clipped to it)."""
@@ -163,7 +122,7 @@ def _target(shot):
 def table_depth(shot, resistance):
     """Depth (m) with the crater of :func:`crater_calibres` and cavex's tunnel integrator."""
     crater = crater_calibres(shot.crh) * shot.diameter
-    projectile = shot_projectile(shot)
+    projectile = Projectile.tangent_ogive(shot.mass, shot.diameter, shot.crh, shot.V0)
     energy = shot.mass * shot.V0 ** 2
     static = resistance.force(0.0, 0.0)
     if energy <= crater * static:
@@ -176,47 +135,3 @@ def table_depth(shot, resistance):
 def model_depth(shot, constants=None):
     """Predicted depth (m) of the concrete cavity-expansion model for ``shot``."""
     return table_depth(shot, TableResistance(shot, constants))
-
-
-def li_chen_depth(shot):
-    """Li and Chen (2003): Forrestal's form with ``S = 72 f_c^-0.5`` and ``k = 0.707 + h/d``."""
-    S = LI_CHEN_COEFFICIENT * (shot.fc / 1e6) ** -0.5
-    return shot.diameter * empirical.penetration_calibres(
-        shot.mass, shot.diameter, shot.crh, shot.V0, shot.fc, shot.rho, S=S,
-        crater_calibres=crater_calibres(shot.crh))
-
-
-#: f_c (Pa) above which the recommended model leaves Li and Chen's formula for the concrete
-#: model: the upper bound of normal strength in the validation's regimes
-SPLIT_STRENGTH = 100e6
-
-
-def split_depth(shot, concrete_depth=None):
-    """The recommended model: Li and Chen's (2003) depth for ``f_c <= 100 MPa``
-    (:data:`SPLIT_STRENGTH`), the concrete model's above (``concrete_depth`` if it is known,
-    else :func:`model_depth`; None stays None).
-
-    Li and Chen fitted ``S = 72 f_c^-1/2`` to published shots; above 100 MPa, on the
-    development shots, it over-predicts depths threefold (bias +1.10), the concrete
-    model, whose strength is capped at ``7 f_c`` from its correlations, twofold (+0.72), and
-    the choice holds with any one reference left out (docs/validation.md)."""
-    if shot.fc <= SPLIT_STRENGTH:
-        return li_chen_depth(shot)
-    return model_depth(shot) if concrete_depth is None else concrete_depth
-
-
-def nose_pressure(shot, resistance):
-    """Mean nose pressure at impact ``F(V0)/(pi a^2)`` (Pa)."""
-    return resistance.force(0.0, shot.V0) / (math.pi * 0.25 * shot.diameter ** 2)
-
-
-def rigid_flag(shot, resistance):
-    """``"non-rigid"`` when the mean nose pressure at impact exceeds the projectile's listed
-    yield strength (column ``proj_yield_MPa``), ``""`` otherwise or when it is not listed."""
-    text = shot.extra.get("proj_yield_MPa", "")
-    try:
-        strength = float(text) * 1e6
-    except ValueError:
-        return ""
-    require(strength > 0.0, "proj_yield_MPa", "a positive strength in MPa", text)
-    return "non-rigid" if nose_pressure(shot, resistance) > strength else ""

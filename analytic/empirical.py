@@ -38,6 +38,7 @@ from cavex.errors import require
 S_COEFFICIENT = 82.6  # S = 82.6 f_c^-0.544, f_c in MPa (Forrestal et al. 1994)
 S_EXPONENT = -0.544
 CRATER_CALIBRES = 2.0  # crater depth k d with k = 2 (4 shank radii), Forrestal et al. 1994
+LI_CHEN_COEFFICIENT = 72.0  # S = 72 f_c^-0.5, f_c in MPa (Li and Chen 2003)
 
 
 def _require_all(values, name, accepted, lower, inclusive=False):
@@ -108,5 +109,19 @@ def forrestal_depth(mass, diameter, crh, velocity, fc, rho, *, S=None,
 
 
 def shot_depth(shot, S=None):
-    """Forrestal et al.'s depth (m) for a :class:`~cavex.verification.validation.shots.Shot`."""
+    """Forrestal et al.'s depth (m) for a shot (any object with ``mass, diameter, crh, V0, fc,
+    rho``, e.g. a :class:`~cavex.verification.validation.shots.Shot`)."""
     return forrestal_depth(shot.mass, shot.diameter, shot.crh, shot.V0, shot.fc, shot.rho, S=S)
+
+
+def crater_calibres(crh):
+    """Li and Chen's (2003) crater depth ``k = 0.707 + h/d``, ``h/d = sqrt(4 CRH - 1)/2``."""
+    return 0.707 + 0.5 * np.sqrt(4.0 * crh - 1.0)  # numbers or arrays
+
+
+def li_chen_depth(shot):
+    """Li and Chen (2003): Forrestal's form with ``S = 72 f_c^-0.5`` and ``k = 0.707 + h/d``."""
+    S = LI_CHEN_COEFFICIENT * (shot.fc / 1e6) ** -0.5
+    return shot.diameter * penetration_calibres(
+        shot.mass, shot.diameter, shot.crh, shot.V0, shot.fc, shot.rho, S=S,
+        crater_calibres=crater_calibres(shot.crh))

@@ -1,4 +1,7 @@
-r"""From a shot's concrete, ``(f_c, rho)``, to cavex's material parameters.
+r"""A concrete of strength ``f_c`` and density ``rho``, described once from published correlations:
+the Mohr-Coulomb layer of the closed forms and the FE (:func:`concrete_material`, under a
+:class:`Mapping`), and the constants of the concrete cavity model (:class:`Constants`,
+:func:`tensile_strength`; :func:`cavex.analytic.penetration.concrete_table.concrete_cavity`).
 
 A published test reports the unconfined compressive strength ``f_c`` and the density ``rho``;
 cavex's models need ``E, nu, rho, lam, tau`` (:class:`cavex.materials.Material`). The mapping
@@ -32,7 +35,7 @@ import math
 from dataclasses import dataclass, fields, replace
 
 from cavex.errors import CavexInputError, require
-from cavex.materials import Material, Target
+from cavex.materials import Material
 
 RICHART_CONFINEMENT = 4.1  # f_cc = f_c + 4.1 f_l (Richart, Brandtzaeg and Brown 1928)
 DEFAULT_NU = 0.2  # EN 1992-1-1, 3.1.3(4)
@@ -91,6 +94,34 @@ def concrete_material(fc, rho, mapping=None):
         raise CavexInputError(f"concrete f_c = {fc:g} Pa, rho = {rho:g} kg/m^3: {exc}") from None
 
 
-def shot_target(shot, mapping=None):
-    """The semi-infinite one-layer target of a shot (thick concrete)."""
-    return Target((concrete_material(shot.fc, shot.rho, mapping),), ())
+@dataclass(frozen=True)
+class Constants:
+    """The global constants of the mapping (defaults: the published values in the docstring).
+
+    ``cap`` is ``S_max = tau_max/f_c``, ``lock_pressure`` ``p_l`` (Pa), ``lock_strain`` HJC's
+    ``mu_l``, ``locked_modulus`` ``K_1`` (Pa), ``confinement`` Richart's ``k``.
+    """
+
+    cap: float = 7.0
+    lock_pressure: float = 0.8e9
+    lock_strain: float = 0.1
+    locked_modulus: float = 85e9
+    confinement: float = 4.1
+    nu: float = DEFAULT_NU
+    power_B: float = math.nan
+    power_N: float = 1.0
+
+    def with_values(self, names, values):
+        return replace(self, **{n: float(v) for n, v in zip(names, values, strict=True)})
+
+    def as_dict(self):
+        return {item.name: getattr(self, item.name) for item in fields(self)}
+
+
+def tensile_strength(fc):
+    """fib Model Code 2010 mean tensile strength (Pa) of a concrete of mean strength ``fc`` (Pa):
+    ``0.3 (f_c - 8)^(2/3)`` MPa up to 58 MPa, ``2.12 ln(1 + f_c/10)`` MPa above."""
+    f = fc / 1e6
+    if f <= 58.0:
+        return 0.3 * max(f - 8.0, 1.0) ** (2.0 / 3.0) * 1e6
+    return 2.12 * math.log(1.0 + 0.1 * f) * 1e6

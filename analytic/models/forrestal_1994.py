@@ -1,0 +1,18 @@
+"""The empirical model of Forrestal, Altman, Cargile and Hanchak (1994)
+(:mod:`cavex.analytic.empirical`): ``S = 82.6 f_c^-0.544`` and a crater of two calibres."""
+
+from cavex.analytic.models.registry import Model, register
+
+
+class Forrestal1994(Model):
+    name = "forrestal-1994"
+    predicts_shots = True
+    prediction_seconds = 0.0
+
+    def shot_depth(self, shot, **options):
+        from cavex.analytic.empirical import shot_depth
+
+        return shot_depth(shot)
+
+
+register(Forrestal1994())

@@ -1,0 +1,55 @@
+"""The FE-tabulated resistance (``cavex table``; docs/fem.md): the FE's wall stress
+``sigma_r(V, L)`` of the target, interpolated (:mod:`cavex.analytic.penetration.tabulated`);
+compressible and at finite strain, which no closed form is. Beside a layered run the first
+layer alone flies the derived closed form (``--boundary`` is its convention)."""
+
+from pathlib import Path
+
+from cavex.analytic.models.registry import Model, get, register
+from cavex.errors import require
+
+
+class Table(Model):
+    name = "table"
+    help = "an FE table (--table)"
+    flies = flies_3d = predicts_shots = fits_mapping = True
+    takes_table = True
+    first_layer = "derived"
+    free_surface_option = True  # its 3-D law (derived: its own; table: the FE's)
+    prediction_seconds = 3e-2  # a prediction with an FE table (docs/validation.md)
+
+    def check(self, boundary=None):
+        get(self.first_layer).check(boundary)  # the first layer's convention
+
+    def boundary(self, boundary=None):
+        return get(self.first_layer).boundary(boundary)
+
+    def describe(self, boundary=None, epsilon=None, table=None, law=None):
+        closed = get(self.first_layer).describe(boundary, epsilon)
+        return f"FE table {Path(str(table)).name} (first layer alone: {closed})"
+
+    def settings_text(self, summary):
+        return f" ({summary['table']}; first layer alone: {summary['first_layer_model']})"
+
+    def resistance(self, target, projectile, *, table=None, **options):
+        from cavex.analytic.penetration.tabulated import TabulatedResistance, read_table
+
+        require(table is not None, "table", "given with resistance 'table'", table)
+        data = table if hasattr(table, "attrs") else read_table(table)
+        return TabulatedResistance(data, target, projectile)
+
+    def stress_law(self, target, projectile, *, table=None, **options):
+        from cavex.analytic.penetration.stress_laws import TableLaw
+        from cavex.analytic.penetration.tabulated import TabulatedResistance
+
+        require(table is not None, "table", "given for --resistance table", None)
+        return TableLaw(TabulatedResistance(table, target, projectile))
+
+    def shot_depth(self, shot, *, mapping=None, tables=None, **options):
+        from cavex.analytic.models.shots import flown_depth
+
+        require(tables is not None, "tables", "an FE-table source for the table model", None)
+        return flown_depth(self, shot, mapping, table=tables.table(shot, mapping))
+
+
+register(Table())
