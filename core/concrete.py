@@ -32,7 +32,7 @@ The free parameters of a calibration are ``lam``, ``strength_factor`` and ``modu
 """
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 
 from cavex.errors import CavexInputError, require
 from cavex.materials import Material
@@ -125,3 +125,63 @@ def tensile_strength(fc):
     if f <= 58.0:
         return 0.3 * max(f - 8.0, 1.0) ** (2.0 / 3.0) * 1e6
     return 2.12 * math.log(1.0 + 0.1 * f) * 1e6
+
+
+@dataclass(frozen=True)
+class Concrete:
+    """One concrete, described once: mean strength ``fc`` (Pa), density ``rho`` (kg/m^3) and
+    the :class:`Constants` of its description. The closed forms and the FE take their material
+    from it:
+
+    - :meth:`layer`: the Mohr-Coulomb layer of the layered closed forms, the FE and the FE
+      tables (:func:`concrete_material` under a :class:`Mapping`);
+    - :meth:`fe_layer`: that layer with the cap ``tau_max = S_max f_c`` and the tension
+      cut-off ``f_t`` that the FE carries (docs/fem.md "Concrete");
+    - :meth:`cavity_parameters`: the dimensionless constants of the concrete cavity model
+      (:class:`cavex.analytic.concrete_cavity.ConcreteCavity`, stresses over ``f_c``).
+    """
+
+    fc: float
+    rho: float
+    constants: Constants = field(default_factory=Constants)
+
+    def __post_init__(self):
+        for name in ("fc", "rho"):
+            value = getattr(self, name)
+            require(isinstance(value, (int, float)) and not isinstance(value, bool)
+                    and math.isfinite(value) and value > 0.0, name, "a finite number > 0",
+                    value)
+
+    @property
+    def modulus(self):
+        """Young's modulus (Pa), ACI 318-19 (:func:`aci_modulus`)."""
+        return aci_modulus(self.fc, self.rho)
+
+    @property
+    def tensile_strength(self):
+        """Mean tensile strength (Pa), fib Model Code 2010 (:func:`tensile_strength`)."""
+        return tensile_strength(self.fc)
+
+    def layer(self, mapping=None):
+        """The Mohr-Coulomb layer of this concrete under ``mapping`` (default
+        :class:`Mapping`)."""
+        return concrete_material(self.fc, self.rho, mapping)
+
+    def fe_layer(self, mapping=None, cracking=True):
+        """:meth:`layer` with the cap ``tau_max = cap f_c`` and, if ``cracking``, the tension
+        cut-off at :attr:`tensile_strength`: the concrete the FE carries."""
+        return replace(self.layer(mapping), tau_max=self.constants.cap * self.fc,
+                       tensile_strength=self.tensile_strength if cracking else None)
+
+    def cavity_parameters(self):
+        """The concrete cavity model's constants, stresses over ``f_c``: ``modulus = E/f_c``,
+        ``nu``, ``lam`` (Richart's ``k``), ``tau_max = S_max``, the HJC hydrostat's ``bulk =
+        p_l/(eta_l f_c)`` with ``eta_l = mu_l/(1 + mu_l)``, ``bulk_locked = K_1/f_c`` and
+        ``tensile = f_t/f_c``."""
+        c, fc = self.constants, self.fc
+        eta_lock = c.lock_strain / (1.0 + c.lock_strain)
+        return {"modulus": aci_modulus(fc, self.rho) / fc, "nu": c.nu,
+                "lam": mohr_coulomb_lambda(c.confinement), "tau_max": c.cap,
+                "bulk": c.lock_pressure / eta_lock / fc, "eta_lock": eta_lock,
+                "bulk_locked": c.locked_modulus / fc, "tensile": tensile_strength(fc) / fc,
+                "power_B": c.power_B, "power_N": c.power_N}

@@ -8,13 +8,21 @@ from importlib import resources
 
 from cavex.errors import CavexInputError, check_keys, prefixed, require
 from cavex.input_files import in_file, read_toml
-from cavex.materials import Material, Projectile, Target
+from cavex.materials import (
+    Material,
+    Projectile,
+    Target,
+    fe_only_parameters,
+    material_parameters,
+)
 
-LAYER_KEYS = {"name", "thickness", "E", "nu", "rho", "lam", "tau", "sigma_c", "bottom",
-              "scab_depth", "tau_max", "tensile_strength", "law_A", "law_B", "tunnel_wall"}
+#: a layer's keys: the material's parameters (declared by :class:`cavex.materials.Material`)
+#: and the layer's own (its name, thickness, bottom face, plain law, tunnel wall)
+LAYER_KEYS = {"name", "thickness", *material_parameters(), "bottom", "scab_depth", "law_A",
+              "law_B", "tunnel_wall"}
 #: FE-only layer keys (docs/config.md), written back only when given: targets without them keep
 #: their tables and fingerprints
-OPTIONAL_LAYER_KEYS = ("tau_max", "tensile_strength")
+OPTIONAL_LAYER_KEYS = fe_only_parameters()
 BOTTOM_KEYS = ("bottom", "scab_depth")  # how a layer's bottom face holds: not on the last layer
 PROJECTILE_KEYS = {"r", "l", "R", "crh", "m", "V0", "length", "inertia", "cg", "mu"}
 TOP_KEYS = {"projectile", "layers"}

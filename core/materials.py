@@ -1,7 +1,7 @@
 """Materials, layered targets and projectiles (SI units, compression positive)."""
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from functools import cached_property
 from itertools import accumulate
 
@@ -57,15 +57,18 @@ class Material:
         ``tension_cutoff`` setting (through the cone's apex unless set). FE only.
     """
 
-    E: float
-    nu: float
-    rho: float
-    lam: float
-    tau: float | None = None
+    E: float = field(metadata={"unit": "Pa"})
+    nu: float = field(metadata={"unit": "1"})
+    rho: float = field(metadata={"unit": "kg m-3"})
+    lam: float = field(metadata={"unit": "1"})
+    tau: float | None = field(default=None, metadata={"unit": "Pa"})
     name: str = ""
-    sigma_c: float | None = field(default=None, compare=False)
-    tau_max: float | None = None
-    tensile_strength: float | None = None
+    sigma_c: float | None = field(default=None, compare=False, metadata={"unit": "Pa"})
+    # the FE-only parameters (None: absent; config files and tables write them only when
+    # given, so that targets without them keep their tables and fingerprints)
+    tau_max: float | None = field(default=None, metadata={"unit": "Pa", "fe_only": True})
+    tensile_strength: float | None = field(default=None,
+                                           metadata={"unit": "Pa", "fe_only": True})
 
     def __post_init__(self):
         require(isinstance(self.name, str), "name", "a string", self.name)
@@ -138,6 +141,18 @@ BONDINGS = ("bonded", "debonded")
 #: units of tau; B ~ 1; soils B ~ 1-3) and bounded where the stresses stay finite
 LAW_A_RANGE = (0.0, 1e3)
 LAW_B_RANGE = (0.0, 100.0)
+
+
+def material_parameters():
+    """``{name: unit}`` of a :class:`Material`'s numerical parameters, in order (its config
+    keys, the sweep file's ``[materials]`` keys and the units of their tables)."""
+    return {f.name: f.metadata["unit"] for f in fields(Material) if "unit" in f.metadata}
+
+
+def fe_only_parameters():
+    """The :class:`Material` parameters that only the FE reads (the closed forms ignore them),
+    in order."""
+    return tuple(f.name for f in fields(Material) if f.metadata.get("fe_only"))
 
 
 @dataclass(frozen=True)

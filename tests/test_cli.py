@@ -253,7 +253,7 @@ def test_resistance_options_of_every_command():
     """One vocabulary: the settings each command reads from its options (calibrate builds its
     FE tables, so it has no --table; stress has no table)."""
     from cavex.verification.cli import build_parser
-    from cavex.verification.commands.options import CLOSED_FORMS, resistance_settings
+    from cavex.verification.commands.options import CLOSED_FORMS, FLOWN, resistance_settings
 
     parser = build_parser()
     calibrate = ["calibrate", "--shots", "s.csv", "--out", "c.toml"]
@@ -275,7 +275,7 @@ def test_resistance_options_of_every_command():
           "table": None}),
     ]
     for argv, settings in cases:
-        offered = CLOSED_FORMS if argv[0] == "stress" else ("derived", "paper", "table", "law")
+        offered = CLOSED_FORMS if argv[0] == "stress" else FLOWN
         assert resistance_settings(parser.parse_args(argv), offered) == settings, argv
 
 

@@ -17,6 +17,7 @@ from cavex.errors import CavexInputError, CavexNumericalError
 from cavex.verification.commands.options import (
     CLOSED_FORMS,
     FLOWN,
+    FLOWN_3D,
     add_interface_option,
     add_resistance_options,
 )
@@ -147,7 +148,7 @@ def build_parser():
                             help="plane of the angle of attack about the velocity (deg; 0: "
                             "in the plane of obliquity toward +x)")
     trajectory.add_argument("--spin", type=float, default=0.0, help="spin about the axis (rad/s)")
-    add_resistance_options(trajectory, FLOWN)
+    add_resistance_options(trajectory, FLOWN_3D)
     add_interface_option(trajectory)
     trajectory.add_argument("--contact-ramp", dest="contact_ramp", type=float, default=None,
                             help="contact regularisation: the stress rises linearly over "

@@ -46,7 +46,7 @@ from cavex.analytic.concrete_cavity import ConcreteCavity, fit_AB, wall_stress
 from cavex.analytic.empirical import crater_calibres
 from cavex.analytic.penetration.integrator import crater_exit, penetrate
 from cavex.analytic.penetration.nose import nose_rule
-from cavex.concrete import Constants, aci_modulus, mohr_coulomb_lambda, tensile_strength
+from cavex.concrete import Concrete, Constants
 from cavex.materials import Material, Projectile, Target
 
 TABLE_POINTS = 33
@@ -54,14 +54,9 @@ PHI_TOP = 16.0  # smallest table top (rho V^2/f_c)
 
 
 def concrete_cavity(fc, rho, constants=None):
-    """The :class:`~cavex.analytic.concrete_cavity.ConcreteCavity` of ``(f_c, rho)``."""
-    c = constants or Constants()
-    eta_lock = c.lock_strain / (1.0 + c.lock_strain)
-    return ConcreteCavity(modulus=aci_modulus(fc, rho) / fc, nu=c.nu,
-                          lam=mohr_coulomb_lambda(c.confinement), tau_max=c.cap,
-                          bulk=c.lock_pressure / eta_lock / fc, eta_lock=eta_lock,
-                          bulk_locked=c.locked_modulus / fc, tensile=tensile_strength(fc) / fc,
-                          power_B=c.power_B, power_N=c.power_N)
+    """The :class:`~cavex.analytic.concrete_cavity.ConcreteCavity` of ``(f_c, rho)``
+    (:meth:`cavex.concrete.Concrete.cavity_parameters`)."""
+    return ConcreteCavity(**Concrete(fc, rho, constants or Constants()).cavity_parameters())
 
 
 def table_top(phi):

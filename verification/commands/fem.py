@@ -3,6 +3,8 @@
 import json
 import sys
 
+from cavex.materials import fe_only_parameters
+
 #: m/s: the upper end of the model's range (docs/fem.md "Range"): the velocities the FE is
 #: verified over (cavex.verification.fedata.table.DEFAULT_VELOCITIES, 0-1200 m/s), a little
 #: above the speeds the rigid-projectile model is used at (the paper's V0 = 1000 m/s, the
@@ -41,7 +43,7 @@ def material_warnings(target):
     forms ignore them, so the comparison is between different materials."""
     named = []
     for i, material in enumerate(target.layers):
-        keys = [k for k in ("tau_max", "tensile_strength") if getattr(material, k) is not None]
+        keys = [k for k in fe_only_parameters() if getattr(material, k) is not None]
         if keys:
             named.append(f"{target.layer_name(i)} ({', '.join(keys)})")
     if not named:

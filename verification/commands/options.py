@@ -21,9 +21,12 @@ from cavex.errors import CavexInputError
 from cavex.materials import BONDINGS
 from cavex.problem import BOUNDARIES
 
-FLOWN = names(flies=True)  # penetrate, trajectory: every model with a resistance
-CLOSED_FORMS = names(closed_form=True)  # stress: the closed forms of the wall stress
-FITTED = names(fits_mapping=True)  # calibrate: the models of the (f_c, rho) mapping
+# the models a command offers, as the capabilities it selects from the registry (read when the
+# parser is built, so that a model registered later is offered too)
+FLOWN = {"flies": True}  # penetrate: every model with a 1-D resistance
+FLOWN_3D = {"flies_3d": True}  # trajectory: every model with a 3-D stress law
+CLOSED_FORMS = {"closed_form": True}  # stress: the closed forms of the wall stress
+FITTED = {"fits_mapping": True}  # calibrate: the models of the (f_c, rho) mapping
 NEW_OPTIONS = "--resistance derived|paper|table (with --boundary dynamic|quasi-static)"
 #: old values of --resistance and --model that are no label, with what replaced them
 OLD_VALUES = {"closed-form": "--resistance derived or --resistance paper",
@@ -33,7 +36,8 @@ OLD_VALUES = {"closed-form": "--resistance derived or --resistance paper",
 def add_resistance_options(command, offered=FITTED, table=True, epsilon=True):
     """``--resistance`` (one of ``offered``), ``--boundary``, ``--table`` (if ``table``),
     ``--epsilon`` (if ``epsilon``), ``--law-A/--law-B`` (where a model offered takes them)
-    and the refused ``--model``."""
+    and the refused ``--model``; ``offered``: the capabilities of the models offered."""
+    offered = names(**offered)
     models = [get(name) for name in offered]
     phrases = [m.help + (" (--epsilon)" if m.takes_epsilon and epsilon else "") for m in models]
     command.add_argument("--resistance", default="derived", metavar="{" + ",".join(offered) + "}",
@@ -97,16 +101,17 @@ def replaced(value):
 
 def resistance_settings(args, offered=FITTED):
     """``{"resistance", "boundary", "epsilon", "table"}`` of the parsed options, checked: no
-    old spelling, the resistance is one of ``offered``, ``--table FILE`` goes with a model that
-    takes a table (both or neither, where the command has ``--table``: ``calibrate`` builds its
-    own tables), the model takes the boundary given, ``--epsilon`` only with the model that
-    reads it (default quasi-static). ``boundary`` is resolved (for a table the first layer's
-    model's; the derived model's default for a model with no convention: the law)."""
+    old spelling; the resistance is a model with the capabilities ``offered``; ``--table
+    FILE`` goes with a model that takes a table (both or neither, where the command has
+    ``--table``: ``calibrate`` builds its own tables); the model takes the boundary given;
+    ``--epsilon`` only with the model that reads it (default quasi-static). ``boundary`` is
+    resolved: for a table the first layer's model's, for a model with no convention (the
+    law) the derived model's default."""
     if args.old_model is not None:
         hint = replaced(args.old_model)
         raise CavexInputError(f"option --model was replaced by {NEW_OPTIONS}"
                               + (f"; for '{args.old_model}' use {hint}" if hint else ""))
-    resistance = args.resistance
+    resistance, offered = args.resistance, names(**offered)
     if resistance not in offered:
         hint = None if resistance in names() else replaced(resistance)
         if hint:

@@ -561,13 +561,13 @@ def run(args, target, projectile):
     kill), returns the text or JSON to print."""
     from cavex.errors import CavexInputError, CavexNumericalError
     from cavex.verification.commands.options import (
-        FLOWN,
+        FLOWN_3D,
         interface_target,
         law_settings,
         resistance_settings,
     )
 
-    settings = resistance_settings(args, FLOWN)
+    settings = resistance_settings(args, FLOWN_3D)
     target = interface_target(args, target, settings["resistance"])
     if args.tunnel_wall is not None:
         require(is_finite_number(args.tunnel_wall) and 0.0 <= args.tunnel_wall <= 1.0,

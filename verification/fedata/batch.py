@@ -21,7 +21,7 @@ from cavex.config import parse_projectile, parse_target
 from cavex.errors import CavexInputError, check_keys, is_finite_number, prefixed, require
 from cavex.fem.settings import make_numerics
 from cavex.input_files import in_file, read_toml
-from cavex.materials import MAX_VELOCITY
+from cavex.materials import MAX_VELOCITY, material_parameters
 from cavex.verification.fedata.cases import (
     CaseBuilder,
     config_tables,
@@ -39,10 +39,9 @@ SECTIONS = ("sweep", "target", "grid", "numerics", "materials")
 SWEEP_KEYS = ("name", "scheduler", "workers")
 TARGET_KEYS = ("config", "layers", "projectile")
 GRID_KEYS = ("velocities", "depths", "nu")
-MATERIAL_PROPERTIES = ("thickness", "E", "nu", "rho", "lam", "tau", "sigma_c", "tau_max",
-                       "tensile_strength")
-PROPERTY_UNITS = {"thickness": "m", "E": "Pa", "nu": "1", "rho": "kg m-3", "lam": "1",
-                  "tau": "Pa", "sigma_c": "Pa", "tau_max": "Pa", "tensile_strength": "Pa"}
+#: a layer's sweepable properties and their units: its thickness and the material's parameters
+PROPERTY_UNITS = {"thickness": "m", **material_parameters()}
+MATERIAL_PROPERTIES = tuple(PROPERTY_UNITS)
 NUMERICS_UNITS = {"seed_radius": "m", "tension_cutoff": "Pa", "dilatancy_deg": "degree"}
 SWEEP_FILE, STORE_DIR, RESULTS_FILE = "sweep.json", "cases", "results.nc"
 
