@@ -3,7 +3,6 @@ layer's own ``tau_k A_k + B_k rho_k V_n^2`` (its ``law_A``, ``law_B`` keys; docs
 "Plain law"): flown by ``penetrate`` and ``trajectory`` only; no boundary convention."""
 
 from cavex.analytic.models.registry import Model, register
-from cavex.errors import CavexInputError
 
 
 def law_echo(target, law_A, law_B):
@@ -30,17 +29,6 @@ class PlainLaw(Model):
     help = "sigma_n = A + B V_n^2 (--law-A, --law-B)"
     flies = flies_3d = True
     takes_law = True
-
-    def check(self, boundary=None):
-        if boundary is not None:
-            raise CavexInputError("option '--boundary' goes with '--resistance derived' (or "
-                                  "table); '--resistance law' has no boundary convention")
-
-    def label(self, boundary=None):
-        return self.name
-
-    def boundary(self, boundary=None):
-        return None
 
     def describe(self, boundary=None, epsilon=None, table=None, law=None):
         return "plain law " + law_text(law)

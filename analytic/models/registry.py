@@ -95,9 +95,14 @@ class Model:
         """The convention the model runs with: ``boundary``, or its default."""
         return self.default_boundary if boundary is None else boundary
 
+    def has_boundary(self):
+        """The model has a boundary convention (a choice of it, or one of its own)."""
+        return bool(self.boundaries or self.default_boundary)
+
     def check(self, boundary=None):
-        """``boundary`` (None: the default) is one the model takes."""
-        if boundary is None:
+        """``boundary`` (None: the default) is one the model takes; a model with no convention
+        ignores it (the command line refuses ``--boundary`` for it)."""
+        if boundary is None or not self.has_boundary():
             return
         require_choice(boundary, BOUNDARIES, "boundary")
         accepted = self.boundaries or ((self.default_boundary,) if self.default_boundary

@@ -307,7 +307,10 @@ def _phase_events(resistance, stop_depth, stop_reason, label, start_time=None):
     def state_changed(t, y):
         if t == start_time:
             return 1.0
-        return 1.0 if resistance.label(y[0], max(y[1], 0.0)) == label else -1.0
+        # a trial point past the stop may lie above the surface (a force that does not fall
+        # with V, e.g. a constant one, lets the error estimate vanish and the steps grow far
+        # beyond the stop): the label there is the surface's; the stop event ends the phase
+        return 1.0 if resistance.label(max(y[0], 0.0), max(y[1], 0.0)) == label else -1.0
 
     stopped.direction = state_changed.direction = -1.0
     events = [(stopped, STOPPED)]

@@ -86,9 +86,15 @@ def law_settings(args, target):
                                   "'--law-A PA --law-B KG_PER_M3' (the layer's plain law "
                                   "S = A + B rho V^2 / tau; docs/config.md)",
                                   f"layers[{missing}].law_A")
-    if takes_law:
-        get(args.resistance).check(args.boundary)
+    if takes_law and args.boundary is not None:
+        refuse_boundary(args.resistance)
     return {"law_A": args.law_A, "law_B": args.law_B}
+
+
+def refuse_boundary(resistance):
+    """Refuse ``--boundary`` for the model ``resistance``, which has no boundary convention."""
+    raise CavexInputError(f"option '--boundary' goes with '--resistance derived' (or table); "
+                          f"'--resistance {resistance}' has no boundary convention")
 
 
 def replaced(value):
@@ -126,8 +132,10 @@ def resistance_settings(args, offered=FITTED):
     if "table" in args and model.takes_table != (table is not None):
         raise CavexInputError("option '--table FILE' goes with '--resistance table' (both or "
                               "neither)")
-    if not model.takes_law:
-        model.check(args.boundary)
+    if not model.has_boundary() and not model.first_layer and args.boundary is not None:
+        if not model.takes_law:  # the law's options are checked first (law_settings)
+            refuse_boundary(resistance)
+    model.check(args.boundary)
     epsilon = getattr(args, "epsilon", None)
     if epsilon is not None and not model.takes_epsilon:
         raise CavexInputError(f"option '--epsilon' goes with '--resistance paper' (the paper "

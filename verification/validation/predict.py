@@ -46,7 +46,8 @@ from cavex.verification.output.number_format import FE_DIGITS, round_significant
 from cavex.verification.validation.regimes import regime_statistics, rigid_flag
 from cavex.verification.validation.shots import shot_projectile, shot_target
 
-#: the labels of the models validate runs, in the order of its columns (the registry's)
+#: the labels of the models validate runs, in the order of its columns (the registry's when
+#: this module is imported; the functions below read the registry when called)
 MODELS = labels(predicts_shots=True)
 CAVEX_MODELS = labels(fits_mapping=True)  # what a calibration can fit: the flown models
 FE_MODEL = names(takes_table=True)[0]  # the model that needs FE tables
@@ -96,7 +97,7 @@ def predict(shot, model, mapping=None, tables=None):
 
     ``tables`` (a :class:`TableCache`) gives the FE tables of the ``table`` model.
     """
-    chosen, boundary = parse_label(model, "models", MODELS)
+    chosen, boundary = parse_label(model, "models", labels(predicts_shots=True))
     if chosen.takes_table:
         tables = tables or TableCache()
     return chosen.shot_depth(shot, boundary=boundary, mapping=mapping, tables=tables)
@@ -225,7 +226,8 @@ def run_estimate(shots, models, tables, workers):
                       if model == FE_MODEL]
     build, reused = tables.plan(shots, table_mappings) if table_mappings else (0, 0)
     cases = build * len(tables._velocities) * len(TABLE_DEPTHS)
-    chosen = [parse_label(model, "models", MODELS)[0] for model, _ in models.values()]
+    chosen = [parse_label(model, "models", labels(predicts_shots=True))[0]
+              for model, _ in models.values()]
     per_shot = sum(model.prediction_seconds for model in chosen)
     table_seconds = max((model.concrete_table_seconds for model in chosen), default=0.0)
     concretes = len({(s.fc, s.rho) for s in shots}) if table_seconds else 0
@@ -283,11 +285,12 @@ def ratio_statistics(ratios):
 def check_models(models):
     """``models`` (None: all of :data:`MODELS`) as a tuple of distinct labels in the order of
     :data:`MODELS`; an unknown one is refused naming the accepted labels."""
+    offered = labels(predicts_shots=True)
     if models is None:
-        return MODELS
+        return offered
     for name in models:
-        require_choice(name, MODELS, "models")
-    return tuple(m for m in MODELS if m in models)
+        require_choice(name, offered, "models")
+    return tuple(m for m in offered if m in models)
 
 
 def validation_columns(calibrations=(), mapping=None, models=None):
@@ -329,7 +332,7 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     tables = tables or TableCache()
     tables.velocities_for(shots)
     concrete = [name for name, (model, _) in columns.items()
-                if parse_label(model, "models", MODELS)[0].concrete_table_seconds]
+                if parse_label(model, "models")[0].concrete_table_seconds]
     ids = [shot.id for shot in shots]
     depths, failures = predictions(
         shots, {k: v for k, v in columns.items() if k not in concrete}, tables, progress)
@@ -339,7 +342,7 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
                                                                          progress)
         for name in concrete:
             depths[name], failed = concrete_depths, concrete_failures
-            if parse_label(columns[name][0], "models", MODELS)[0].parts:
+            if parse_label(columns[name][0], "models")[0].parts:
                 depths[name] = [_split_depth(shot, depth)
                                 for shot, depth in zip(shots, concrete_depths, strict=True)]
                 failed = {i: reason for i, reason in concrete_failures.items()
