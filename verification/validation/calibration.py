@@ -26,19 +26,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cavex.analytic.models import model_label, parse_model_label
+from cavex.analytic.models import model_label, parse_label, parse_model_label
 from cavex.concrete import BOUNDS, FREE_PARAMETERS, Mapping
 from cavex.errors import CavexInputError, CavexNumericalError, check_keys, prefixed, require
 from cavex.input_files import in_file, read_toml
 from cavex.verification.output.number_format import round_significant
-from cavex.verification.validation.predict import FE_MODEL, OUTLIER_FACTOR, TableCache, predict
+from cavex.verification.validation.predict import OUTLIER_FACTOR, TableCache, predict
 from cavex.verification.validation.shots import shot_projectile, shot_target
 
 PARAMETER_DIGITS = 6
 DEFAULT_PARAMETERS = ("lam", "strength_factor")
 LOG_PARAMETERS = ("strength_factor", "modulus_factor")
-DIFF_STEP = {"closed form": 1e-6, FE_MODEL: 2e-2}
-TOLERANCE = {"closed form": 1e-12, FE_MODEL: 1e-3}  # FE: its depths carry ~1e-3 noise
+# forward-difference steps and tolerances: a closed form's depth is smooth to round-off, an
+# FE table's (a model that takes a table) carries ~1e-3 noise
+DIFF_STEP = {"closed form": 1e-6, "FE table": 2e-2}
+TOLERANCE = {"closed form": 1e-12, "FE table": 1e-3}
 CALIBRATION_KEYS = {"model", "params", "lam", "strength_factor", "modulus_factor", "nu",
                     "shots", "shots_file", "reference_shot", "n", "mean_abs_log_ratio",
                     "rms_log_ratio", "evaluations", "skipped", "outliers"}
@@ -205,7 +207,7 @@ def _least_squares(shots, model, params, start, tables, progress):
     :class:`ShotFailure` passes through."""
     from scipy.optimize import least_squares  # not at the top: the checks run without scipy
 
-    kind = FE_MODEL if model == FE_MODEL else "closed form"
+    kind = "FE table" if parse_label(model, "model")[0].takes_table else "closed form"
     count = [0]
     began = time.monotonic()
 

@@ -223,7 +223,7 @@ def run_estimate(shots, models, tables, workers):
     each model's ``prediction_seconds`` and ``concrete_table_seconds`` (the registry's)."""
     tables.velocities_for(shots)
     table_mappings = [mapping or Mapping() for model, mapping in models.values()
-                      if model == FE_MODEL]
+                      if parse_label(model, "models")[0].takes_table]
     build, reused = tables.plan(shots, table_mappings) if table_mappings else (0, 0)
     cases = build * len(tables._velocities) * len(TABLE_DEPTHS)
     chosen = [parse_label(model, "models", labels(predicts_shots=True))[0]
