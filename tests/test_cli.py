@@ -279,6 +279,40 @@ def test_resistance_options_of_every_command():
         assert resistance_settings(parser.parse_args(argv), offered) == settings, argv
 
 
+def test_every_command_module_has_the_one_shape():
+    """The parser is gathered from the command modules (``COMMANDS``, in its order), and each
+    module has the shape of verification/commands/__init__.py: ``HELP``, ``add_arguments(parser)``,
+    ``run(args, target, projectile)``, ``text(result)``, ``summary(result)`` exactly where the
+    command has ``--json``, ``write_outputs(result, out, ...)`` where it writes files."""
+    import inspect
+
+    from cavex.verification.cli import COMMANDS, build_parser, command_module
+
+    commands = build_parser()._subparsers._group_actions[0]  # argparse keeps them only here
+    assert list(commands.choices) == list(COMMANDS)
+    helps = {action.dest: action.help for action in commands._choices_actions}
+    writes = {"penetrate", "trajectory", "validate", "table", "calibrate"}
+    for name in COMMANDS:
+        module = command_module(name)
+        assert helps[name] == module.HELP, name
+
+        def parameters(function):
+            return list(inspect.signature(function).parameters)
+
+        assert parameters(module.add_arguments) == ["parser"], name
+        assert parameters(module.run) == ["args", "target", "projectile"], name
+        assert len(parameters(module.text)) == 1, name
+        has_json = "--json" in commands.choices[name]._option_string_actions
+        assert hasattr(module, "summary") == has_json, name
+        if has_json:
+            assert len(parameters(module.summary)) == 1, name
+        assert hasattr(module, "write_outputs") == (name in writes), name
+        if name in writes:
+            required = [p for p in inspect.signature(module.write_outputs).parameters.values()
+                        if p.default is inspect.Parameter.empty]
+            assert len(required) == 2, name
+
+
 @pytest.mark.parametrize("argv, message", OLD_SPELLINGS, ids=lambda v: " ".join(v)
                          if isinstance(v, list) else None)
 def test_old_spellings_are_refused_with_the_new_one(capsys, tmp_path, argv, message):

@@ -22,9 +22,10 @@ The shape of a command module (``cli`` calls only these):
 
 Imports: a command refuses bad input before it loads the numerical libraries. A command
 module imports at its top only what its parser-side checks need (the standard library, numpy,
-cavex's core, the resistance vocabulary ``analytic.penetration.labels``, the output helpers);
-whatever loads scipy, numba, matplotlib, xarray, scikit-fem or dask is imported inside the
-function that computes or draws, after the checks; the modules the checks live in
+cavex's core, the resistance vocabulary ``analytic.penetration.labels``, the output helpers,
+the ``report`` modules of its figures and markdown, which load matplotlib only in the functions
+that draw); whatever loads scipy, numba, matplotlib, xarray, scikit-fem or dask is imported
+inside the function that computes or draws, after the checks; the modules the checks live in
 (``fedata.table``, ``fedata.batch``, ``fedata.cases``, ``validation.predict``,
 ``validation.calibration``, ``validation.shots``, ``cavex.fem.settings``) follow the same rule.
 Every command does, for the checks it makes before it computes: ``penetrate``, ``trajectory``,
