@@ -63,17 +63,30 @@ def command_module(name):
     return importlib.import_module(f"cavex.verification.commands.{name}")
 
 
-def build_parser():
+def build_parser(command=None):
     """The ``cavex`` parser: one subparser per command of :data:`COMMANDS`, with the command's
-    one-line ``HELP`` and the options its ``add_arguments`` adds."""
+    one-line ``HELP`` and the options its ``add_arguments`` adds. ``command``: only that
+    command's module is imported and its subparser filled (the others are there by name), which
+    is all ``cavex COMMAND ...`` parses, so a command's start costs the import of its own module
+    only; None: every command (``cavex --help``)."""
     parser = _Parser(prog="cavex", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"cavex {__version__}")
     commands = parser.add_subparsers(dest="command", parser_class=_Parser, metavar="COMMAND")
     for name in COMMANDS:
-        module = command_module(name)
-        module.add_arguments(commands.add_parser(name, help=module.HELP))
+        if command is None or name == command:
+            module = command_module(name)
+            module.add_arguments(commands.add_parser(name, help=module.HELP))
+        else:
+            commands.add_parser(name)
     _describe(commands)
     return parser
+
+
+def named_command(argv):
+    """The command ``argv`` names (its first word that is no option; ``cavex`` has no option
+    that takes a value), or None when it names none of :data:`COMMANDS`."""
+    word = next((str(a) for a in argv if not str(a).startswith("-")), None)
+    return word if word in COMMANDS else None
 
 
 def _describe(commands):
@@ -139,7 +152,8 @@ def interrupted(exc):
 
 def main(argv=None):
     """Entry point; returns the exit code (0 ok, 1 numerical failure, 2 bad input)."""
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(named_command(argv))
     try:
         args = parser.parse_args(argv)
         if args.command is None:  # bare `cavex`: what it can do
