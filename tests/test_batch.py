@@ -147,7 +147,7 @@ def test_sweep_on_dask_gives_identical_numbers(tmp_path):
 
 def batch_text(sweep, out):
     """What ``cavex batch SWEEP --out OUT --workers 1`` prints."""
-    return batch_command.text(batch_command.summary(batch_command.job(sweep, out, workers=1)))
+    return batch_command.text(batch_command.job(sweep, out, workers=1))
 
 
 def test_batch_command_summary_and_resume_from_the_store(tmp_path):

@@ -279,6 +279,63 @@ def test_resistance_options_of_every_command():
         assert resistance_settings(parser.parse_args(argv), offered) == settings, argv
 
 
+def test_every_command_module_has_the_one_shape():
+    """The parser is gathered from the command modules (``COMMANDS``, in its order), and each
+    module has the shape of verification/commands/__init__.py: ``HELP``, ``add_arguments(parser)``,
+    ``run(args, target, projectile)``, ``text(result)``, ``summary(result)`` exactly where the
+    command has ``--json``, ``write_outputs(result, out, ...)`` where it writes files."""
+    import inspect
+
+    from cavex.verification.cli import COMMANDS, build_parser, command_module
+
+    commands = build_parser()._subparsers._group_actions[0]  # argparse keeps them only here
+    assert list(commands.choices) == list(COMMANDS)
+    helps = {action.dest: action.help for action in commands._choices_actions}
+    writes = {"penetrate", "trajectory", "validate", "table", "calibrate"}
+    for name in COMMANDS:
+        module = command_module(name)
+        assert helps[name] == module.HELP, name
+
+        def parameters(function):
+            return list(inspect.signature(function).parameters)
+
+        assert parameters(module.add_arguments) == ["parser"], name
+        assert parameters(module.run) == ["args", "target", "projectile"], name
+        assert len(parameters(module.text)) == 1, name
+        has_json = "--json" in commands.choices[name]._option_string_actions
+        assert hasattr(module, "summary") == has_json, name
+        if has_json:
+            assert len(parameters(module.summary)) == 1, name
+        assert hasattr(module, "write_outputs") == (name in writes), name
+        if name in writes:
+            required = [p for p in inspect.signature(module.write_outputs).parameters.values()
+                        if p.default is inspect.Parameter.empty]
+            assert len(required) == 2, name
+
+
+def test_a_command_parses_as_in_the_whole_parser_and_imports_only_its_module():
+    """``cavex COMMAND ...`` builds only COMMAND's options (``build_parser(COMMAND)``): the same
+    help and defaults as in the whole parser, and no other command's module is imported (a
+    command starts as fast as before the parser was gathered from the modules)."""
+    from cavex.verification.cli import COMMANDS, build_parser, named_command
+
+    whole = build_parser()._subparsers._group_actions[0].choices
+    for name in COMMANDS:
+        assert named_command([name, "--json"]) == name
+        alone = build_parser(name)._subparsers._group_actions[0].choices[name]
+        assert alone.format_help() == whole[name].format_help(), name
+        assert [(a.dest, a.default, a.required) for a in alone._actions] == \
+            [(a.dest, a.default, a.required) for a in whole[name]._actions], name
+    assert named_command(["--version"]) is None and named_command(["penetrat"]) is None
+    probe = ("import sys; from cavex.verification.cli import main; main(['config']); "
+             "print(' '.join(m.rsplit('.', 1)[1] for m in sys.modules "
+             "if m.startswith('cavex.verification.commands.')))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          timeout=120, check=True)
+    loaded = set(done.stdout.splitlines()[-1].split())
+    assert "config" in loaded and not loaded & (set(COMMANDS) - {"config"}), loaded
+
+
 @pytest.mark.parametrize("argv, message", OLD_SPELLINGS, ids=lambda v: " ".join(v)
                          if isinstance(v, list) else None)
 def test_old_spellings_are_refused_with_the_new_one(capsys, tmp_path, argv, message):

@@ -134,11 +134,15 @@ def not_blank(path):
 
 @pytest.fixture
 def drawn(monkeypatch):
-    from cavex.verification.commands import penetrate, trajectory, validate
     from cavex.verification.output import files
+    from cavex.verification.report import (
+        penetration_figures,
+        trajectory_figures,
+        validation_figures,
+    )
 
     record = Drawn()
-    for module in (penetrate, trajectory, validate, files):
+    for module in (penetration_figures, trajectory_figures, validation_figures, files):
         if hasattr(module, "save_figure"):
             monkeypatch.setattr(module, "save_figure", record.wrap(module.save_figure))
     return record
@@ -206,11 +210,8 @@ def test_the_3d_block_holds_the_body(case, strike):
     (the body is drawn as polygons, which the line check above does not see), with room for
     readable ticks: each horizontal side at least 0.4 of the largest."""
     from cavex.analytic.penetration.oblique import Strike
-    from cavex.verification.commands.trajectory import (
-        block_limits,
-        body_outline_3d,
-        trajectory_job,
-    )
+    from cavex.verification.commands.trajectory import trajectory_job
+    from cavex.verification.report.trajectory_figures import block_limits, body_outline_3d
 
     target, projectile = load_config()
     result = trajectory_job(target, projectile, Strike(*strike))["runs"]["runway"]
@@ -234,7 +235,11 @@ def test_a_normal_shot_draws_notes_not_round_off(tmp_path, drawn, capsys):
 
 @pytest.mark.parametrize("calibrated", [True, False])
 def test_validation_figures(tmp_path, drawn, calibrated):
-    from cavex.verification.commands.validate import FIGURES, REGIME_FIGURES, write_figures
+    from cavex.verification.report.validation_figures import (
+        FIGURES,
+        REGIME_FIGURES,
+        write_figures,
+    )
     from cavex.verification.validation.regimes import REGIMES
 
     result = json.loads((ROOT / "results" / "validation" / "validation.json").read_text())
@@ -294,14 +299,14 @@ def test_penetrate_layer_names_fit_without_overlap():
     """The deceleration figure's layer names: a layer narrower than its name keeps it when its
     neighbours leave room (the runway's macadam on a 5 m axis); names that would overlap or
     stick out of the axes are left out; the placed ones never overlap."""
-    from cavex.verification.commands.penetrate import _layer_names
     from cavex.verification.output.files import agg_figure
+    from cavex.verification.report.penetration_figures import layer_names
 
     def placed(bounds, names, xlim):
         fig = agg_figure(figsize=(6.4, 4.8))
         ax = fig.add_subplot()
         ax.set_xlim(*xlim)
-        _layer_names(ax, names, [xlim[0], *bounds, xlim[1]])
+        layer_names(ax, names, [xlim[0], *bounds, xlim[1]])
         renderer = fig.canvas.get_renderer()
         boxes = sorted(((t.get_window_extent(renderer), t.get_text()) for t in ax.texts),
                        key=lambda b: b[0].x0)

@@ -10,9 +10,10 @@ Floors, bottom to top (README "Where things are"):
   ``empirical``) sit below the penetration feature (``analytic/penetration/``), and the model
   registry (``analytic/models/``: one module a model) above both;
 - ``verification/``: ``output/`` (file formats) at the bottom, then ``fedata/`` (FE data
-  production), then ``report/`` and ``validation/`` (which use ``fedata/`` but not each
-  other), then ``studies/`` (which may use ``validation/``: a study of the validation data),
-  then ``commands/`` (one module per command), then ``cli``.
+  production), then ``validation/`` (which uses ``fedata/``), then ``report/`` (the reports'
+  words and figures, which may use ``validation/``: the validation's figures and markdown) and
+  ``studies/`` (which may use ``validation/``: a study of the validation data), which do not
+  use each other, then ``commands/`` (one module per command), then ``cli``.
 """
 
 import ast
@@ -42,7 +43,7 @@ ALLOWED = {
     V + "output": CORE + (V + "output",),
     V + "fedata": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata"),
     V + "report": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
-                          V + "report"),
+                          V + "validation", V + "report"),
     V + "validation": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
                               V + "validation"),
     V + "studies": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",

@@ -88,8 +88,9 @@ def test_toy_model_flies_in_trajectory(toy, capsys, tmp_path):
 
 
 def test_toy_model_predicts_in_validate(toy, capsys, tmp_path):
-    """``validate --models toy-constant-pressure forrestal-1994``: the toy's column, each
-    depth the toy's own ``shot_depth``."""
+    """``validate --models toy-constant-pressure forrestal-1994``: the toy's column after
+    Forrestal's (the registry's order: the toy registered last), each depth the toy's own
+    ``shot_depth``; the figures drawn (the toy gets the registry's next marker)."""
     from cavex.verification.validation.shots import read_shots
 
     code, out, err = run(capsys, "validate", "--shots", SHOTS, "--models",
@@ -97,7 +98,8 @@ def test_toy_model_predicts_in_validate(toy, capsys, tmp_path):
                          tmp_path / "v", "--no-progress")
     assert code == 0, err
     result = json.loads(out)
-    assert result["models"] == ["toy-constant-pressure", "forrestal-1994"]
+    assert result["models"] == ["forrestal-1994", "toy-constant-pressure"]
+    assert (tmp_path / "v" / "predicted_vs_measured.png").exists()
     for row, shot in zip(result["shots"], read_shots(SHOTS).shots, strict=True):
         assert row["predicted_m"]["toy-constant-pressure"] == pytest.approx(
             toy.MODEL.shot_depth(shot), rel=1e-5)

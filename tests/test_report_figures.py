@@ -18,7 +18,7 @@ from cavex.analytic.penetration.integrator import crater_depth
 from cavex.config import load_config
 from cavex.verification.commands import penetrate as penetration_report
 from cavex.verification.fedata.table import analytic_table, write_table
-from cavex.verification.report import plots
+from cavex.verification.report import penetration_figures, plots
 from cavex.verification.report.analysis import analyse
 from cavex.verification.report.build import quick_axes
 from cavex.verification.report.html import markdown_to_html, slug
@@ -55,7 +55,7 @@ def figures(monkeypatch):
         return path
 
     monkeypatch.setattr(plots, "_save", keep)
-    monkeypatch.setattr(penetration_report, "_save", keep)
+    monkeypatch.setattr(penetration_figures, "_save", keep)
     yield kept
     plt.close("all")
 
@@ -170,14 +170,14 @@ def test_penetration_titles(runway, figures, tmp_path):
     job = penetration_report.penetration_job(target, projectile, resistance="table", table=path)
     assert job["table"] == str(path)  # the command's own output keeps the full path
     assert (job["model"], job["first_layer_model"]) == ("table", "derived-dynamic")
-    penetration_report._write_figures(job, tmp_path)
+    penetration_figures.figures(job, tmp_path)
     for name in ("velocity_time.png", "deceleration_depth.png"):
         ax = figures[name].axes[0]
         assert str(tmp_path) not in ax.get_title() and "table.nc" in ax.get_title()
         assert "runway (layered, FE table)" in [t.get_text() for t in ax.get_legend().texts]
     assert figures["deceleration_depth.png"].axes[0].get_ylabel() == r"deceleration ($10^3$ g)"
     job = penetration_report.penetration_job(target, projectile, resistance="paper")
-    penetration_report._write_figures(job, tmp_path)
+    penetration_figures.figures(job, tmp_path)
     titles = [figures[n].axes[0].get_title() for n in ("velocity_time.png",
                                                         "deceleration_depth.png")]
     assert all("boundary" not in t and "paper model" in t for t in titles)

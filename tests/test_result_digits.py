@@ -168,11 +168,9 @@ def penetration():
     return penetration_report.penetration_job(target, projectile)
 
 
-def test_penetration_csv_is_byte_identical_and_has_nine_digits(penetration, tmp_path,
-                                                               monkeypatch):
-    monkeypatch.setattr(penetration_report, "_write_figures", lambda job, out: [])
-    first = penetration_report.write_outputs(penetration, tmp_path / "a")
-    second = penetration_report.write_outputs(penetration, tmp_path / "b")
+def test_penetration_csv_is_byte_identical_and_has_nine_digits(penetration, tmp_path):
+    first = penetration_report.write_outputs(penetration, tmp_path / "a", draw=False)
+    second = penetration_report.write_outputs(penetration, tmp_path / "b", draw=False)
     assert [p.rsplit("/", 1)[1] for p in first] == [
         "trajectory_runway.csv", "trajectory_first_layer_only.csv", "phases_runway.csv"]
     numbers = 0
@@ -207,11 +205,9 @@ def test_another_cpu_writes_the_same_penetration_text(penetration):
     assert changed > len(generic)  # the full-precision text would have changed
 
 
-def test_penetration_csv_unchanged_by_a_perturbed_trajectory(penetration, tmp_path,
-                                                              monkeypatch):
+def test_penetration_csv_unchanged_by_a_perturbed_trajectory(penetration, tmp_path):
     """Writer input multiplied by (1 + 1e-8), the measured spread of an integrated trajectory,
     values near a boundary left out of the check."""
-    monkeypatch.setattr(penetration_report, "_write_figures", lambda job, out: [])
     run = penetration["runs"]["runway"]
     columns = run.as_columns()
     generic = np.ones(len(run.t), dtype=bool)

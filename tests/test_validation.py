@@ -418,7 +418,7 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
     from cavex.analytic.empirical import li_chen_depth
     from cavex.analytic.models.li_chen_concrete import SPLIT_STRENGTH
     from cavex.analytic.penetration.concrete_table import model_depth
-    from cavex.verification.commands.validate import recommendation
+    from cavex.verification.report.validation_markdown import recommendation
 
     out_dir = tmp_path / "val"
     code, out, err = run(capsys, "validate", "--shots", SHOTS, "--models", "concrete",
@@ -523,7 +523,7 @@ def test_committed_validation_report_is_consistent():
     the one the numbers give."""
     from pathlib import Path
 
-    from cavex.verification.commands.validate import verdict
+    from cavex.verification.report.validation_markdown import verdict
 
     folder = Path("results/validation")
     result = json.loads((folder / "validation.json").read_text())
@@ -581,7 +581,7 @@ def test_committed_development_validation_is_consistent():
 
 def test_a_shot_id_of_any_characters_is_one_markdown_table_cell():
     """report.md's tables stay tables for ids with '|', line breaks, tabs or emoji."""
-    from cavex.verification.commands.validate import table_cell
+    from cavex.verification.report.validation_markdown import table_cell
 
     for shot_id, cell in (("A|1", "A\\|1"), ("two\nlines", "two lines"), ("t\tab", "t ab"),
                           ("\U0001F3AF", "\U0001F3AF"), ("\x07bell", " bell")):

@@ -62,24 +62,24 @@ def test_stress_prints_a_table_in_mpa_and_mm_with_the_state_spelled_out(capsys):
     assert "3349129710" not in out and "{" not in out  # no reprs, no dicts
 
 
-def test_table_states_the_depth_grid_it_runs(capsys, tmp_path):
-    import json
-
+def test_table_states_the_depth_grid_it_runs(tmp_path):
+    """The command's result (what ``cavex table`` computes), its JSON summary and its text."""
     from cavex.config import load_config
+    from cavex.verification.cli import build_parser
+    from cavex.verification.commands import table
     from cavex.verification.fedata.table import grid_depths
 
-    code, out, err = _run(capsys, "table", "-o", str(tmp_path / "t.nc"), "--velocities", "0",
-                          "600", "--depths", "0.3", "0.5", "0.7", "--workers", "1", "--json")
-    assert code == 0
-    document = json.loads(out)
+    args = build_parser().parse_args(["table", "-o", str(tmp_path / "t.nc"), "--velocities",
+                                      "0", "600", "--depths", "0.3", "0.5", "0.7", "--workers",
+                                      "1"])
     target, projectile = load_config()
+    result = table.run(args, target, projectile)
+    document = table.summary(result)
     run = grid_depths([0.3, 0.5, 0.7], target, projectile)
     assert document["depths_requested_m"] == [0.3, 0.5, 0.7]
     assert sorted(document["depths_requested_m"] + document["depths_added_m"]) == list(run)
     assert document["depths_m"] == list(run) and len(run) > 3
-    from cavex.verification.commands.table import text
-
-    line = text(document).splitlines()[1]
+    line = table.text(result).splitlines()[1]
     assert line.startswith(f"depths  {len(run)} depths run (3 requested + {len(run) - 3} added "
                            "at the layer switches: ")
 
@@ -183,18 +183,20 @@ def test_standard_errors_are_those_of_linear_least_squares():
 def test_calibrate_prints_standard_errors_and_warns_when_every_shot_is_fitted(capsys, tmp_path):
     import json
 
+    from cavex.verification.cli import build_parser
+    from cavex.verification.commands import calibrate
+
     shots = "examples/shots_forrestal1994.csv"
-    code, out, err = _run(capsys, "calibrate", "--shots", shots, "--out",
-                          str(tmp_path / "c.toml"), "--ids", "F94-39", "F94-40", "F94-41",
-                          "--workers", "1", "--json")
-    assert (code, err) == (0, "")
-    document = json.loads(out)
+    args = build_parser().parse_args(["calibrate", "--shots", shots, "--out",
+                                      str(tmp_path / "c.toml"), "--ids", "F94-39", "F94-40",
+                                      "F94-41", "--workers", "1"])
+    result = calibrate.run(args, None, None)  # what `cavex calibrate ... --json` summarises
+    assert capsys.readouterr().err == ""
+    document = json.loads(json.dumps(calibrate.summary(result)))
     errors = document["standard_errors"]
     assert set(errors) == {"lam", "strength_factor"}
     assert all(0.0 < e < float("inf") for e in errors.values())
-    from cavex.verification.commands.calibrate import text
-
-    fitted = text(document).splitlines()[1]
+    fitted = calibrate.text(result).splitlines()[1]
     assert f"lam = {document['fitted']['lam']:.6g} +- {errors['lam']:.2g}" in fitted
     code, out, err = _run(capsys, "calibrate", "--shots", shots, "--out",
                           str(tmp_path / "all.toml"), "--workers", "1")

@@ -1,28 +1,25 @@
-"""The ``cavex`` command line: the parser, the configuration, dispatch to the command's module
-(:mod:`cavex.verification.commands`, one per command: ``run(args, target, projectile)`` returns
-the text to print) and exit codes."""
+"""The ``cavex`` command line: the parser (each command's module adds its own options), the
+configuration, dispatch to the command's module (:mod:`cavex.verification.commands`, one per
+command: ``run(args, target, projectile)`` returns the result, printed as ``summary`` JSON with
+``--json``, else as ``text``) and exit codes."""
 
 import argparse
 import gc
 import importlib
+import json
 import os
 import re
 import signal
 import sys
 
 from cavex import __version__
-from cavex.analytic.models import labels
 from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
-from cavex.verification.commands.options import (
-    CLOSED_FORMS,
-    FLOWN,
-    FLOWN_3D,
-    add_interface_option,
-    add_resistance_options,
-)
 
-DEFAULT_PENETRATION_DIR = "results/penetration"
+#: The commands, in the order ``cavex --help`` lists them; each is the module
+#: ``cavex.verification.commands.<name>``.
+COMMANDS = ("penetrate", "stress", "fem", "table", "verify", "batch", "calibrate", "validate",
+            "trajectory", "config")
 
 
 class _Help(argparse.ArgumentDefaultsHelpFormatter):
@@ -61,137 +58,35 @@ DESCRIPTION = ("cavex: layered spherical cavity-expansion resistance, checked ag
                "code 2; a numerical failure: exit code 1.")
 
 
-def build_parser():
+def command_module(name):
+    """The module of the command ``name`` (:data:`COMMANDS`)."""
+    return importlib.import_module(f"cavex.verification.commands.{name}")
+
+
+def build_parser(command=None):
+    """The ``cavex`` parser: one subparser per command of :data:`COMMANDS`, with the command's
+    one-line ``HELP`` and the options its ``add_arguments`` adds. ``command``: only that
+    command's module is imported and its subparser filled (the others are there by name), which
+    is all ``cavex COMMAND ...`` parses, so a command's start costs the import of its own module
+    only; None: every command (``cavex --help``)."""
     parser = _Parser(prog="cavex", description=DESCRIPTION)
     parser.add_argument("--version", action="version", version=f"cavex {__version__}")
     commands = parser.add_subparsers(dest="command", parser_class=_Parser, metavar="COMMAND")
-    penetrate = commands.add_parser("penetrate", help="integrate the projectile through the target")
-    _config(penetrate)
-    add_resistance_options(penetrate, FLOWN)
-    add_interface_option(penetrate)
-    penetrate.add_argument("--json", action="store_true", help="print JSON")
-    penetrate.add_argument("--out", default=DEFAULT_PENETRATION_DIR, help="output folder")
-    _figures(penetrate, "the CSV trajectories and phase table")
-    penetrate.add_argument("--crater", choices=("nose-base", "nose-tip"), default="nose-base",
-                           help="where the crater depth 4.5 r is measured from")
-    stress = commands.add_parser("stress", help="cavity-wall stress at a nose depth")
-    _config(stress)
-    add_resistance_options(stress, CLOSED_FORMS, table=False)
-    stress.add_argument("--json", action="store_true", help="print JSON")
-    stress.add_argument("--velocity", type=float, required=True, help="expansion velocity V (m/s)")
-    stress.add_argument("--depth", type=float, required=True, help="nose-tip depth L (m)")
-    fem = commands.add_parser("fem", help="FE against analytic wall stress at a nose depth")
-    _config(fem)
-    fem.add_argument("--velocity", type=float, required=True, help="expansion velocity V (m/s)")
-    fem.add_argument("--depth", type=float, required=True, help="nose-tip depth L (m)")
-    fem.add_argument("--nu", type=float, help="Poisson's ratio for every layer (default: file's)")
-    fem.add_argument("--json", action="store_true", help="print JSON")
-    fem.add_argument("--fields", help="folder for the FE fields (XDMF time series for ParaView "
-                     "and meshio, history CSV; default: none written)")
-    table = commands.add_parser("table", help="FE-tabulated sigma_r(V, L) for the target")
-    _config(table)
-    table.add_argument("--velocities", nargs="+", type=float,
-                       help="m/s (default 0, 100, ..., 1200)")
-    table.add_argument("--depths", nargs="+", type=float, help="nose depths, m (default: the "
-                       "target's default grid; the layer switch and refinement depths are "
-                       "added, and the run states the grid)")
-    table.add_argument("-o", "--out", default="results/table.nc", help="NetCDF file to write")
-    table.add_argument("--nu", type=float, help="Poisson's ratio for every layer (default: "
-                       "file's)")
-    table.add_argument("--json", action="store_true", help="print JSON")
-    _parallel(table)
-    verify = commands.add_parser("verify", help="analytic against FE report for the target")
-    _config(verify)
-    verify.add_argument("--quick", action="store_true", help="small grid (under a minute)")
-    verify.add_argument("--out", help="report folder (default results/verification)")
-    verify.add_argument("--json", action="store_true", help="print JSON")
-    _parallel(verify)
-    batch = commands.add_parser("batch", help="run a sweep of FE cases (TOML) into one Dataset")
-    batch.add_argument("sweep", help="sweep TOML file; its [target] section names the target")
-    batch.add_argument("--out", help="output folder (default results/batch/<sweep name>)")
-    batch.add_argument("--json", action="store_true", help="print JSON")
-    _parallel(batch)
-    batch.add_argument("--allow-large", action="store_true",
-                       help="run a sweep of more than 20000 FE cases")
-    calibrate = commands.add_parser("calibrate", help="fit material parameters to measured "
-                                    "penetration depths (docs/validation.md)")
-    calibrate.add_argument("--shots", required=True, help="shot file (CSV)")
-    calibrate.add_argument("--out", required=True, help="calibration TOML file to write")
-    calibrate.add_argument("--params", nargs="+", help="free parameters: lam, strength_factor, "
-                           "modulus_factor (default: lam strength_factor)")
-    add_resistance_options(calibrate, table=False, epsilon=False)
-    calibrate.add_argument("--ids", nargs="+", help="fit only these shots (default: all)")
-    calibrate.add_argument("--json", action="store_true", help="print JSON")
-    _parallel(calibrate)
-    validate = commands.add_parser("validate", help="predicted against measured penetration "
-                                   "depths (docs/validation.md)")
-    validate.add_argument("--shots", required=True, help="shot file (CSV)")
-    validate.add_argument("--calibration", nargs="+", action="extend",
-                          help="calibration TOML file(s) from `cavex calibrate` (default: "
-                          "none, the uncalibrated models only)")
-    validate.add_argument("--models", nargs="+", action="extend", metavar="NAME",
-                          help="run only these models: " + ", ".join(labels(predicts_shots=True))
-                          + " (default: all; calibrations add their columns)")
-    validate.add_argument("--json", action="store_true", help="print JSON")
-    validate.add_argument("--out", help="output folder (default results/validation)")
-    _figures(validate, "validation.json, predictions.csv and report.md")
-    _parallel(validate)
-    trajectory = commands.add_parser("trajectory", help="oblique shot with attitude: the rigid "
-                                     "projectile in 3-D through the layers (docs/oblique.md)")
-    _config(trajectory)
-    trajectory.add_argument("--velocity", type=float, help="striking speed (m/s; default V0)")
-    trajectory.add_argument("--obliquity", type=float, default=0.0,
-                            help="angle of the velocity from the target normal (deg)")
-    trajectory.add_argument("--attack", type=float, default=0.0,
-                            help="angle of attack, axis from velocity (deg)")
-    trajectory.add_argument("--attack-plane", type=float, default=0.0,
-                            help="plane of the angle of attack about the velocity (deg; 0: "
-                            "in the plane of obliquity toward +x)")
-    trajectory.add_argument("--spin", type=float, default=0.0, help="spin about the axis (rad/s)")
-    add_resistance_options(trajectory, FLOWN_3D)
-    add_interface_option(trajectory)
-    trajectory.add_argument("--contact-ramp", dest="contact_ramp", type=float, default=None,
-                            help="contact regularisation: the stress rises linearly over "
-                            "0 < V_n < this (m/s; default 0.01; docs/oblique.md)")
-    trajectory.add_argument("--contact-hold", dest="contact_hold", type=float, default=None,
-                            help="held contact instead of the ramp: each element's load rises "
-                            "over this push into its wall, then it cuts (m in [1e-7, 1e-5]; "
-                            "not with --contact-ramp or --tangency-psi; default: off, the "
-                            "velocity ramp; docs/oblique.md)")
-    trajectory.add_argument("--tunnel-wall", dest="tunnel_wall", type=float, default=None,
-                            help="factor in [0, 1] on the shank's load in every layer (a "
-                            "sensitivity setting, uncalibrated; default: each layer's "
-                            "tunnel_wall key, else 1; docs/oblique.md)")
-    trajectory.add_argument("--tangency-psi", dest="tangency_psi", type=float, default=0.0,
-                            help="OFPM's attenuation: an element's load falls linearly within "
-                            "this angle of tangency to its velocity (deg in [0, 30]; default "
-                            "0: none; docs/oblique.md)")
-    trajectory.add_argument("--entry-crater", dest="entry_crater", action="store_true",
-                            help="the shank carries no load in the entry crater, nose-tip "
-                            "depth 0 to 4.5 r + l (the 1-D crater depth; default: off, the "
-                            "tunnel wall from the surface; docs/oblique.md)")
-    trajectory.add_argument("--crater", choices=("nose-base", "nose-tip"), default=None,
-                            help="where the crater depth 4.5 r of the entry and interface "
-                            "craters is measured from (with --entry-crater or debonded "
-                            "interfaces; default nose-base, as penetrate)")
-    trajectory.add_argument("--no-free-surface", action="store_true",
-                            help="no free-surface reduction of the derived law")
-    trajectory.add_argument("--compare-homogeneous", action="store_true",
-                            help="also the same shot into the first layer alone")
-    trajectory.add_argument("--json", action="store_true", help="print JSON")
-    _figures(trajectory, "the CSV histories and summary.json")
-    trajectory.add_argument("--progress", action=argparse.BooleanOptionalAction,
-                            help="progress bar of integrator steps on stderr (default: when "
-                            "stderr is a terminal)")
-    trajectory.add_argument("--out", default="results/trajectory",
-                            help="output folder (default results/trajectory)")
-    config = commands.add_parser("config", help="print the configuration as TOML: the embedded "
-                                 "default (Table 1) to copy and edit, or a checked --config FILE")
-    _config(config)
-    config.add_argument("--default", action="store_true", help="the embedded default (also "
-                        "without --config)")
+    for name in COMMANDS:
+        if command is None or name == command:
+            module = command_module(name)
+            module.add_arguments(commands.add_parser(name, help=module.HELP))
+        else:
+            commands.add_parser(name)
     _describe(commands)
     return parser
+
+
+def named_command(argv):
+    """The command ``argv`` names (its first word that is no option; ``cavex`` has no option
+    that takes a value), or None when it names none of :data:`COMMANDS`."""
+    word = next((str(a) for a in argv if not str(a).startswith("-")), None)
+    return word if word in COMMANDS else None
 
 
 def _describe(commands):
@@ -200,26 +95,6 @@ def _describe(commands):
         sub = commands.choices[action.dest]
         if sub.description is None:
             sub.description = action.help
-
-
-def _parallel(command):
-    command.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://127.0.0.1:8786 "
-                         "(default: local processes, --workers)")
-    command.add_argument("--workers", type=int, help="local worker processes (default: CPUs)")
-    command.add_argument("--progress", action=argparse.BooleanOptionalAction,
-                         help="progress bar on stderr (default: when stderr is a terminal)")
-
-
-def _figures(command, files):
-    """``--figures/--no-figures``: draw the PNG figures (default), or write only ``files`` (for
-    scripted runs: no matplotlib)."""
-    command.add_argument("--figures", action=argparse.BooleanOptionalAction, default=True,
-                         help=f"draw the figures (default; --no-figures: {files} only, for "
-                         "scripted runs)")
-
-
-def _config(command):
-    command.add_argument("--config", help="target TOML file (default: the paper's Table 1)")
 
 
 COMPILING = ("cavex: compiling the numerical kernels (first run after installing or updating; "
@@ -277,7 +152,8 @@ def interrupted(exc):
 
 def main(argv=None):
     """Entry point; returns the exit code (0 ok, 1 numerical failure, 2 bad input)."""
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(named_command(argv))
     try:
         args = parser.parse_args(argv)
         if args.command is None:  # bare `cavex`: what it can do
@@ -287,8 +163,10 @@ def main(argv=None):
             raise CavexInputError("options --default and --config FILE exclude each other")
         target, projectile = load_config(args.config) if "config" in args else (None, None)
         _announce_on_terminal(args.command)
-        command = importlib.import_module(f"cavex.verification.commands.{args.command}")
-        text = command.run(args, target, projectile)
+        command = command_module(args.command)
+        result = command.run(args, target, projectile)
+        text = (json.dumps(command.summary(result), indent=2) if getattr(args, "json", False)
+                else command.text(result))
     except CavexInputError as exc:
         print(f"cavex: error: {exc}", file=sys.stderr)
         return 2

@@ -6,12 +6,25 @@ import os
 import sys
 import time
 
+from cavex.verification.commands.shared_options import add_parallel_options
+
+HELP = "run a sweep of FE cases (TOML) into one Dataset"
+
+
+def add_arguments(parser):
+    """The options of ``cavex batch``."""
+    parser.add_argument("sweep", help="sweep TOML file; its [target] section names the target")
+    parser.add_argument("--out", help="output folder (default results/batch/<sweep name>)")
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    add_parallel_options(parser)
+    parser.add_argument("--allow-large", action="store_true",
+                        help="run a sweep of more than 20000 FE cases")
+
 
 def run(args, target, projectile):
-    """Run the sweep; return its summary as text or JSON."""
-    document = summary(job(args.sweep, args.out, scheduler=args.scheduler, workers=args.workers,
-                           progress=args.progress, allow_large=args.allow_large))
-    return json.dumps(document, indent=2) if args.json else text(document)
+    """Run the sweep (:func:`job`); returns its result."""
+    return job(args.sweep, args.out, scheduler=args.scheduler, workers=args.workers,
+               progress=args.progress, allow_large=args.allow_large)
 
 
 def job(path, out_dir=None, *, scheduler=None, workers=None, progress=None, allow_large=False):
@@ -61,9 +74,9 @@ def summary(job):
             "store": os.path.join(out_dir, STORE_DIR)}
 
 
-def text(summary):
+def text(job):
     """Cases run, loaded and failed (the first ten reasons), dimensions, files."""
-    s = summary
+    s = summary(job)
     sizes = ", ".join(f"{name}={size}" for name, size in s["dimension_sizes"].items())
     reasons = s["failure_reasons"]
     lines = [f"sweep '{s['sweep']}': {s['cases']} cases ({s['run']} run, "

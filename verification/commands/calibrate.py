@@ -1,16 +1,33 @@
 """``cavex calibrate``: fit a model's free material parameters to measured depths, written as a
 calibration file (:mod:`cavex.verification.validation.calibration`, docs/validation.md)."""
 
-import json
 import shlex
 import sys
 import time
 from pathlib import Path
 
+from cavex.verification.commands.options import add_resistance_options
+from cavex.verification.commands.shared_options import add_parallel_options
+
+HELP = "fit material parameters to measured penetration depths (docs/validation.md)"
+
+
+def add_arguments(parser):
+    """The options of ``cavex calibrate``."""
+    parser.add_argument("--shots", required=True, help="shot file (CSV)")
+    parser.add_argument("--out", required=True, help="calibration TOML file to write")
+    parser.add_argument("--params", nargs="+", help="free parameters: lam, strength_factor, "
+                        "modulus_factor (default: lam strength_factor)")
+    add_resistance_options(parser, table=False, epsilon=False)
+    parser.add_argument("--ids", nargs="+", help="fit only these shots (default: all)")
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    add_parallel_options(parser)
+
 
 def run(args, target, projectile):
-    """Check everything, fit, write ``--out``; return the summary as text or JSON. Nothing is
-    written when an input is refused or the fit fails."""
+    """Check everything, fit, write ``--out``; returns the result (:func:`job`) with the shots
+    file, the reference shot and the command line the file records and the file written
+    (``outputs``). Nothing is written when an input is refused or the fit fails."""
     from cavex.verification.commands.options import resistance_settings
     from cavex.verification.output.paths import check_output_file
     from cavex.verification.validation.calibration import check_parameters
@@ -25,19 +42,21 @@ def run(args, target, projectile):
                  params=params, workers=args.workers, scheduler=args.scheduler,
                  progress=args.progress, out=out)
     calibration = result["calibration"]
-    command = command_line(args.shots, args.out, calibration.model, params, args.ids)
+    result["command"] = command_line(args.shots, args.out, calibration.model, params, args.ids)
     warning = all_fitted_warning(shots, len(shot_file.shots))
     if warning:
         print(f"cavex calibrate: warning: {warning}", file=sys.stderr)
-    reference = next(s for s in shots if s.id in calibration.shots)  # the first one fitted
-    document = summary(result, write_outputs(result, args.shots, reference, command, out))
-    return json.dumps(document, indent=2) if args.json else text(document)
+    result["shots_path"] = args.shots
+    result["reference"] = next(s for s in shots if s.id in calibration.shots)  # first fitted
+    result["outputs"] = write_outputs(result, out)
+    return result
 
 
 def job(shots, *, resistance="derived", boundary=None, params=None, workers=None,
         scheduler=None, progress=None, out=None):
     """Fit (:func:`cavex.verification.validation.calibration.fit`) after checking the execution
-    settings and that ``out`` (if given) ends in .toml: ``{"calibration", "seconds"}``."""
+    settings and that ``out`` (if given) ends in .toml: ``{"calibration", "seconds",
+    "output"}`` (``output``: ``out``, the file to write)."""
     from cavex.errors import require
     from cavex.verification.fedata.runner import check_execution, show_progress
     from cavex.verification.validation.calibration import fit
@@ -51,7 +70,7 @@ def job(shots, *, resistance="derived", boundary=None, params=None, workers=None
     began = time.monotonic()
     calibration = fit(shots, resistance, params, tables=tables, progress=show,
                       boundary=boundary)
-    return {"calibration": calibration, "seconds": time.monotonic() - began}
+    return {"calibration": calibration, "seconds": time.monotonic() - began, "output": out}
 
 
 def command_line(shots_path, out_path, model, params, ids=None):
@@ -64,17 +83,19 @@ def command_line(shots_path, out_path, model, params, ids=None):
     return " ".join(shlex.quote(w) for w in words)
 
 
-def write_outputs(job, shots_path, reference, command, out):
-    """Write the calibration file ``out`` (reference shot ``reference``); return its path."""
+def write_outputs(job, out):
+    """Write the calibration file ``out``, recording the job's ``shots_path``, ``reference``
+    shot and ``command``; return the paths written."""
     from cavex.verification.output.files import write_text_atomic
     from cavex.verification.validation.calibration import calibration_text
 
     out = Path(out)
-    text = calibration_text(job["calibration"], shots_path, reference, command)
+    text = calibration_text(job["calibration"], job["shots_path"], job["reference"],
+                            job["command"])
     if out.parent != Path(""):
         out.parent.mkdir(parents=True, exist_ok=True)
     write_text_atomic(out, text)
-    return out
+    return [str(out)]
 
 
 def _outlier_lines(s):
@@ -90,7 +111,7 @@ def _outlier_lines(s):
             f"{', '.join(s['outliers'])}", f"without  {fit}"]
 
 
-def summary(job, out):
+def summary(job):
     """What ``cavex calibrate --json`` prints: the model, the fitted parameters (all
     dimensionless), the mapping, the shots fitted, the fit statistics, the shots skipped, the
     outliers and the statistics without them, the wall time and the file written."""
@@ -106,13 +127,13 @@ def summary(job, out):
             "outlier_factor": OUTLIER_FACTOR, "outliers": list(calibration.outliers),
             "without_outliers": dict(calibration.without_outliers),
             "wall_time_s": float(job["seconds"]),
-            "output": str(out)}
+            "output": str(job["output"])}
 
 
-def text(summary):
+def text(job):
     """The model and its shots, the fitted values, the fit, the shots the model could not
     predict (left out of the fit), the file."""
-    s = summary
+    s = summary(job)
     errors = s["standard_errors"]
     why = ("as many shots as parameters" if len(s["shots"]) <= len(s["fitted"])
            else "the shots do not determine it")

@@ -5,6 +5,17 @@ and checked (every key in docs/config.md)."""
 from pathlib import Path
 
 from cavex.config import default_config_text
+from cavex.verification.commands.shared_options import add_config_option
+
+HELP = ("print the configuration as TOML: the embedded default (Table 1) to copy and edit, or a "
+        "checked --config FILE")
+
+
+def add_arguments(parser):
+    """The options of ``cavex config``."""
+    add_config_option(parser)
+    parser.add_argument("--default", action="store_true", help="the embedded default (also "
+                        "without --config)")
 
 
 def run(args, target, projectile):
@@ -13,3 +24,8 @@ def run(args, target, projectile):
     if args.config is None:
         return default_config_text().rstrip("\n")
     return Path(args.config).read_text(encoding="utf-8").rstrip("\n")
+
+
+def text(result):
+    """The TOML text as it is (``cavex config`` has no ``--json``)."""
+    return result

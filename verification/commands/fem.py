@@ -1,9 +1,11 @@
 """``cavex fem``: the FE wall stress against both closed-form conventions at one nose depth."""
 
-import json
 import sys
 
 from cavex.materials import fe_only_parameters
+from cavex.verification.commands.shared_options import add_config_option
+
+HELP = "FE against analytic wall stress at a nose depth"
 
 #: m/s: the upper end of the model's range (docs/fem.md "Range"): the velocities the FE is
 #: verified over (cavex.verification.fedata.table.DEFAULT_VELOCITIES, 0-1200 m/s), a little
@@ -13,18 +15,29 @@ from cavex.materials import fe_only_parameters
 RANGE_VELOCITY = 1200.0
 
 
+def add_arguments(parser):
+    """The options of ``cavex fem``."""
+    add_config_option(parser)
+    parser.add_argument("--velocity", type=float, required=True, help="expansion velocity V (m/s)")
+    parser.add_argument("--depth", type=float, required=True, help="nose-tip depth L (m)")
+    parser.add_argument("--nu", type=float, help="Poisson's ratio for every layer (default: "
+                        "file's)")
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    parser.add_argument("--fields", help="folder for the FE fields (XDMF time series for "
+                        "ParaView and meshio, history CSV; default: none written)")
+
+
 def run(args, target, projectile):
-    """The comparison as text or JSON; ``--fields`` also writes the FE fields. A velocity
-    beyond :data:`RANGE_VELOCITY` is computed, with one warning line on stderr."""
+    """The comparison (:func:`job`); ``--fields`` also writes the FE fields. A velocity beyond
+    :data:`RANGE_VELOCITY`, or a layer with FE-only keys, is computed, with one warning line
+    each on stderr."""
     from cavex.verification.commands.options import refuse_debonded
 
     refuse_debonded(target, "fem")
-    document = summary(job(target, projectile, args.depth, args.velocity, nu=args.nu,
-                           fields=args.fields))
-    document["warnings"] += material_warnings(target)
-    for warning in document["warnings"]:
+    result = job(target, projectile, args.depth, args.velocity, nu=args.nu, fields=args.fields)
+    for warning in result["warnings"]:
         print(f"cavex fem: warning: {warning}", file=sys.stderr)
-    return json.dumps(document, indent=2) if args.json else text(document)
+    return result
 
 
 def range_warnings(velocity, wall_stress):
@@ -53,26 +66,29 @@ def material_warnings(target):
 
 
 def job(target, projectile, depth, velocity, *, nu=None, fields=None):
-    """:func:`cavex.verification.fedata.comparison.compare_at_depth` (JSON-able). The problem
-    is checked first, before the FE solver is loaded: bad input answers at once."""
+    """:func:`cavex.verification.fedata.comparison.compare_at_depth` (JSON-able) with
+    ``warnings``: the velocity beyond the model's range (:func:`range_warnings`) and the
+    FE-only keys (:func:`material_warnings`). The problem is checked first, before the FE
+    solver is loaded: bad input answers at once."""
     from cavex.analytic.geometry import spherical_problem
     from cavex.problem import SphericalProblem
 
     SphericalProblem(*spherical_problem(target, projectile, depth), velocity, projectile.r)
     from cavex.verification.fedata.comparison import compare_at_depth
 
-    return compare_at_depth(target, projectile, depth, velocity, nu=nu, fields=fields)
+    result = compare_at_depth(target, projectile, depth, velocity, nu=nu, fields=fields)
+    return {**result, "warnings": range_warnings(result["velocity_m_s"], result["fe_sigma_r_Pa"])
+            + material_warnings(target)}
 
 
-def summary(job):
-    """What ``cavex fem --json`` prints: the comparison as it is, with ``warnings`` (the
-    velocity beyond the model's range, :func:`range_warnings`)."""
-    return {**job, "warnings": range_warnings(job["velocity_m_s"], job["fe_sigma_r_Pa"])}
+def summary(result):
+    """What ``cavex fem --json`` prints: the comparison as it is, with its ``warnings``."""
+    return result
 
 
-def text(summary):
+def text(result):
     """The problem, the FE and analytic wall stresses with their differences, the estimate."""
-    s = summary
+    s = result
     fe, analytic = s["fe_sigma_r_Pa"], s["analytic_sigma_r_Pa"]
     lines = [f"nose depth {s['depth_m']:.6g} m, V = {s['velocity_m_s']:.6g} m/s, cavity "
              f"radius {s['cavity_radius_m']:.6g} m, layers {', '.join(s['layers'])}",

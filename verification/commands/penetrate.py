@@ -1,45 +1,57 @@
-"""``cavex penetrate``: trajectories, the Table 2 comparison, CSV and PNG outputs.
+"""``cavex penetrate``: trajectories, the Table 2 comparison, CSV and PNG outputs (the figures:
+:mod:`cavex.verification.report.penetration_figures`).
 
 The CSV files carry :data:`~cavex.verification.output.number_format.TRAJECTORY_DIGITS` significant
 digits (the integrator's tolerance; see :mod:`cavex.verification.output.number_format`), so that
 they are the same when regenerated on another CPU.
 """
 
-import json
 from pathlib import Path
 
 from cavex.analytic.models import get
 from cavex.analytic.models.plain_law import law_echo
 from cavex.analytic.penetration.zones import crater_depth, scab_depth
 from cavex.config import load_config
-from cavex.verification.output.files import (
-    agg_figure,
-    collector_paused,
-    save_figure,
-    write_columns_csv,
+from cavex.verification.commands.options import (
+    FLOWN,
+    add_interface_option,
+    add_resistance_options,
+    interface_target,
+    law_settings,
+    resistance_settings,
 )
+from cavex.verification.commands.shared_options import add_config_option, add_figures_option
+from cavex.verification.output.files import write_columns_csv
 from cavex.verification.output.paths import check_output_dir, write_staged
 from cavex.verification.studies.table2 import not_reproduced_line, table2_comparison
 
+HELP = "integrate the projectile through the target"
+DEFAULT_OUT = "results/penetration"
+
+
+def add_arguments(parser):
+    """The options of ``cavex penetrate``."""
+    add_config_option(parser)
+    add_resistance_options(parser, FLOWN)
+    add_interface_option(parser)
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    parser.add_argument("--out", default=DEFAULT_OUT, help="output folder")
+    add_figures_option(parser, "the CSV trajectories and phase table")
+    parser.add_argument("--crater", choices=("nose-base", "nose-tip"), default="nose-base",
+                        help="where the crater depth 4.5 r is measured from")
+
 
 def run(args, target, projectile):
-    """``cavex penetrate``: fly, write every file or none (also on Ctrl-C or kill), return the
-    text or JSON to print."""
-    from cavex.verification.commands.options import (
-        FLOWN,
-        interface_target,
-        law_settings,
-        resistance_settings,
-    )
-
+    """``cavex penetrate``: fly, write every file or none (also on Ctrl-C or kill); returns
+    the job with the files written (``outputs``)."""
     settings = resistance_settings(args, FLOWN)
     target = interface_target(args, target, settings["resistance"])
     laws = law_settings(args, target)
     folder = check_output_dir(args.out, "out")
     job = penetration_job(target, projectile, crater=args.crater, **settings, **laws)
-    written = write_staged(folder, lambda stage: write_outputs(job, stage, draw=args.figures))
-    document = summary(job, written)
-    return json.dumps(document, indent=2) if args.json else text(document)
+    job["outputs"] = write_staged(folder,
+                                  lambda stage: write_outputs(job, stage, draw=args.figures))
+    return job
 
 
 def penetration_job(target, projectile, *, resistance="derived", boundary=None,
@@ -100,17 +112,18 @@ def interface_summary(target, projectile):
                                             strict=True))]
 
 
-def summary(job, written=()):
+def summary(job):
     """What ``cavex penetrate --json`` prints: the settings, the runway's phases, the rows
-    beside the paper's Table 2 (None for another target) and the files written."""
+    beside the paper's Table 2 (None for another target) and the files written
+    (``job["outputs"]``, none before they are)."""
     return {**{key: job[key] for key in SETTINGS if key in job},
             "phases": phases_as_dicts(job["runs"]["runway"]), "table2": job["table2"],
-            "outputs": list(written)}
+            "outputs": list(job.get("outputs", ()))}
 
 
-def text(summary):
+def text(job):
     """The phase table, the rows beside the paper's Table 2 and the files written."""
-    s = summary
+    s = summary(job)
     debonded = [i for i in s["interfaces"] if i["bottom"] == "debonded"]
     lines = [f"model {s['model']}{get(s['resistance']).settings_text(s)}, crater from "
              f"{s['crater']}"]
@@ -174,85 +187,11 @@ def write_outputs(job, out_dir, draw=True):
         rows = [{k: v for k, v in row.items() if k != "stage"} for row in rows]
     written.append(write_columns_csv(out / "phases_runway.csv", _columns(rows)))
     if draw:
-        written += _write_figures(job, out)
+        from cavex.verification.report.penetration_figures import figures
+
+        written += figures(job, out)
     return [str(p) for p in written]
 
 
 def _columns(rows):
     return {key: [row[key] for row in rows] for key in rows[0]}
-
-
-def _write_figures(job, out):
-    """The two figures, made without pyplot and drawn with the garbage collector paused
-    (:func:`~cavex.verification.output.files.collector_paused`); returns their paths."""
-    with collector_paused():
-        return _draw_figures(job, out)
-
-
-def _draw_figures(job, out):
-    import textwrap
-
-    runway, single = job["runs"]["runway"], job["runs"]["first_layer_only"]
-    subtitle = textwrap.fill(job["title"], 70)
-    names = job.get("layer_names", [])
-    fig = agg_figure(figsize=(6.4, 4.8))
-    ax = fig.add_subplot()
-    runway_label = "runway (layered)" if job.get("table") is None else \
-        "runway (layered, FE table)"
-    if job.get("debonded"):
-        runway_label = "runway (layered, debonded interfaces)"
-    ax.plot(runway.t * 1e3, runway.velocity, label=runway_label)
-    ax.plot(single.t * 1e3, single.velocity, "--", label=f"{names[0] if names else 'first layer'}"
-            " alone")
-    ax.set(xlabel="time (ms)", ylabel="velocity (m/s)")
-    ax.set_title(f"Velocity against time\n{subtitle}", fontsize=10)
-    _legend_below(ax)
-    velocity_png = _save(fig, out / "velocity_time.png")
-    fig = agg_figure(figsize=(6.4, 4.8))
-    ax = fig.add_subplot()
-    ax.plot(runway.depth, runway.deceleration / 9.81 / 1e3, label=runway_label)
-    ax.plot(single.depth, single.deceleration / 9.81 / 1e3, "--",
-            label=f"{names[0] if names else 'first layer'} alone")
-    left, right = ax.get_xlim()
-    bounds = [left, *job["interface_depths"], right]
-    for depth in job["interface_depths"]:
-        ax.axvline(depth, color="grey", linewidth=0.8, linestyle=":")
-    ax.set_xlim(left, right)
-    _layer_names(ax, names, bounds)
-    ax.set(xlabel="nose-tip depth (m)", ylabel=r"deceleration ($10^3$ g)")
-    ax.set_title(f"Deceleration against depth\n{subtitle}", fontsize=10, pad=14)
-    _legend_below(ax)
-    return [velocity_png, _save(fig, out / "deceleration_depth.png")]
-
-
-def _layer_names(ax, names, bounds):
-    """Each layer's name above the axes, centred on the part of its depth range ``bounds[k]``
-    to ``bounds[k + 1]`` in view; a name that would stick out of the axes or overlap a
-    name already placed is left out (its extent measured, not guessed: a layer narrower
-    than its name keeps it when its neighbours leave room)."""
-    left, right = ax.get_xlim()
-    renderer = ax.figure.canvas.get_renderer()
-    frame, placed = ax.get_window_extent(renderer), []
-    for k, name in enumerate(names[:len(bounds) - 1]):
-        lo, hi = max(bounds[k], left), min(bounds[k + 1], right)
-        if hi <= lo:
-            continue
-        text = ax.text(0.5 * (lo + hi), 1.0, name, ha="center", va="bottom", fontsize=8,
-                       style="italic", transform=ax.get_xaxis_transform())
-        box = text.get_window_extent(renderer)
-        if (box.x0 < frame.x0 or box.x1 > frame.x1
-                or any(box.x0 < other.x1 and other.x0 < box.x1 for other in placed)):
-            text.remove()
-        else:
-            placed.append(box)
-
-
-def _legend_below(ax):
-    """The legend below the axes, off the data."""
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False,
-              fontsize=9)
-
-
-def _save(fig, path):
-    fig.tight_layout()
-    return save_figure(fig, path, dpi=120)

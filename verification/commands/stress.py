@@ -1,16 +1,29 @@
 """``cavex stress``: S, sigma_r, response state and b at one nose depth and velocity."""
 
-import json
 import math
 
 from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.models import get, names
 from cavex.errors import CavexNumericalError, require
 from cavex.materials import MAX_VELOCITY
+from cavex.verification.commands.options import add_resistance_options
+from cavex.verification.commands.shared_options import add_config_option
+
+HELP = "cavity-wall stress at a nose depth"
+
+
+def add_arguments(parser):
+    """The options of ``cavex stress``."""
+    add_config_option(parser)
+    add_resistance_options(parser, ("derived", "paper"), table=False)
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    parser.add_argument("--velocity", type=float, required=True, help="expansion velocity V (m/s)")
+    parser.add_argument("--depth", type=float, required=True, help="nose-tip depth L (m)")
 
 
 def run(args, target, projectile):
-    """The closed form's wall stress as text or JSON (a table is no closed form: refused)."""
+    """The closed form's wall stress (:func:`stress_at_depth`; a table is no closed form:
+    refused)."""
     from cavex.verification.commands.options import (
         CLOSED_FORMS,
         refuse_debonded,
@@ -19,11 +32,9 @@ def run(args, target, projectile):
 
     refuse_debonded(target, "stress")
     settings = resistance_settings(args, CLOSED_FORMS)
-    document = summary(stress_at_depth(target, projectile, args.depth, args.velocity,
-                                       resistance=settings["resistance"],
-                                       boundary=settings["boundary"],
-                                       epsilon=settings["epsilon"]))
-    return json.dumps(document, indent=2) if args.json else text(document)
+    return stress_at_depth(target, projectile, args.depth, args.velocity,
+                           resistance=settings["resistance"], boundary=settings["boundary"],
+                           epsilon=settings["epsilon"])
 
 
 def stress_at_depth(target, projectile, depth, velocity, *, resistance="derived", boundary=None,
@@ -40,18 +51,18 @@ def stress_at_depth(target, projectile, depth, velocity, *, resistance="derived"
                                      boundary=model.boundary(boundary), epsilon=epsilon))
 
 
-def summary(job):
-    """What ``cavex stress --json`` prints: the job's description as it is (JSON-able)."""
-    return job
+def summary(result):
+    """What ``cavex stress --json`` prints: the result's description as it is (JSON-able)."""
+    return result
 
 
 DIGITS = 4  # significant digits of the text table (the JSON keeps every digit)
 
 
-def text(summary):
+def text(result):
     """A table of quantity, value (:data:`DIGITS` significant digits) and unit: stresses in
     MPa, lengths in mm, the response state spelled out (:func:`state_meaning`)."""
-    s = summary
+    s = summary(result)
     g = _digits
     model = s["model"] + (f", epsilon {s['epsilon']}" if "epsilon" in s
                           else f" ({s['boundary']} boundary)")

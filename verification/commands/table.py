@@ -5,7 +5,6 @@ the two wall-layer switch depths): concrete, macadam and into the soil
 (:data:`cavex.verification.fedata.table.DEFAULT_VELOCITIES`, ``DEFAULT_DEPTHS``).
 """
 
-import json
 import math
 import shutil
 import sys
@@ -13,18 +12,37 @@ import time
 
 import numpy as np
 
+from cavex.verification.commands.shared_options import add_config_option, add_parallel_options
+
+HELP = "FE-tabulated sigma_r(V, L) for the target"
 STORE_SUFFIX = ".cases"  # the resumable case store: <out>.cases/ until the table is written
 
 
+def add_arguments(parser):
+    """The options of ``cavex table``."""
+    add_config_option(parser)
+    parser.add_argument("--velocities", nargs="+", type=float,
+                        help="m/s (default 0, 100, ..., 1200)")
+    parser.add_argument("--depths", nargs="+", type=float, help="nose depths, m (default: the "
+                        "target's default grid; the layer switch and refinement depths are "
+                        "added, and the run states the grid)")
+    parser.add_argument("-o", "--out", default="results/table.nc", help="NetCDF file to write")
+    parser.add_argument("--nu", type=float, help="Poisson's ratio for every layer (default: "
+                        "file's)")
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    add_parallel_options(parser)
+
+
 def run(args, target, projectile):
-    """Build, write and summarise the table; return the text or JSON to print."""
+    """Build and write the table; returns the result (:func:`job`) with the file written
+    (``outputs``)."""
     from cavex.verification.commands.options import refuse_debonded
 
     refuse_debonded(target, "table")
     result = job(target, projectile, args.velocities, args.depths, args.out, nu=args.nu,
                  workers=args.workers, scheduler=args.scheduler, progress=args.progress)
-    document = summary(result, write_outputs(result))
-    return json.dumps(document, indent=2) if args.json else text(document)
+    result["outputs"] = write_outputs(result, result["output"])
+    return result
 
 
 def job(target, projectile, velocities=None, depths=None, out_path="results/table.nc", *,
@@ -82,17 +100,17 @@ def grid_line(grid):
             + ", ".join(f"{d:.4g}" for d in added) + " m)")
 
 
-def write_outputs(job):
-    """Write the table, remove the case store (the table holds every cell now); return the
-    path written."""
+def write_outputs(job, out):
+    """Write the table into the file ``out``, remove the case store (the table holds every cell
+    now); return the paths written."""
     from cavex.verification.fedata.table import write_table
 
-    written = write_table(job["table"], job["output"])
+    written = write_table(job["table"], out)
     shutil.rmtree(job["store"], ignore_errors=True)
-    return written
+    return [str(written)]
 
 
-def summary(job, path):
+def summary(job):
     """What ``cavex table --json`` prints: FE cases (the grid plus the first layer alone),
     the grid's axes, failed cells, the largest error estimate (None: none estimated), the wall
     time and the file written."""
@@ -107,12 +125,12 @@ def summary(job, path):
             "depths_added_m": job["grid"]["added"],
             "failed": int(table["failed"].sum()) + int(table["failed_first_layer"].sum()),
             "max_error_estimate": estimate, "wall_time_s": float(job["seconds"]),
-            "output": str(path)}
+            "output": str(job["output"])}
 
 
-def text(summary):
+def text(job):
     """Cases, failed cells, time and path of a built table, one item per line."""
-    s = summary
+    s = summary(job)
     v, d = s["velocities_m_s"], s["depths_m"]
     estimate = math.nan if s["max_error_estimate"] is None else s["max_error_estimate"]
     return "\n".join([

@@ -2,15 +2,15 @@
 
 The job runs :func:`cavex.analytic.penetration.oblique.fly` for the runway (and, with
 ``compare_homogeneous``, for the first layer alone, as the paper does), writes the histories as
-CSV (9 significant digits) and the figures: side view to scale with the projectile outline at
-intervals, pitch against time, axial and lateral overload against time and depth with the
-interfaces marked, a 3-D view of the path in the layered block to scale (matplotlib's mplot3d).
+CSV (9 significant digits) and the figures (:mod:`cavex.verification.report.trajectory_figures`):
+side view to scale with the projectile outline at intervals, pitch against time, axial and
+lateral overload against time and depth with the interfaces marked, a 3-D view of the path in
+the layered block to scale (matplotlib's mplot3d).
 """
 
+import argparse
 import json
-import math
 import sys
-import textwrap
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -19,17 +19,23 @@ import numpy as np
 from cavex.analytic.models import get
 from cavex.analytic.models.plain_law import law_echo
 from cavex.analytic.penetration.strike import Strike
-from cavex.errors import is_finite_number, require
-from cavex.verification.fedata.runner import show_progress
-from cavex.verification.output.files import (
-    agg_figure,
-    collector_paused,
-    save_figure,
-    write_columns_csv,
-    write_text_atomic,
+from cavex.errors import CavexInputError, CavexNumericalError, is_finite_number, require
+from cavex.verification.commands.options import (
+    FLOWN_3D,
+    add_interface_option,
+    add_resistance_options,
+    interface_target,
+    law_settings,
+    resistance_settings,
 )
+from cavex.verification.commands.shared_options import add_config_option, add_figures_option
+from cavex.verification.fedata.runner import show_progress
+from cavex.verification.output.files import write_columns_csv, write_text_atomic
 from cavex.verification.output.paths import check_output_dir, write_staged
+from cavex.verification.report.trajectory_figures import figures, shot_title
 
+HELP = ("oblique shot with attitude: the rigid projectile in 3-D through the layers "
+        "(docs/oblique.md)")
 DEFAULT_DIR = "results/trajectory"
 # m/s: below it the damping Jacobian frozen over a ROS2 step misjudges the switching contact
 # and the steps explode (1e-4 m/s: 241 823 steps against 419 at 1e-3, docs/oblique.md)
@@ -46,6 +52,49 @@ MIN_CONTACT_HOLD, MAX_CONTACT_HOLD = 1e-7, 1e-5
 # integrator steps per run before it is stopped as a numerical failure: measured shots take
 # 300-7 000 (docs/oblique.md); the largest spin once accepted took 599 113 steps (272 s)
 MAX_STEPS = 100_000
+
+
+def add_arguments(parser):
+    """The options of ``cavex trajectory``."""
+    add_config_option(parser)
+    parser.add_argument("--velocity", type=float, help="striking speed (m/s; default V0)")
+    parser.add_argument("--obliquity", type=float, default=0.0,
+                        help="angle of the velocity from the target normal (deg)")
+    parser.add_argument("--attack", type=float, default=0.0,
+                        help="angle of attack, axis from velocity (deg)")
+    parser.add_argument("--attack-plane", type=float, default=0.0, help="plane of the angle of "
+                        "attack about the velocity (deg; 0: in the plane of obliquity toward +x)")
+    parser.add_argument("--spin", type=float, default=0.0, help="spin about the axis (rad/s)")
+    add_resistance_options(parser, FLOWN_3D)
+    add_interface_option(parser)
+    parser.add_argument("--contact-ramp", type=float, help="contact regularisation: the stress "
+                        "rises linearly over 0 < V_n < this (m/s; default 0.01; docs/oblique.md)")
+    parser.add_argument("--contact-hold", type=float, help="held contact instead of the ramp: "
+                        "each element's load rises over this push into its wall, then it cuts "
+                        "(m in [1e-7, 1e-5]; not with --contact-ramp or --tangency-psi; default: "
+                        "off, the velocity ramp; docs/oblique.md)")
+    parser.add_argument("--tunnel-wall", type=float, help="factor in [0, 1] on the shank's load "
+                        "in every layer (a sensitivity setting, uncalibrated; default: each "
+                        "layer's tunnel_wall key, else 1; docs/oblique.md)")
+    parser.add_argument("--tangency-psi", type=float, default=0.0, help="OFPM's attenuation: an "
+                        "element's load falls linearly within this angle of tangency to its "
+                        "velocity (deg in [0, 30]; default 0: none; docs/oblique.md)")
+    parser.add_argument("--entry-crater", action="store_true", help="the shank carries no load "
+                        "in the entry crater, nose-tip depth 0 to 4.5 r + l (the 1-D crater "
+                        "depth; default: off, the tunnel wall from the surface; docs/oblique.md)")
+    parser.add_argument("--crater", choices=("nose-base", "nose-tip"), help="where the crater "
+                        "depth 4.5 r of the entry and interface craters is measured from (with "
+                        "--entry-crater or debonded interfaces; default nose-base, as penetrate)")
+    parser.add_argument("--no-free-surface", action="store_true",
+                        help="no free-surface reduction of the derived law")
+    parser.add_argument("--compare-homogeneous", action="store_true",
+                        help="also the same shot into the first layer alone")
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    add_figures_option(parser, "the CSV histories and summary.json")
+    parser.add_argument("--progress", action=argparse.BooleanOptionalAction, help="progress bar "
+                        "of integrator steps on stderr (default: when stderr is a terminal)")
+    parser.add_argument("--out", default=DEFAULT_DIR,
+                        help="output folder (default results/trajectory)")
 
 
 def trajectory_job(target, projectile, strike, resistance="derived", *, boundary="dynamic",
@@ -124,8 +173,6 @@ def check_answered(name, result):
     either the body has turned tail-first and slides through the target, which resists only
     surfaces moving into it and has no tail face to plough (a large attack, or one against the
     obliquity, gets there), or it is too heavy for the target to stop within the time limit."""
-    from cavex.errors import CavexNumericalError
-
     end = result.end
     if end["state"] != "time limit":
         return
@@ -146,8 +193,6 @@ def check_answered(name, result):
 def _steps(name, enabled):
     """``callable(t, y)`` counting integrator steps (a numerical failure past
     :data:`MAX_STEPS`) and, when ``enabled``, advancing a tqdm bar of them."""
-    from cavex.errors import CavexNumericalError
-
     count = [0]
 
     def budget(t, y):
@@ -189,12 +234,11 @@ def run_summary(result):
                                for z, g in overload_peaks(result.history)]}
 
 
-def summary(job, written=None):
+def summary(job):
     """What ``cavex trajectory --json`` prints: the runway's end and phases, the settings,
-    :func:`run_summary` of every run and (``written``) the files written; a number that is not
-    finite (a repeated time sample gives an infinite rate) is a numerical failure."""
-    from cavex.errors import CavexNumericalError
-
+    :func:`run_summary` of every run and (once written, ``job["outputs"]``) the files written;
+    a number that is not finite (a repeated time sample gives an infinite rate) is a numerical
+    failure."""
     runs = {name: run_summary(result) for name, result in job["runs"].items()}
     try:
         json.dumps(runs, allow_nan=False)
@@ -204,7 +248,7 @@ def summary(job, written=None):
     main = runs["runway"]
     document = {"end": main["end"], "phases": main["phases"], "settings": job["settings"],
                 "runs": runs}
-    return document if written is None else {**document, "outputs": written}
+    return document if "outputs" not in job else {**document, "outputs": job["outputs"]}
 
 
 def write_outputs(job, out, draw=True):
@@ -225,348 +269,9 @@ def write_outputs(job, out, draw=True):
     return written
 
 
-# --- figures ----------------------------------------------------------------------------------
-
-def figures(job, folder):
-    """The four figures into ``folder``, drawn without pyplot and with the garbage collector
-    paused (:func:`collector_paused`); returns their paths."""
-    with collector_paused():
-        written = [side_view(job, folder / "path_side.png"),
-                   pitch_time(job, folder / "pitch_time.png"),
-                   overloads(job, folder / "overload.png"),
-                   view_3d(job, folder / "path_3d.png")]
-    return [str(path) for path in written]
-
-
-def _interfaces(ax, target, vertical=True, deepest=math.inf):
-    """The interfaces down to ``deepest`` (m) as dashed lines (an interface the shot never
-    reaches would stretch the axis away from what moves)."""
-    for H in target.interface_depths:
-        if H <= deepest:
-            (ax.axhline if vertical else ax.axvline)(H, color="0.5", lw=0.8, ls="--")
-
-
-#: A pitch (deg) or lateral overload (fraction of the axial peak) below this is round-off (a
-#: shot in the plane of symmetry: normal incidence without attack): noted, not plotted.
-PITCH_ROUNDOFF_DEG = 1e-6
-LATERAL_ROUNDOFF = 1e-9
-SIDE_WIDTH_IN = 7.5  # side view: width (in); its height follows the picture's aspect
-
-
-def margins(fig, left, right, top, bottom, **space):
-    """Place the axes of ``fig`` with fixed margins (in) around them: no layout engine, so a
-    figure is drawn once when saved (a layout engine or ``bbox_inches="tight"`` draws it twice
-    and lays out its text each time: most of the figure time, benchmarks/commands.py)."""
-    width, height = fig.get_size_inches()
-    fig.subplots_adjust(left=left / width, right=1.0 - right / width, top=1.0 - top / height,
-                        bottom=bottom / height, **space)
-
-
-def _layer_names(ax, target):
-    """Each layer's name at the right edge of a side view, in the middle of the part of its
-    depth range that is in view (only the layers in view)."""
-    tops = [0.0, *target.interface_depths, math.inf]
-    deep, shallow = ax.get_ylim()  # the axis is inverted: ylim = (deepest, shallowest)
-    for k, name in enumerate(target.layer_names()):
-        low, high = max(tops[k], shallow, 0.0), min(tops[k + 1], deep)
-        if high > low:
-            ax.text(1.01, 0.5 * (low + high), name, transform=ax.get_yaxis_transform(),
-                    va="center", fontsize=8, color="0.3")
-
-
-def outline_points(result, y):
-    """Closed outline of the projectile (x, z) in the plane of obliquity at state ``y``: the
-    outline of :func:`body_outline_3d` (in the plane that contains the axis and the body e2
-    axis, the plane of obliquity for in-plane shots)."""
-    world = body_outline_3d(result, y)
-    return world[:, 0], world[:, 2]
-
-
-def side_limits(xs, zs, target, min_ratio=0.3):
-    """``(x limits, z limits)`` of a side view drawn to scale around what moves: the extent of
-    ``xs``, ``zs`` (outlines and path) and the surface, with a margin; the narrower extent is
-    widened to at least ``min_ratio`` of the wider (a straight shot is not a hairline), and
-    the interfaces the picture reaches are in it."""
-    x0, x1 = float(np.min(xs)), float(np.max(xs))
-    z0, z1 = min(float(np.min(zs)), 0.0), max(float(np.max(zs)), 0.0)
-    span = max(x1 - x0, z1 - z0)
-    margin = 0.08 * span
-    x0, x1, z0, z1 = x0 - margin, x1 + margin, z0 - margin, z1 + margin
-    width, depth = x1 - x0, z1 - z0
-    if width < min_ratio * depth:
-        middle, half = 0.5 * (x0 + x1), 0.5 * min_ratio * depth
-        x0, x1 = middle - half, middle + half
-    elif depth < min_ratio * width:
-        grow = min_ratio * width - depth
-        z0, z1 = z0 - 0.25 * grow, z1 + 0.75 * grow  # mostly below: the target
-    return (x0, x1), (z0, z1)
-
-
-def side_view(job, path):
-    """The path in the plane of obliquity to scale (equal axes) around what moves
-    (:func:`side_limits`): the centre of mass and the outline at 9 equal time intervals, the
-    surface, the interfaces in view and the layers named; the legend below the axes."""
-    target = job["target"]
-    curves, xs, zs = [], [], []
-    for k, (name, result) in enumerate(job["runs"].items()):
-        h = result.history
-        outlines = [outline_points(result, result.state(t))
-                    for t in np.linspace(0.0, h["t_s"][-1], 9)]
-        curves.append((name, f"C{k}", h, outlines))
-        xs += [h["cg_x_m"], *(o[0] for o in outlines)]
-        zs += [h["cg_z_m"], *(o[1] for o in outlines)]
-    (x0, x1), (z0, z1) = side_limits(np.concatenate(xs), np.concatenate(zs), target)
-    # the axes box to scale: 5.75 in wide, or narrower where 8 in high would not hold it (the
-    # figure then narrower too, at least 5.5 in for the title and the legend)
-    box_w = min(SIDE_WIDTH_IN - 1.75, 8.0 * (x1 - x0) / (z1 - z0))
-    box_h = box_w * (z1 - z0) / (x1 - x0)
-    rows = 2 * len(curves)  # legend rows: centre of mass and outline of each run
-    bottom, top = 0.6 + 0.2 * rows, 0.55
-    fig = agg_figure(figsize=(max(box_w + 1.75, 5.5), box_h + bottom + top))
-    ax = fig.subplots()
-    margins(fig, left=0.75, right=1.0, top=top, bottom=bottom)
-    for name, color, h, outlines in curves:
-        ax.plot(h["cg_x_m"], h["cg_z_m"], color=color, lw=1, label=f"{name}: centre of mass")
-        for k, (ox, oz) in enumerate(outlines):
-            ax.plot(ox, oz, color=color, lw=0.8,
-                    label=f"{name}: outline at 9 equal time intervals" if k == 0 else None)
-    for depth in target.interface_depths:
-        if z0 < depth < z1:
-            ax.axhline(depth, color="0.5", lw=0.8, ls="--")
-    ax.axhline(0.0, color="k", lw=1)
-    ax.set_xlim(x0, x1)
-    ax.set_ylim(z1, z0)  # depth downward
-    ax.set_aspect("equal")
-    _layer_names(ax, target)
-    ax.set_xlabel("x (m, horizontal, plane of obliquity)")
-    ax.set_ylabel("z (m, depth)")
-    # the title (wrapped to the narrow figure) above the axes, the legend below: off the data
-    fig.suptitle(textwrap.fill(_title(job), 64), fontsize=9, va="top",
-                 y=1.0 - 0.05 / fig.get_size_inches()[1])
-    fig.legend(*ax.get_legend_handles_labels(), fontsize=8, loc="lower center",
-               bbox_to_anchor=(0.5, 0.0), frameon=False)
-    return save_figure(fig, path, dpi=120)
-
-
-def _title(job):
-    s = job["settings"]
-    law = get(s["resistance"]).label(s["boundary"])
-    return (f"V0 = {s['speed_m_s']:g} m/s, obliquity {s['obliquity_deg']:g} deg, attack "
-            f"{s['attack_deg']:g} deg; resistance {law}, "
-            + (f"contact ramp {s['contact_ramp_m_s']:g} m/s" if "contact_ramp_m_s" in s
-               else f"held contact {s['contact_hold_m']:g} m")
-            + (f"; entry crater to {s['entry_crater_m'][1]:.3g} m" if "entry_crater_m" in s
-               else ""))
-
-
-def _note(ax, text):
-    """``text`` in the middle of an empty axes (instead of a curve of round-off)."""
-    ax.set_xticks([])
-    ax.set_yticks([])
-    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", fontsize=9,
-            wrap=True, color="0.25")
-
-
-def pitch_time(job, path):
-    """Pitch against time with the phase ends dotted; a note instead of a curve where the
-    pitch stays below :data:`PITCH_ROUNDOFF_DEG` (round-off)."""
-    fig = agg_figure(figsize=(8, 4.5))
-    ax = fig.subplots()
-    runs = job["runs"].items()
-    moving = [(k, name, result) for k, (name, result) in enumerate(runs)
-              if np.max(np.abs(result.history["pitch_deg"])) >= PITCH_ROUNDOFF_DEG]
-    for k, name, result in moving:
-        h = result.history
-        ax.plot(h["t_s"] * 1e3, h["pitch_deg"], color=f"C{k}", label=name)
-        for ph in result.phases[:-1]:
-            ax.axvline(ph["end_time_s"] * 1e3, color=f"C{k}", lw=0.6, ls=":")
-    # room on the right for the legend (off the data) only where there are curves
-    margins(fig, left=0.8, right=1.6 if moving else 0.8, top=0.75, bottom=0.55)
-    if moving:
-        ax.set_xlabel("t (ms)")
-        ax.set_ylabel("pitch (deg, axis from +z toward +x)")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    still = [name for name, _ in runs if name not in {m[1] for m in moving}]
-    if still:
-        note = (f"pitch of {', '.join(still)} stays 0 (below {PITCH_ROUNDOFF_DEG:g} deg: "
-                "round-off; a shot in its plane of symmetry does not turn)")
-        if moving:
-            ax.text(0.01, 0.02, note, transform=ax.transAxes, fontsize=8, color="0.25")
-        else:
-            _note(ax, note.replace(" (", "\n("))
-    ax.set_title(_title(job).replace("; ", "\n")
-                 + ("; dotted: phase ends (nose tip crosses an interface, ...)"
-                    if moving else ""), fontsize=9)
-    return save_figure(fig, path, dpi=120)
-
-
-def overloads(job, path):
-    """Axial and lateral overload against time and nose-tip depth; a note instead of the
-    lateral curves where they stay below :data:`LATERAL_ROUNDOFF` of the axial peak."""
-    from matplotlib.ticker import MaxNLocator
-
-    fig = agg_figure(figsize=(10, 7))
-    axes = fig.subplots(2, 2)
-    margins(fig, left=0.75, right=0.2, top=0.55, bottom=0.55 + 0.25 * (len(job["runs"]) > 1),
-            hspace=0.3, wspace=0.22)
-    runs = list(job["runs"].items())
-    for row, key in enumerate(("axial_g", "lateral_g")):
-        shown = 0
-        for k, (name, result) in enumerate(runs):
-            h = result.history
-            peak = np.max(np.abs(h["axial_g"]))
-            if key == "lateral_g" and np.max(np.abs(h[key])) < LATERAL_ROUNDOFF * peak:
-                continue
-            shown += 1
-            axes[row, 0].plot(h["t_s"] * 1e3, h[key] / 1e3, color=f"C{k}", label=name)
-            axes[row, 1].plot(h["tip_z_m"], h[key] / 1e3, color=f"C{k}", label=name)
-        word = key.split("_")[0]
-        if not shown:
-            for a in axes[row]:
-                _note(a, f"lateral overload 0\n(below {LATERAL_ROUNDOFF:g} of the axial peak: "
-                      "round-off;\na shot in its plane of symmetry\nhas no lateral force)")
-            continue
-        axes[row, 0].set_ylabel(f"{word} overload (thousands of g)")
-        axes[row, 0].set_xlabel("t (ms)")
-        axes[row, 1].set_xlabel("nose-tip depth (m); dashed: interfaces")
-        deepest = max(float(np.max(r.history["tip_z_m"])) for _, r in runs)
-        _interfaces(axes[row, 1], job["target"], vertical=False, deepest=deepest)
-        for a in axes[row]:
-            a.grid(alpha=0.3)
-            a.xaxis.set_major_locator(MaxNLocator(6))  # no overprinted ticks (mm depths)
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.suptitle(_title(job), fontsize=10)
-    if len(runs) > 1:
-        fig.legend(handles, labels, loc="lower center", ncol=len(runs), fontsize=8,
-                   frameon=False, bbox_to_anchor=(0.5, 0.0))
-    return save_figure(fig, path, dpi=120)
-
-
-LAYER_COLOURS = ("#bbbbbb", "#c8a27a", "#9cbf5a", "#8c8c8c")  # the 3-D view's layers, top down
-VIEW_3D_SIZE_IN = (7.5, 6.5)  # the 3-D view: width, height (in)
-
-
-def block_limits(result, target, min_ratio=0.4):
-    """``(x limits, y limits, depth limits)`` (m) of the 3-D view's block: around the path and
-    the body (tip and centre of mass) with a margin, from above the surface (the body at the
-    strike) to below the deepest interface and the path, so that every layer is in it; each
-    horizontal extent at least ``min_ratio`` of the largest extent (no hairline axis, room for
-    readable ticks); ``y`` covers the half ``y >= 0`` behind the plane of obliquity and any
-    lateral motion."""
-    h = result.history
-    x = np.concatenate([h["tip_x_m"], h["cg_x_m"]])
-    y = np.concatenate([h["tip_y_m"], h["cg_y_m"]])
-    z = np.concatenate([h["tip_z_m"], h["cg_z_m"]])
-    length = result.model.body.length
-    interfaces = target.interface_depths or (0.0,)
-    top = min(float(z.min()), 0.0) - 0.5 * length
-    deepest = max(float(z.max()), interfaces[-1])
-    span = max(float(np.ptp(x)), deepest - top, length)
-    margin = 0.1 * span
-    bottom = deepest + margin
-    x0, x1 = float(x.min()) - margin, float(x.max()) + margin
-    depth = bottom - top
-    if x1 - x0 < min_ratio * depth:
-        middle, half = 0.5 * (x0 + x1), 0.5 * min_ratio * depth
-        x0, x1 = middle - half, middle + half
-    y0 = min(float(y.min()), 0.0) - 0.5 * margin
-    y1 = max(float(y.max()), 0.0, y0 + min_ratio * max(depth, x1 - x0))
-    return (x0, x1), (y0, y1), (top, bottom)
-
-
-def body_outline_3d(result, y):
-    """Closed outline of the body in the plane of its axis and its e2 axis, as world points
-    ``(n, 3)`` (m; z depth) at state ``y``."""
-    from cavex.analytic.penetration.surface_force import rotation_matrix
-
-    body = result.model.body
-    ax, rad = body.outline[:, 0], body.outline[:, 1]
-    top = np.stack([ax, rad, np.zeros_like(ax)], -1)
-    bottom = np.stack([ax[::-1], -rad[::-1], np.zeros_like(ax)], -1)
-    pts = np.concatenate([top, bottom, top[:1]])
-    return y[0:3] + pts @ rotation_matrix(y[3:7]).T
-
-
-def view_3d(job, path):
-    """The path in the layered block, drawn to scale (equal axes, ticks in m) with matplotlib's
-    mplot3d: the block is cut open along the plane of obliquity (its half ``y >= 0``, behind the
-    path as seen), each layer a coloured band on the block's back walls and floor, the surface
-    and the interfaces outlined, the centre of mass's path and the body's outline at 6 equal
-    time intervals drawn over them; the legend below the axes (off the data)."""
-    from matplotlib.patches import Patch
-    from matplotlib.ticker import MaxNLocator
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
-    target = job["target"]
-    result = job["runs"]["runway"]
-    h = result.history
-    (x0, x1), (y0, y1), (top, bottom) = block_limits(result, target)
-    fig = agg_figure(figsize=VIEW_3D_SIZE_IN)
-    # the drawing order is set here (walls, outlines, path, body): everything drawn is either
-    # on the block's back walls or in front of them, so no depth sorting is needed
-    ax = fig.add_axes((0.0, 0.12, 1.0, 0.78), projection="3d", computed_zorder=False)
-    ax.view_init(elev=22, azim=-58)
-    planes = [0.0, *target.interface_depths, bottom]
-    names = target.layer_names()
-    handles = []
-    for k in range(len(planes) - 1):
-        a, b = planes[k], planes[k + 1]
-        colour = LAYER_COLOURS[k % len(LAYER_COLOURS)]
-        walls = [[(x0, y1, a), (x1, y1, a), (x1, y1, b), (x0, y1, b)],  # back wall
-                 [(x0, y0, a), (x0, y1, a), (x0, y1, b), (x0, y0, b)]]  # left wall
-        if k == len(planes) - 2:  # the floor: under the last layer
-            walls.append([(x0, y0, b), (x1, y0, b), (x1, y1, b), (x0, y1, b)])
-        ax.add_collection3d(Poly3DCollection(walls, facecolor=colour, alpha=0.45,
-                                             edgecolor="none", zorder=1))
-        handles.append(Patch(facecolor=colour, alpha=0.6, label=names[k]))
-    for k, depth in enumerate(planes[:-1]):  # the surface (solid) and the interfaces (dashed)
-        ax.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], [depth] * 5, zorder=2,
-                color="k" if k == 0 else "0.35", lw=1.0 if k == 0 else 0.8,
-                ls="-" if k == 0 else "--")
-    path_line, = ax.plot(h["cg_x_m"], h["cg_y_m"], h["cg_z_m"], color="red", lw=1.2, zorder=5,
-                         label="centre of mass")
-    handles.insert(0, path_line)
-    for t in np.linspace(0.0, h["t_s"][-1], 6):
-        pts = body_outline_3d(result, result.state(t))
-        ax.add_collection3d(Poly3DCollection([pts], facecolor="navy", edgecolor="navy",
-                                             lw=0.6, zorder=4))
-    handles.insert(1, Patch(facecolor="navy", label="body at 6 equal time intervals"))
-    ax.set_xlim(x0, x1)
-    ax.set_ylim(y0, y1)
-    ax.set_zlim(bottom, top)  # depth downward
-    ax.set_box_aspect((x1 - x0, y1 - y0, bottom - top), zoom=0.95)  # to scale
-    extents = (x1 - x0, y1 - y0, bottom - top)
-    for axis, extent in zip((ax.xaxis, ax.yaxis, ax.zaxis), extents, strict=True):
-        # ticks in proportion to the axis's drawn length: a short axis gets 2-3 (no crowding)
-        axis.set_major_locator(MaxNLocator(nbins=max(2, round(5 * extent / max(extents))),
-                                           steps=[1, 2, 2.5, 5, 10]))
-        axis.set_pane_color((1.0, 1.0, 1.0, 0.0))
-    ax.grid(False)
-    ax.tick_params(labelsize=8, pad=1)
-    ax.set_xlabel("x (m)", fontsize=8, labelpad=6)
-    ax.set_ylabel("y (m)", fontsize=8, labelpad=4)
-    ax.set_zlabel("depth z (m)", fontsize=8, labelpad=6)
-    fig.suptitle(_title(job).replace("; ", "\n") + "\nx: horizontal in the plane of obliquity; "
-                 "the block cut open along it", fontsize=9, y=0.985)
-    fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=min(len(handles), 3),
-               frameon=False, bbox_to_anchor=(0.5, 0.0))
-    return save_figure(fig, path, dpi=120)
-
-
-# --- the command -----------------------------------------------------------------------------
-
 def run(args, target, projectile):
     """``cavex trajectory``: checks, runs, writes (every file or none, also on Ctrl-C or
-    kill), returns the text or JSON to print."""
-    from cavex.errors import CavexInputError, CavexNumericalError
-    from cavex.verification.commands.options import (
-        FLOWN_3D,
-        interface_target,
-        law_settings,
-        resistance_settings,
-    )
-
+    kill); returns the job with the files written (``outputs``)."""
     settings = resistance_settings(args, FLOWN_3D)
     target = interface_target(args, target, settings["resistance"])
     if args.tunnel_wall is not None:
@@ -618,15 +323,16 @@ def run(args, target, projectile):
                 "ended at t = 0 s: the integrator could not advance (a shot too slow, or "
                 "forces far beyond the projectile's mass and inertia)"))
     summary(job)  # the peaks and rates are finite too, before anything is written
-    written = write_staged(folder, lambda stage: write_outputs(job, stage, draw=args.figures))
-    document = summary(job, written)
-    return json.dumps(document, indent=2) if args.json else text(document)
+    job["outputs"] = write_staged(folder,
+                                  lambda stage: write_outputs(job, stage, draw=args.figures))
+    return job
 
 
-def text(summary):
+def text(job):
     """The settings, each run's phase table, end state and peaks, the files written."""
-    lines = [_title(summary)]
-    for name, s in summary["runs"].items():
+    document = summary(job)
+    lines = [shot_title(document)]
+    for name, s in document["runs"].items():
         e = s["end"]
         lines += ["", f"{name}:",
                   f"{'phase':<10} {'ends at t (ms)':>14} {'tip z (m)':>10} {'pitch':>8} "
@@ -638,5 +344,5 @@ def text(summary):
         lines.append(f"end: {e['state']}, nose tip ({tip}) m, pitch "
                      f"{e['pitch_deg']:.2f} deg; peaks: axial {s['max_axial_g']:.0f} g, "
                      f"lateral {s['max_lateral_g']:.0f} g")
-    lines += ["", "wrote: " + ", ".join(summary["outputs"])]
+    lines += ["", "wrote: " + ", ".join(document["outputs"])]
     return "\n".join(lines)

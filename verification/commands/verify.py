@@ -5,21 +5,31 @@ The report is written into a hidden folder and moved in complete: Ctrl-C or kill
 previous report as it was, or (if that was removed) no report, never a partial one.
 """
 
-import json
 from pathlib import Path
 
+from cavex.verification.commands.shared_options import add_config_option, add_parallel_options
+
+HELP = "analytic against FE report for the target"
 DEFAULT_OUT = "results/verification"
 
 
+def add_arguments(parser):
+    """The options of ``cavex verify``."""
+    add_config_option(parser)
+    parser.add_argument("--quick", action="store_true", help="small grid (under a minute)")
+    parser.add_argument("--out", help="report folder (default results/verification)")
+    parser.add_argument("--json", action="store_true", help="print JSON")
+    add_parallel_options(parser)
+
+
 def run(args, target, projectile):
-    """Write the report; return its summary as text or JSON."""
+    """Write the report (:func:`job`); returns its result."""
     from cavex.verification.commands.options import refuse_debonded
 
     refuse_debonded(target, "verify")
-    document = summary(job(target, projectile, config_path=args.config, quick=args.quick,
-                           out_dir=args.out, scheduler=args.scheduler, workers=args.workers,
-                           progress=args.progress))
-    return json.dumps(document, indent=2) if args.json else text(document)
+    return job(target, projectile, config_path=args.config, quick=args.quick,
+               out_dir=args.out, scheduler=args.scheduler, workers=args.workers,
+               progress=args.progress)
 
 
 def job(target, projectile, *, config_path=None, quick=False, out_dir=None, scheduler=None,
@@ -63,7 +73,8 @@ def summary(job):
 
 
 def text(summary):
-    """Cells, times, the picture's cell, the conclusions and where the report is."""
+    """Cells, times, the picture's cell, the conclusions and where the report is (of the job's
+    result or its :func:`summary`: the same keys)."""
     return "\n".join([
         f"cells   {summary['cells']} ({summary['failed']} failed)",
         f"time    {summary['wall_time_s']:.1f} s (FE table {summary['table_wall_time_s']:.1f} s, "

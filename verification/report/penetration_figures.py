@@ -1,0 +1,99 @@
+"""The figures of ``cavex penetrate``: velocity against time and deceleration against nose-tip
+depth, the runway beside its first layer alone (the paper's Fig. 4 pair), drawn without pyplot.
+
+Each takes the command's job (:func:`cavex.verification.commands.penetrate.penetration_job`:
+its ``runs``, ``title``, ``layer_names``, ``interface_depths``, ``table``, ``debonded``); the
+panels are drawn by functions of a matplotlib ``Axes`` and the job (:func:`draw_velocity`,
+:func:`draw_deceleration`), so that the Python API draws the same.
+"""
+
+import textwrap
+
+from cavex.verification.output.files import agg_figure, collector_paused, save_figure
+
+
+def figures(job, out):
+    """The two figures into the folder ``out``, made without pyplot and drawn with the garbage
+    collector paused (:func:`~cavex.verification.output.files.collector_paused`); returns their
+    paths."""
+    with collector_paused():
+        fig = agg_figure(figsize=(6.4, 4.8))
+        draw_velocity(fig.add_subplot(), job)
+        velocity_png = _save(fig, out / "velocity_time.png")
+        fig = agg_figure(figsize=(6.4, 4.8))
+        draw_deceleration(fig.add_subplot(), job)
+        return [velocity_png, _save(fig, out / "deceleration_depth.png")]
+
+
+def _labels(job):
+    """The legend's words for the runway and for its first layer alone."""
+    names = job.get("layer_names", [])
+    runway = "runway (layered)" if job.get("table") is None else "runway (layered, FE table)"
+    if job.get("debonded"):
+        runway = "runway (layered, debonded interfaces)"
+    return runway, f"{names[0] if names else 'first layer'} alone"
+
+
+def draw_velocity(ax, job):
+    """On ``ax``: velocity against time of the runway and of its first layer alone (dashed),
+    titled with the resistance (``job["title"]``), the legend below the axes."""
+    runway, single = job["runs"]["runway"], job["runs"]["first_layer_only"]
+    runway_label, single_label = _labels(job)
+    ax.plot(runway.t * 1e3, runway.velocity, label=runway_label)
+    ax.plot(single.t * 1e3, single.velocity, "--", label=single_label)
+    ax.set(xlabel="time (ms)", ylabel="velocity (m/s)")
+    ax.set_title(f"Velocity against time\n{textwrap.fill(job['title'], 70)}", fontsize=10)
+    legend_below(ax)
+
+
+def draw_deceleration(ax, job):
+    """On ``ax``: deceleration (10^3 g) against nose-tip depth of the runway and of its first
+    layer alone (dashed), the interfaces dotted and the layers named above the axes
+    (:func:`layer_names`), the legend below the axes."""
+    runway, single = job["runs"]["runway"], job["runs"]["first_layer_only"]
+    runway_label, single_label = _labels(job)
+    ax.plot(runway.depth, runway.deceleration / 9.81 / 1e3, label=runway_label)
+    ax.plot(single.depth, single.deceleration / 9.81 / 1e3, "--", label=single_label)
+    left, right = ax.get_xlim()
+    bounds = [left, *job["interface_depths"], right]
+    for depth in job["interface_depths"]:
+        ax.axvline(depth, color="grey", linewidth=0.8, linestyle=":")
+    ax.set_xlim(left, right)
+    layer_names(ax, job.get("layer_names", []), bounds)
+    ax.set(xlabel="nose-tip depth (m)", ylabel=r"deceleration ($10^3$ g)")
+    ax.set_title(f"Deceleration against depth\n{textwrap.fill(job['title'], 70)}", fontsize=10,
+                 pad=14)
+    legend_below(ax)
+
+
+def layer_names(ax, names, bounds):
+    """Each layer's name above the axes, centred on the part of its depth range ``bounds[k]``
+    to ``bounds[k + 1]`` in view; a name that would stick out of the axes or overlap a
+    name already placed is left out (its extent measured, not guessed: a layer narrower
+    than its name keeps it when its neighbours leave room)."""
+    left, right = ax.get_xlim()
+    renderer = ax.figure.canvas.get_renderer()
+    frame, placed = ax.get_window_extent(renderer), []
+    for k, name in enumerate(names[:len(bounds) - 1]):
+        lo, hi = max(bounds[k], left), min(bounds[k + 1], right)
+        if hi <= lo:
+            continue
+        text = ax.text(0.5 * (lo + hi), 1.0, name, ha="center", va="bottom", fontsize=8,
+                       style="italic", transform=ax.get_xaxis_transform())
+        box = text.get_window_extent(renderer)
+        if (box.x0 < frame.x0 or box.x1 > frame.x1
+                or any(box.x0 < other.x1 and other.x0 < box.x1 for other in placed)):
+            text.remove()
+        else:
+            placed.append(box)
+
+
+def legend_below(ax):
+    """The legend below the axes, off the data."""
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False,
+              fontsize=9)
+
+
+def _save(fig, path):
+    fig.tight_layout()
+    return save_figure(fig, path, dpi=120)
