@@ -6,7 +6,12 @@ from cavex.analytic.geometry import spherical_problem
 from cavex.analytic.models import get, names
 from cavex.errors import CavexNumericalError, require
 from cavex.materials import MAX_VELOCITY
-from cavex.verification.commands.options import add_resistance_options
+from cavex.verification.commands.options import (
+    CLOSED_FORMS,
+    add_resistance_options,
+    refuse_debonded,
+    resistance_settings,
+)
 from cavex.verification.commands.shared_options import add_config_option
 
 HELP = "cavity-wall stress at a nose depth"
@@ -15,7 +20,7 @@ HELP = "cavity-wall stress at a nose depth"
 def add_arguments(parser):
     """The options of ``cavex stress``."""
     add_config_option(parser)
-    add_resistance_options(parser, ("derived", "paper"), table=False)
+    add_resistance_options(parser, CLOSED_FORMS, table=False)
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.add_argument("--velocity", type=float, required=True, help="expansion velocity V (m/s)")
     parser.add_argument("--depth", type=float, required=True, help="nose-tip depth L (m)")
@@ -24,12 +29,6 @@ def add_arguments(parser):
 def run(args, target, projectile):
     """The closed form's wall stress (:func:`stress_at_depth`; a table is no closed form:
     refused)."""
-    from cavex.verification.commands.options import (
-        CLOSED_FORMS,
-        refuse_debonded,
-        resistance_settings,
-    )
-
     refuse_debonded(target, "stress")
     settings = resistance_settings(args, CLOSED_FORMS)
     return stress_at_depth(target, projectile, args.depth, args.velocity,
