@@ -38,12 +38,14 @@ import numpy as np
 from numba import njit
 
 from cavex.fem.constitutive import return_point
+from cavex.fem.records import Assembly, Layout, PointResponse
 
 
 @njit(cache=True, error_model="numpy")
-def assemble_cases(u, layout, material, theta_p, gamma_p, skip, out):
+def assemble_cases(u, layout, material, theta_p, gamma_p, skip, out, resp):
     """Response, internal force and banded tangent at the radial dofs ``u`` of every case ``c``
-    with ``not skip[c]``, into the :class:`~cavex.fem.records.Assembly` ``out``.
+    with ``not skip[c]``, into the :class:`~cavex.fem.records.Assembly` ``out`` and the
+    :class:`~cavex.fem.records.PointResponse` ``resp``.
 
     ``layout`` is the stack's :class:`~cavex.fem.records.Layout`, ``material`` its
     :data:`~cavex.fem.material_records.MATERIAL` record per element, ``theta_p, gamma_p`` the
@@ -51,12 +53,14 @@ def assemble_cases(u, layout, material, theta_p, gamma_p, skip, out):
     the displacement gradients ``du/dR``, ``u/R`` (zero in a folded case). ``out.f`` and
     ``out.band`` must be zero on the cases evaluated; the point response and per-case
     ``folded`` and ``force_scale`` (the largest nodal force one point contributes: Newton's
-    yardstick) are written in place.
+    yardstick) are written in place. Records come named or as plain tuples
+    (:mod:`cavex.fem.records`, the boundary rule).
     """
+    layout, out, resp = Layout(*layout), Assembly(*out), PointResponse(*resp)
     element_dofs, dNdR, N = layout.element_dofs, layout.dNdR, layout.N
     R_points, force_weights = layout.R_points, layout.force_weights
     el_start, el_count = layout.el_start, layout.el_count
-    Gr, Gt, resp = out.Gr, out.Gt, out.response
+    Gr, Gt = out.Gr, out.Gt
     tau_r, tau_t, plastic, yield_ratio = resp.tau_r, resp.tau_t, resp.plastic, resp.yield_ratio
     th_p_new, ga_p_new = resp.theta_p, resp.gamma_p
     folded, force_scale = out.folded, out.force_scale

@@ -44,7 +44,16 @@ from numba import njit
 
 from cavex.fem.banded import solve_blocks
 from cavex.fem.element import assemble_cases
-from cavex.fem.records import Convergence, Equations, Progress
+from cavex.fem.records import (
+    Assembly,
+    Convergence,
+    Equations,
+    Layout,
+    PointResponse,
+    Progress,
+    Scheme,
+    StepStart,
+)
 
 MAX_ITERATIONS = 30     # Newton iterations per attempt
 STALL_ITERATIONS = 4    # an attempt fails once its residual has not reached a new low in this many
@@ -87,27 +96,28 @@ def newton(stack, w, scheme, tol):
     to be used).
     """
     k = stack.n_cases
-    u, assembly, equations = newton_buffers(stack)
+    u, assembly, response, equations = newton_buffers(stack)
     progress = Progress(status=np.where(w.active, 0, 1).astype(np.int64),
                         iterations=np.zeros(k, dtype=np.int64),
                         evaluations=np.zeros(k, dtype=np.int64))
-    iterate(u, w, stack.layout, stack.material, scheme,
-            Convergence(tol, MAX_ITERATIONS, STALL_ITERATIONS), assembly, equations, progress)
+    convergence = Convergence(tol, MAX_ITERATIONS, STALL_ITERATIONS)
+    iterate(u, tuple(w), tuple(stack.layout), stack.material, tuple(scheme), tuple(convergence),
+            tuple(assembly), tuple(response), tuple(equations), tuple(progress))
     status, iterations = progress.status, progress.iterations
     reasons = [FAILURES.get(code) for code in status.tolist()]
     iterations[status != 1] = 0
-    return (u, equations.a, assembly.f, assembly.response, iterations, reasons,
-            progress.evaluations)
+    return u, equations.a, assembly.f, response, iterations, reasons, progress.evaluations
 
 
 def newton_buffers(stack):
     """The arrays :func:`newton` works in, made once per stack and reused by every call on it
     (every value a call returns is written by that call; the solver copies what it keeps
-    before the next call): ``(u, assembly, equations)`` (:class:`~cavex.fem.records.Assembly`,
+    before the next call): ``(u, assembly, response, equations)``
+    (:class:`~cavex.fem.records.Assembly`, :class:`~cavex.fem.records.PointResponse`,
     :class:`~cavex.fem.records.Equations`)."""
     if not hasattr(stack, "_newton_buffers"):
-        assembly = stack.new_buffers()
-        stack._newton_buffers = (np.zeros(stack.ndof), assembly, Equations(
+        assembly, response = stack.new_buffers()
+        stack._newton_buffers = (np.zeros(stack.ndof), assembly, response, Equations(
             a=np.zeros(stack.ndof), r_free=np.zeros(stack.ndof),
             jac=np.zeros_like(assembly.band), scale=np.zeros(stack.n_cases),
             r_max=np.zeros(stack.n_cases)))
@@ -128,17 +138,23 @@ def stalls(relative, best, stalled, c, limit):
 
 
 @njit(cache=True, error_model="numpy")
-def iterate(u, w, layout, material, scheme, convergence, assembly, equations, progress):
+def iterate(u, w, layout, material, scheme, convergence, assembly, response, equations,
+            progress):
     """Compiled body of :func:`newton`: the iterations of every case with ``progress.status``
     0 from the predictor (:func:`predict_cases`, written into ``u``, which is then updated in
-    place, as every output: ``assembly``, ``equations``, ``progress``). ``w`` is the
-    :class:`~cavex.fem.records.StepStart`, ``layout`` the stack's
-    :class:`~cavex.fem.records.Layout`, ``material`` its record per element. Per iteration: the
+    place, as every output: ``assembly``, ``response``, ``equations``, ``progress``). ``w`` is
+    the :class:`~cavex.fem.records.StepStart`, ``layout`` the stack's
+    :class:`~cavex.fem.records.Layout`, ``material`` its record per element; the records come
+    as plain tuples (:mod:`cavex.fem.records`, the boundary rule). Per iteration: the
     kernel (:func:`cavex.fem.element.assemble_cases`), the step equations
     (:func:`step_equations`), the rules (folded, non-finite, :func:`converged`, stall), the
     banded solve (:func:`cavex.fem.banded.solve_blocks`, fixed dofs as identity rows) and the
     update. ``status`` per case on return: 1 converged (``iterations`` = Newton solves), else
     the failure code of :data:`FAILURES`; ``evaluations`` is incremented per kernel pass."""
+    w, layout, scheme = StepStart(*w), Layout(*layout), Scheme(*scheme)
+    convergence, assembly, response = Convergence(*convergence), Assembly(*assembly), \
+        PointResponse(*response)
+    equations, progress = Equations(*equations), Progress(*progress)
     status, iterations, evaluations = progress.status, progress.iterations, progress.evaluations
     dof_start, dof_count, free = layout.dof_start, layout.dof_count, layout.free
     f, band, folded = assembly.f, assembly.band, assembly.folded
@@ -161,7 +177,7 @@ def iterate(u, w, layout, material, scheme, convergence, assembly, equations, pr
                 s0, m = dof_start[c], dof_count[c]
                 f[s0:s0 + m] = 0.0
                 band[:, s0:s0 + m] = 0.0
-        assemble_cases(u, layout, material, w.theta_p, w.gamma_p, skip, assembly)
+        assemble_cases(u, layout, material, w.theta_p, w.gamma_p, skip, assembly, response)
         for c in range(k):
             if not done[c] and folded[c]:
                 status[c] = 2
@@ -215,7 +231,7 @@ def iterate(u, w, layout, material, scheme, convergence, assembly, equations, pr
 def predict(stack, w, dynamic):
     """First Newton iterate of every active case (:func:`predict_cases`), a new array."""
     u = np.empty(stack.ndof)
-    predict_cases(u, w, w.active, stack.layout, dynamic)
+    predict_cases(u, tuple(w), w.active, tuple(stack.layout), dynamic)
     return u
 
 
@@ -235,6 +251,7 @@ def predict_cases(u, w, active, layout, dynamic):
 
     Written into ``u``; the prescribed dofs (and every dof of an inactive case) keep ``u0``,
     the wall its prescribed displacement ``load`` under displacement control."""
+    w, layout = StepStart(*w), Layout(*layout)
     u0, v0, du_prev, load, dt = w.u0, w.v0, w.du_prev, w.load, w.dt
     dof_start, dof_count, free, pressure = (layout.dof_start, layout.dof_count, layout.free,
                                             layout.pressure)
@@ -274,7 +291,8 @@ def equations(stack, w, scheme, u, assembly, skip=None, out=None):
                         jac=np.zeros_like(assembly.band), scale=np.zeros(k), r_max=np.zeros(k))
     if skip is None:
         skip = np.zeros(k, dtype=bool)
-    step_equations(u, w, stack.layout, scheme, assembly, skip, out)
+    step_equations(u, tuple(w), tuple(stack.layout), tuple(scheme), tuple(assembly), skip,
+                   tuple(out))
     return out
 
 
@@ -282,6 +300,8 @@ def equations(stack, w, scheme, u, assembly, skip=None, out=None):
 def step_equations(u, w, layout, scheme, assembly, skip, out):
     """Compiled body of :func:`equations` (module docstring: the generalized-alpha residual
     and Newton matrix; the inertia from the banded mass matrix)."""
+    w, layout, scheme = StepStart(*w), Layout(*layout), Scheme(*scheme)
+    assembly, out = Assembly(*assembly), Equations(*out)
     u0, v0, a0, f0, dt, load = w.u0, w.v0, w.a0, w.f0, w.dt, w.load
     f, band, force_scale = assembly.f, assembly.band, assembly.force_scale
     a, r_free, jac, scale, r_max = out.a, out.r_free, out.jac, out.scale, out.r_max
@@ -420,13 +440,13 @@ def newton_line_search(stack, w, scheme, tol):
     def evaluate(x):
         u = start.copy()
         u[free] = x
-        assembly = stack.assemble(u, w.theta_p, w.gamma_p)
+        assembly, response = stack.assemble(u, w.theta_p, w.gamma_p)
         if assembly.folded[0]:
             raise StepFailure("non-positive stretch")
         a, r_free, jac, scale, r_max = equations(stack, w, scheme, u, assembly)
         if np.isnan(r_max[0]):
             raise StepFailure("non-finite residual")
-        return r_free[free], scale[0], jac, u, a, assembly.f, assembly.response
+        return r_free[free], scale[0], jac, u, a, assembly.f, response
 
     def solve(out, r):
         rhs = np.zeros(stack.ndof)

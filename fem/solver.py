@@ -32,6 +32,8 @@ from cavex.fem.newton import newton, newton_line_search, replace_points
 from cavex.fem.records import (
     CaseState,
     DofState,
+    Layout,
+    PointResponse,
     PointState,
     Rows,
     Scheme,
@@ -55,10 +57,11 @@ def failure_message(depth, t, wall_radius, load, dt, plain, line_searched):
 
 
 @njit(cache=True, error_model="numpy")
-def commit_cases(ok, rows, trial, w, layout, scheme, dofs, points, cases):
+def commit_cases(ok, rows, trial, resp, w, layout, scheme, dofs, points, cases):
     r"""Accept step ``n -> n+1`` of every case ``c`` of a working stack with ``ok[c]``: its
-    :class:`~cavex.fem.records.Trial` state (``u, a, f`` per dof, the point response) is
-    written into the solver's state (``dofs``, ``points``, ``cases``:
+    :class:`~cavex.fem.records.Trial` state (``u, a, f`` per dof) and its point response
+    ``resp`` (a :class:`~cavex.fem.records.PointResponse`) are written into the solver's state
+    (``dofs``, ``points``, ``cases``:
     :class:`~cavex.fem.records.DofState`, :class:`~cavex.fem.records.PointState`,
     :class:`~cavex.fem.records.CaseState`; at the :class:`~cavex.fem.records.Rows` ``rows`` of
     the working stack's dofs and elements, per case row ``rows.cases[c]``), with
@@ -75,8 +78,12 @@ def commit_cases(ok, rows, trial, w, layout, scheme, dofs, points, cases):
     ``layout.wall_*`` are the CSR rows of the mass matrix at the wall dofs (one per case),
     summed in their stored order as scipy's product does. The start-of-step arrays of ``w``
     (a :class:`~cavex.fem.records.StepStart`) may be views of the state: each value is read
-    before its row is written."""
-    u, a, f, resp = trial.u, trial.a, trial.f, trial.response
+    before its row is written. The records come as plain tuples (:mod:`cavex.fem.records`, the
+    boundary rule)."""
+    rows, trial, resp, w = Rows(*rows), Trial(*trial), PointResponse(*resp), StepStart(*w)
+    layout, scheme, dofs = Layout(*layout), Scheme(*scheme), DofState(*dofs)
+    points, cases = PointState(*points), CaseState(*cases)
+    u, a, f = trial.u, trial.a, trial.f
     u0, v0, a0, f0, dt = w.u0, w.v0, w.a0, w.f0, w.dt
     theta_p0, gamma_p0 = w.theta_p, w.gamma_p
     tau_r, tau_t, theta_p, gamma_p = resp.tau_r, resp.tau_t, resp.theta_p, resp.gamma_p
@@ -179,10 +186,9 @@ class RadialSolver:
         self.dofs["v"][root.wall] = wall_velocity
         shape = root.R_points.shape
         self.points = {name: np.zeros(shape) for name in POINT_STATE}
-        assembly = root.assemble(self.dofs["u"], self.points["theta_p"],
-                                 self.points["gamma_p"])
+        assembly, resp = root.assemble(self.dofs["u"], self.points["theta_p"],
+                                       self.points["gamma_p"])
         self.dofs["f"] = assembly.f
-        resp = assembly.response
         self.points.update(plastic=resp.plastic, yield_ratio=resp.yield_ratio,
                            tau_r=resp.tau_r, tau_t=resp.tau_t)
         self.cases = {name: np.zeros(k) for name in CASE_STATE}
@@ -296,7 +302,7 @@ class RadialSolver:
 
     def _attempt(self, stack, w, active, search):
         """One Newton attempt of the active cases (the line-searched ones case by case).
-        Returns ``((u, a, f, response), ok, iterations, reasons, evaluations)`` on the working
+        Returns ``((trial, response), ok, iterations, reasons, evaluations)`` on the working
         stack (``evaluations``: plain Newton's residual evaluations per case)."""
         u, a, f, resp, iterations, reasons, evaluations = newton(
             stack, w, self.params, self.newton_tol)
@@ -312,15 +318,19 @@ class RadialSolver:
                     u[sdofs], a[sdofs], f[sdofs] = su, sa, sf
                     replace_points(resp, selements, sresp)
         ok = active & np.array([r is None for r in reasons])
-        return Trial(u, a, f, resp), ok, iterations, reasons, evaluations
+        return (Trial(u, a, f), resp), ok, iterations, reasons, evaluations
 
     def _commit(self, stack, cases, dofs, elements, ok, w, trial):
         """Accept the converged cases ``ok`` of the working ``stack`` (compiled:
         :func:`commit_cases`): velocities, plastic state, energies, wall reaction."""
-        rows = Rows(cases=cases, dofs=self._rows if isinstance(dofs, slice) else dofs,
-                    elements=self._point_rows if isinstance(elements, slice) else elements)
-        commit_cases(ok, rows, trial, w, stack.layout, self.params, DofState(**self.dofs),
-                     PointState(**self.points), CaseState(**self.cases))
+        rows = (cases, self._rows if isinstance(dofs, slice) else dofs,
+                self._point_rows if isinstance(elements, slice) else elements)  # Rows
+        state = (tuple(self.dofs[name] for name in DOF_STATE),
+                 tuple(self.points[name] for name in POINT_STATE),
+                 tuple(self.cases[name] for name in CASE_STATE))
+        trial, response = trial
+        commit_cases(ok, rows, tuple(trial), tuple(response), tuple(w), tuple(stack.layout),
+                     tuple(self.params), *state)
 
     def start_under_load(self, load):
         """Consistent start for a wall pressure ``load`` applied suddenly at ``t = 0+``.

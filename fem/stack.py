@@ -119,31 +119,35 @@ class Stack:
         return slice(self.el_start[c], self.el_start[c] + self.el_count[c])
 
     def new_buffers(self):
-        """Output arrays of :meth:`assemble`, an :class:`~cavex.fem.records.Assembly`."""
+        """Output arrays of :meth:`assemble`: an :class:`~cavex.fem.records.Assembly` and a
+        :class:`~cavex.fem.records.PointResponse`."""
         shape = self.R_points.shape
-        return Assembly(f=np.zeros(self.ndof), band=np.zeros((2 * self.degree + 1, self.ndof)),
-                        response=PointResponse.zeros(shape),
-                        folded=np.zeros(self.n_cases, dtype=bool),
-                        force_scale=np.zeros(self.n_cases), Gr=np.zeros(shape),
-                        Gt=np.zeros(shape))
+        return (Assembly(f=np.zeros(self.ndof), band=np.zeros((2 * self.degree + 1, self.ndof)),
+                         folded=np.zeros(self.n_cases, dtype=bool),
+                         force_scale=np.zeros(self.n_cases), Gr=np.zeros(shape),
+                         Gt=np.zeros(shape)),
+                PointResponse.zeros(shape))
 
     def assemble(self, u, theta_p, gamma_p, skip=None, out=None):
-        """The :class:`~cavex.fem.records.Assembly` (``f, band, response, folded,
-        force_scale``, gradients) at ``u`` for the start-of-step plastic strains; cases with
-        ``skip`` set keep the values they have in ``out`` (the previous call's result, reused
-        in place; new arrays when None)."""
+        """``(assembly, response)`` at ``u`` for the start-of-step plastic strains: the
+        :class:`~cavex.fem.records.Assembly` (``f, band, folded, force_scale``, gradients) and
+        the :class:`~cavex.fem.records.PointResponse`; cases with ``skip`` set keep the values
+        they have in ``out`` (the previous call's result, reused in place; new arrays when
+        None)."""
         if out is None:
             out = self.new_buffers()
         if skip is None:
             skip = np.zeros(self.n_cases, dtype=bool)
+        assembly, response = out
         if skip.any():
             keep = ~skip[self.dof_case]
-            out.f[keep] = 0.0
-            out.band[:, keep] = 0.0
+            assembly.f[keep] = 0.0
+            assembly.band[:, keep] = 0.0
         else:
-            out.f[:] = 0.0
-            out.band[:] = 0.0
-        assemble_cases(u, self.layout, self.material, theta_p, gamma_p, skip, out)
+            assembly.f[:] = 0.0
+            assembly.band[:] = 0.0
+        assemble_cases(u, tuple(self.layout), self.material, theta_p, gamma_p, skip,
+                       tuple(assembly), tuple(response))
         return out
 
     def per_case_all(self, dof_flags):

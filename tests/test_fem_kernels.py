@@ -98,8 +98,8 @@ def test_element_kernel_equals_the_scikit_fem_forms():
         one = solver.case()
         rng = np.random.default_rng(3)
         u = one.u * (1.0 + 0.01 * rng.normal(size=one.u.size))  # a Newton iterate
-        f, band, resp, folded, _, _, _ = solver.stack.assemble(u, one.state["theta_p"],
-                                                               one.state["gamma_p"])
+        assembly, resp = solver.stack.assemble(u, one.state["theta_p"], one.state["gamma_p"])
+        f, band, folded = assembly.f, assembly.band, assembly.folded
         f_ref, band_ref, resp_ref = assemble_forms(disc, u, one.state["theta_p"],
                                                    one.state["gamma_p"])
         assert not folded[0] and resp_ref.plastic.any() and not resp_ref.plastic.all()
