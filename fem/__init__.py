@@ -5,8 +5,10 @@ public entry points: :func:`expand_cavities` (many problems), :func:`expand_cavi
 problem, with its history and fields recorded) and :func:`write_result`.
 
 Layout, one idea per module: ``mesh`` (graded radial meshes), ``discretisation`` (bases,
-quadrature, mass), ``constitutive`` (the compiled point kernel: Hencky/Mohr-Coulomb return map),
-``element`` (the compiled element kernel: force and tangent), ``stack`` (cases concatenated,
+quadrature, mass), ``material_records`` (a layer packed into the kernels' material record: the
+one place), ``records`` (the named records the kernels take), ``constitutive`` (the compiled
+point kernel: Hencky/Mohr-Coulomb return map), ``element`` (the compiled element kernel: force
+and tangent), ``stack`` (cases concatenated,
 block-banded solve), ``newton`` (per-case Newton, line search), ``solver`` (stepping, cut-backs,
 observers), ``estimate`` (error companion and refinement policies), ``expansion`` (the problems
 and the public API), ``fields``/``output`` (post-processing, ParaView files).

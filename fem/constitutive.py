@@ -46,7 +46,8 @@ linear, so solved in closed form; the consistent tangent is its exact derivative
 ``d sigma / d(theta, gamma) = E - D G^{-1} (A E - k J e_theta^T)``, ``E = diag(-K, -2G)``.
 
 Implementation: one compiled (numba) kernel per point, :func:`return_point`, used by the element
-loop of :mod:`cavex.fem.element` for every case. It tries the Mohr-Coulomb-only return first (one
+loop of :mod:`cavex.fem.element` for every case, with the element's material record
+(:mod:`cavex.fem.material_records`). It tries the Mohr-Coulomb-only return first (one
 multiplier, the common case) and falls back, for that point only, to the multi-surface return
 when the trial state or the Mohr-Coulomb-returned one violates the tension cut-off. With a
 finite cap, a point whose trial or returned deviator exceeds ``tau_max J`` is returned again
@@ -60,7 +61,6 @@ compared with this kernel point by point (``tests/test_fem_kernels.py``).
 
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -70,56 +70,6 @@ NO_OUTPUTS = (0.0,) * 9  # the outputs of a return that hands over to another
 #: Per-point outputs of :func:`return_point`, in order (``out[i]``).
 OUTPUTS = ("tau_r", "tau_t", "C_rr", "C_rt", "C_tr", "C_tt", "yield_ratio", "theta_p",
            "gamma_p")
-
-
-@dataclass
-class PointMaterial:
-    """Material constants broadcast to the quadrature points (arrays of one shape)."""
-
-    K: np.ndarray
-    G: np.ndarray
-    lam: np.ndarray
-    tau: np.ndarray
-    lam_psi: np.ndarray
-    tension: np.ndarray
-    cap: np.ndarray | None = None  # Tresca cap tau_max (Pa); None: inf everywhere (no cap)
-
-    def __post_init__(self):
-        if self.cap is None:
-            self.cap = np.full(np.shape(self.K), np.inf)
-
-    @classmethod
-    def from_layers(cls, layers, layer_of_point, dilatancy_deg=0.0, tension_cutoff=None):
-        """Constants at points whose layer index is ``layer_of_point`` (int array).
-
-        ``tension_cutoff`` is ``None`` (through the apex, ``tau/lam``), a number (Pa) applied to
-        every layer, or a sequence with one value per layer. A layer's own ``tensile_strength``
-        (:class:`cavex.materials.Material`, when given) takes the place of ``tension_cutoff``
-        in that layer; its ``tau_max`` (None: no cap) is the Tresca cap.
-        """
-        pick = np.asarray(layer_of_point)
-
-        def per_layer(values):
-            return np.asarray(values, dtype=float)[pick]
-
-        if tension_cutoff is None:
-            cut = [m.tau / m.lam if m.lam > 0 else np.inf for m in layers]
-        elif np.ndim(tension_cutoff) == 0:
-            cut = [float(tension_cutoff)] * len(layers)
-        else:
-            cut = list(tension_cutoff)
-        cut = [cut[i] if getattr(m, "tensile_strength", None) is None else m.tensile_strength
-               for i, m in enumerate(layers)]
-        caps = [np.inf if getattr(m, "tau_max", None) is None else m.tau_max for m in layers]
-        sin_psi = np.sin(np.radians(dilatancy_deg))
-        lam_psi = 6.0 * sin_psi / (3.0 - sin_psi)
-        return cls(K=per_layer([m.bulk_modulus for m in layers]),
-                   G=per_layer([m.shear_modulus for m in layers]),
-                   lam=per_layer([m.lam for m in layers]),
-                   tau=per_layer([m.tau for m in layers]),
-                   lam_psi=np.full(pick.shape, lam_psi),
-                   tension=per_layer(cut), cap=per_layer(caps))
-
 
 
 @njit(cache=True, error_model="numpy", inline="always")
@@ -327,12 +277,16 @@ def _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, te
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def return_point(eps_r, eps_t, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap):
+def return_point(eps_r, eps_t, theta_p, gamma_p, material):
     """Return map of one point from its total log strains: ``(plastic, outputs)``, whether the
     point is plastic in this step and the tuple of its :data:`OUTPUTS`.
 
-    ``cap`` is the Tresca cap ``tau_max`` (Pa) on ``|sigma_r - sigma_theta|``; ``inf`` (no
-    cap) takes exactly the Mohr-Coulomb/tension code path (the cap tests are false)."""
+    ``material`` is the point's record of :data:`cavex.fem.material_records.MATERIAL`; the
+    only place where the kernels read its constitutive fields. Its ``cap`` is the Tresca cap
+    ``tau_max`` (Pa) on ``|sigma_r - sigma_theta|``; ``inf`` (no cap) takes exactly the
+    Mohr-Coulomb/tension code path (the cap tests are false)."""
+    K, G, lam, tau = material.K, material.G, material.lam, material.tau
+    lam_psi, tension, cap = material.lam_psi, material.tension, material.cap
     theta = eps_r + 2.0 * eps_t
     gamma = eps_r - eps_t
     J = math.exp(theta)

@@ -17,7 +17,7 @@ import numpy as np
 from skfem import Basis, ElementLineP1, ElementLineP2, asm
 
 from cavex.fem import forms
-from cavex.fem.constitutive import PointMaterial
+from cavex.fem.material_records import pack_layers
 
 ELEMENTS = {1: ElementLineP1, 2: ElementLineP2}
 
@@ -40,7 +40,7 @@ class Discretisation:
         Layer index of every element.
     layers : sequence of Material
     dilatancy_deg, tension_cutoff
-        See :class:`cavex.fem.constitutive.PointMaterial`.
+        See :func:`cavex.fem.material_records.pack_layers`.
     stiffness_points : int, optional
         Gauss points per element for the stiffness; default ``degree`` (the locking-free
         reduced rule). ``degree + 1`` is the full rule, kept to demonstrate locking.
@@ -67,8 +67,9 @@ class Discretisation:
         self.element_layer = np.asarray(element_layer)
         nq = self.basis.X.shape[1]
         self.point_layer = np.repeat(self.element_layer[:, None], nq, axis=1)
-        self.material = PointMaterial.from_layers(self.layers, self.point_layer, dilatancy_deg,
-                                                  tension_cutoff)
+        # one material record per element: the kernels' material, the mass matrix's density
+        self.material = pack_layers(self.layers, self.element_layer, dilatancy_deg,
+                                    tension_cutoff)
         # quadrature data of the reduced rule
         self.N = np.array([np.asarray(b[0])[0] for b in self.basis.basis])  # (nb, nq)
         self.dNdR = np.array([b[0].grad[0] for b in self.basis.basis]).transpose(1, 0, 2)
@@ -76,7 +77,7 @@ class Discretisation:
         self.weights = self.basis.dx * forms.FOUR_PI * self.R_points ** 2
         self.force_weights = self.weights * np.maximum(
             np.abs(self.dNdR).max(axis=1), self.N.max(axis=0) / self.R_points)
-        rho = np.array([m.rho for m in self.layers])[self.element_layer]
+        rho = self.material["rho"]
         nqm = self.mass_basis.X.shape[1]
         self._rho_mass = np.repeat(rho[:, None], nqm, axis=1)
         self.mass = self._assemble_mass()

@@ -24,7 +24,9 @@ storage (``p`` sub- and super-diagonals). The inertia ``int rho_0 u'' du dV`` is
 mass form of :mod:`cavex.fem.forms`, assembled once.
 
 :func:`assemble_cases` runs over a stack of disconnected cases (:class:`cavex.fem.stack.Stack`),
-skipping the cases flagged ``skip`` (their outputs are left as they are). A case in which some
+skipping the cases flagged ``skip`` (their outputs are left as they are); it takes the
+stack's records (:mod:`cavex.fem.records`) and one material record per element
+(:mod:`cavex.fem.material_records`), which it hands to the point kernel unread. A case in which some
 point has a non-positive stretch is *folded*: it is flagged and evaluated at zero strain (its
 Newton iteration is then abandoned by the caller). The scikit-fem forms of the same weak form
 are kept in ``tests/oracles.py`` and compared with this kernel in ``tests/test_fem_kernels.py``.
@@ -36,21 +38,32 @@ import numpy as np
 from numba import njit
 
 from cavex.fem.constitutive import return_point
+from cavex.fem.records import Assembly, Layout, PointResponse
 
 
 @njit(cache=True, error_model="numpy")
-def assemble_cases(u, Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_weights, K, G,
-                   lam, tau, lam_psi, tension, cap, theta_p, gamma_p, el_start, el_count, skip, p,
-                   f, band, tau_r, tau_t, th_p_new, ga_p_new, plastic, yield_ratio, folded,
-                   force_scale):
+def assemble_cases(u, layout, material, theta_p, gamma_p, skip, out, resp):
     """Response, internal force and banded tangent at the radial dofs ``u`` of every case ``c``
-    with ``not skip[c]``.
+    with ``not skip[c]``, into the :class:`~cavex.fem.records.Assembly` ``out`` and the
+    :class:`~cavex.fem.records.PointResponse` ``resp``.
 
-    ``Gr``, ``Gt`` (element, point) receive the displacement gradients ``du/dR``, ``u/R`` (zero
-    in a folded case). ``f`` and ``band`` must be zero on the cases evaluated; the per-point
-    outputs (``tau_r`` ... ``yield_ratio``) and per-case ``folded`` and ``force_scale`` (the
-    largest nodal force one point contributes: Newton's yardstick) are written in place.
+    ``layout`` is the stack's :class:`~cavex.fem.records.Layout`, ``material`` its
+    :data:`~cavex.fem.material_records.MATERIAL` record per element, ``theta_p, gamma_p`` the
+    start-of-step plastic strains per point. ``out.Gr``, ``out.Gt`` (element, point) receive
+    the displacement gradients ``du/dR``, ``u/R`` (zero in a folded case). ``out.f`` and
+    ``out.band`` must be zero on the cases evaluated; the point response and per-case
+    ``folded`` and ``force_scale`` (the largest nodal force one point contributes: Newton's
+    yardstick) are written in place. Records come named or as plain tuples
+    (:mod:`cavex.fem.records`, the boundary rule).
     """
+    layout, out, resp = Layout(*layout), Assembly(*out), PointResponse(*resp)
+    element_dofs, dNdR, N = layout.element_dofs, layout.dNdR, layout.N
+    R_points, force_weights = layout.R_points, layout.force_weights
+    el_start, el_count = layout.el_start, layout.el_count
+    Gr, Gt = out.Gr, out.Gt
+    tau_r, tau_t, plastic, yield_ratio = resp.tau_r, resp.tau_t, resp.plastic, resp.yield_ratio
+    th_p_new, ga_p_new = resp.theta_p, resp.gamma_p
+    folded, force_scale = out.folded, out.force_scale
     nb = element_dofs.shape[1]
     nq = R_points.shape[1]
     C = np.empty((4, nq))
@@ -81,21 +94,20 @@ def assemble_cases(u, Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_we
         scale = 0.0
         for e in range(e0, e1):
             for q in range(nq):
-                plastic[e, q], out = return_point(
+                plastic[e, q], point = return_point(
                     math.log1p(Gr[e, q]), math.log1p(Gt[e, q]), theta_p[e, q], gamma_p[e, q],
-                    K[e, q], G[e, q], lam[e, q], tau[e, q], lam_psi[e, q], tension[e, q],
-                    cap[e, q])
-                tau_r[e, q] = out[0]
-                tau_t[e, q] = out[1]
-                C[0, q], C[1, q], C[2, q], C[3, q] = out[2], out[3], out[4], out[5]
-                yield_ratio[e, q] = out[6]
-                th_p_new[e, q] = out[7]
-                ga_p_new[e, q] = out[8]
-                s = (abs(out[0]) + 2.0 * abs(out[1])) * force_weights[e, q]
+                    material[e])
+                tau_r[e, q] = point[0]
+                tau_t[e, q] = point[1]
+                C[0, q], C[1, q], C[2, q], C[3, q] = point[2], point[3], point[4], point[5]
+                yield_ratio[e, q] = point[6]
+                th_p_new[e, q] = point[7]
+                ga_p_new[e, q] = point[8]
+                s = (abs(point[0]) + 2.0 * abs(point[1])) * force_weights[e, q]
                 if s > scale or s != s:
                     scale = s
-            _element(e, Gr, Gt, C, tau_r, tau_t, element_dofs, dNdR, N, R_points, weights, p,
-                     Br, Bt, X, Y, f, band)
+            _element(e, Gr, Gt, C, tau_r, tau_t, element_dofs, dNdR, N, R_points,
+                     layout.weights, layout.degree, Br, Bt, X, Y, out.f, out.band)
         force_scale[c] = scale
 
 

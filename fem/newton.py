@@ -38,14 +38,22 @@ costs its own work only. Every case gets the same bits alone and inside any stac
 """
 
 import math
-from dataclasses import dataclass
-from types import SimpleNamespace
 
 import numpy as np
 from numba import njit
 
 from cavex.fem.banded import solve_blocks
 from cavex.fem.element import assemble_cases
+from cavex.fem.records import (
+    Assembly,
+    Convergence,
+    Equations,
+    Layout,
+    PointResponse,
+    Progress,
+    Scheme,
+    StepStart,
+)
 
 MAX_ITERATIONS = 30     # Newton iterations per attempt
 STALL_ITERATIONS = 4    # an attempt fails once its residual has not reached a new low in this many
@@ -53,62 +61,8 @@ LINE_SEARCH_EVALUATIONS = 20  # residual evaluations per line search (Illinois s
 LINE_SEARCH_TOLERANCE = 0.5   # accept s once |G(s)| <= this * |G(0)|
 
 
-@dataclass
-class Newmark:
-    """Generalized-alpha parameters from ``rho_inf`` in [0, 1]."""
-
-    alpha_m: float
-    alpha_f: float
-    beta: float
-    gamma: float
-
-    @classmethod
-    def from_rho_inf(cls, rho_inf):
-        am = (2.0 * rho_inf - 1.0) / (rho_inf + 1.0)
-        af = rho_inf / (rho_inf + 1.0)
-        return cls(alpha_m=am, alpha_f=af, beta=0.25 * (1.0 - am + af) ** 2,
-                   gamma=0.5 - am + af)
-
-
 class StepFailure(Exception):
     """A Newton iteration that did not converge (internal: triggers a cut-back)."""
-
-
-@dataclass
-class StepStart:
-    """Start-of-step data of a Newton call, in stack layout.
-
-    Per dof: ``u0, v0, a0, f0`` (displacement, velocity, acceleration and internal force at
-    the start of the step) and ``du_prev`` (the last step's increment); per point:
-    ``theta_p, gamma_p`` (plastic strains); per case: ``load`` (the wall load at the end of
-    the step), ``dt``, ``dt_old`` (the last step's), ``has_prev`` (a last step exists) and
-    ``active`` (the case iterates). ``u``: the current iterate when a call continues another's
-    iteration, None when it starts from the predictor (:func:`predict`).
-    """
-
-    u0: np.ndarray
-    v0: np.ndarray
-    a0: np.ndarray
-    f0: np.ndarray
-    du_prev: np.ndarray
-    theta_p: np.ndarray
-    gamma_p: np.ndarray
-    load: np.ndarray
-    dt: np.ndarray
-    dt_old: np.ndarray
-    has_prev: np.ndarray
-    active: np.ndarray
-    u: np.ndarray | None = None
-
-    def subset(self, dofs, elements, cases, u=None):
-        """The start of a subset of the stack's cases (:meth:`Stack.subset`'s maps), all of
-        them active, continuing from the iterate ``u`` when given."""
-        return StepStart(u0=self.u0[dofs], v0=self.v0[dofs], a0=self.a0[dofs],
-                         f0=self.f0[dofs], du_prev=self.du_prev[dofs],
-                         theta_p=self.theta_p[elements], gamma_p=self.gamma_p[elements],
-                         load=self.load[cases], dt=self.dt[cases], dt_old=self.dt_old[cases],
-                         has_prev=self.has_prev[cases],
-                         active=np.ones(np.size(cases), dtype=bool), u=u)
 
 
 def converged(iteration, r_max, scale, tol):
@@ -129,9 +83,10 @@ FAILURES = {
 }
 
 
-def newton(stack, w, params, dynamic, tol):
-    """Generalized-alpha Newton iteration of every case of ``stack`` with ``w.active``, from
-    the predictor (:func:`predict`).
+def newton(stack, w, scheme, tol):
+    """Generalized-alpha Newton iteration of every case of ``stack`` with ``w.active`` (a
+    :class:`~cavex.fem.records.StepStart`), from the predictor (:func:`predict`), in the time
+    scheme ``scheme`` (:class:`~cavex.fem.records.Scheme`).
 
     The iteration runs compiled (:func:`iterate`), every case with its own convergence
     (:func:`converged`), stall and failure, a case that is done skipped by the kernels.
@@ -141,39 +96,31 @@ def newton(stack, w, params, dynamic, tol):
     to be used).
     """
     k = stack.n_cases
-    u, f, band, resp, folded, force_scale, a, r_free, du, jac, scale, r_max, gradients = \
-        newton_buffers(stack)
-    status = np.where(w.active, 0, 1).astype(np.int64)
-    iterations, evaluations = np.zeros(k, dtype=np.int64), np.zeros(k, dtype=np.int64)
-    m, p = stack.material, params
-    iterate(u, w.u0, w.v0, w.a0, w.f0, w.du_prev, w.theta_p, w.gamma_p, w.load, w.dt,
-            w.dt_old, w.has_prev, tol, MAX_ITERATIONS, STALL_ITERATIONS, stack.element_dofs,
-            stack.dNdR, stack.N, stack.R_points, stack.weights, stack.force_weights, m.K, m.G,
-            m.lam, m.tau, m.lam_psi, m.tension, m.cap, stack.el_start, stack.el_count,
-            stack.degree, stack.mass_band, stack.dof_start, stack.dof_count, stack.free,
-            stack.R_dofs, stack.fixed_entries, stack.fixed_diagonal, p.alpha_m, p.alpha_f,
-            p.beta, dynamic, stack.pressure_control, stack.outer_fixed, *gradients, f, band,
-            resp.tau_r, resp.tau_t, resp.theta_p, resp.gamma_p, resp.plastic,
-            resp.yield_ratio, folded, force_scale, a, r_free, jac, scale, r_max, du, status,
-            iterations, evaluations)
+    u, assembly, response, equations = newton_buffers(stack)
+    progress = Progress(status=np.where(w.active, 0, 1).astype(np.int64),
+                        iterations=np.zeros(k, dtype=np.int64),
+                        evaluations=np.zeros(k, dtype=np.int64))
+    convergence = Convergence(tol, MAX_ITERATIONS, STALL_ITERATIONS)
+    iterate(u, tuple(w), tuple(stack.layout), stack.material, tuple(scheme), tuple(convergence),
+            tuple(assembly), tuple(response), tuple(equations), tuple(progress))
+    status, iterations = progress.status, progress.iterations
     reasons = [FAILURES.get(code) for code in status.tolist()]
     iterations[status != 1] = 0
-    return u, a, f, resp, iterations, reasons, evaluations
+    return u, equations.a, assembly.f, response, iterations, reasons, progress.evaluations
 
 
 def newton_buffers(stack):
     """The arrays :func:`newton` works in, made once per stack and reused by every call on it
     (every value a call returns is written by that call; the solver copies what it keeps
-    before the next call): ``(u, f, band, response, folded, force_scale, a, r_free, du, jac,
-    scale, r_max, gradients)``."""
+    before the next call): ``(u, assembly, response, equations)``
+    (:class:`~cavex.fem.records.Assembly`, :class:`~cavex.fem.records.PointResponse`,
+    :class:`~cavex.fem.records.Equations`)."""
     if not hasattr(stack, "_newton_buffers"):
-        f, band, resp, folded, force_scale = stack.new_buffers()
-        shape = stack.R_points.shape
-        stack._newton_buffers = (np.zeros(stack.ndof), f, band, resp, folded, force_scale,
-                                 np.zeros(stack.ndof), np.zeros(stack.ndof),
-                                 np.zeros(stack.ndof), np.zeros_like(band),
-                                 np.zeros(stack.n_cases), np.zeros(stack.n_cases),
-                                 (np.zeros(shape), np.zeros(shape)))
+        assembly, response = stack.new_buffers()
+        stack._newton_buffers = (np.zeros(stack.ndof), assembly, response, Equations(
+            a=np.zeros(stack.ndof), r_free=np.zeros(stack.ndof),
+            jac=np.zeros_like(assembly.band), scale=np.zeros(stack.n_cases),
+            r_max=np.zeros(stack.n_cases)))
     return stack._newton_buffers
 
 
@@ -191,31 +138,38 @@ def stalls(relative, best, stalled, c, limit):
 
 
 @njit(cache=True, error_model="numpy")
-def iterate(u, u0, v0, a0, f0, du_prev, theta_p, gamma_p, load, dt, dt_old, has_prev, tol,
-            max_iterations, stall_iterations, element_dofs, dNdR, N, R_points, weights,
-            force_weights, K, G, lam, tau, lam_psi, tension, cap, el_start, el_count, p,
-            mass_band, dof_start, dof_count, free, R_dofs, fixed_entries, fixed_diagonal,
-            alpha_m, alpha_f, beta, dynamic, pressure, outer_fixed, Gr, Gt, f, band, tau_r,
-            tau_t, th_p_new, ga_p_new, plastic, yield_ratio, folded, force_scale, a, r_free,
-            jac, scale, r_max, du, status, iterations, evaluations):
-    """Compiled body of :func:`newton`: the iterations of every case with ``status`` 0 from
-    the predictor (:func:`predict_cases`, written into ``u``, which is then updated in place,
-    as every output). Per iteration: the kernel
-    (:func:`cavex.fem.element.assemble_cases`), the step equations (:func:`step_equations`),
-    the rules (folded, non-finite, :func:`converged`, stall), the banded solve
-    (:func:`cavex.fem.banded.solve_blocks`, fixed dofs as identity rows) and the update.
-    ``status`` per case on return: 1 converged (``iterations`` = Newton solves), else the
-    failure code of :data:`FAILURES`; ``evaluations`` is incremented per kernel pass."""
+def iterate(u, w, layout, material, scheme, convergence, assembly, response, equations,
+            progress):
+    """Compiled body of :func:`newton`: the iterations of every case with ``progress.status``
+    0 from the predictor (:func:`predict_cases`, written into ``u``, which is then updated in
+    place, as every output: ``assembly``, ``response``, ``equations``, ``progress``). ``w`` is
+    the :class:`~cavex.fem.records.StepStart`, ``layout`` the stack's
+    :class:`~cavex.fem.records.Layout`, ``material`` its record per element; the records come
+    as plain tuples (:mod:`cavex.fem.records`, the boundary rule). Per iteration: the
+    kernel (:func:`cavex.fem.element.assemble_cases`), the step equations
+    (:func:`step_equations`), the rules (folded, non-finite, :func:`converged`, stall), the
+    banded solve (:func:`cavex.fem.banded.solve_blocks`, fixed dofs as identity rows) and the
+    update. ``status`` per case on return: 1 converged (``iterations`` = Newton solves), else
+    the failure code of :data:`FAILURES`; ``evaluations`` is incremented per kernel pass."""
+    w, layout, scheme = StepStart(*w), Layout(*layout), Scheme(*scheme)
+    convergence, assembly, response = Convergence(*convergence), Assembly(*assembly), \
+        PointResponse(*response)
+    equations, progress = Equations(*equations), Progress(*progress)
+    status, iterations, evaluations = progress.status, progress.iterations, progress.evaluations
+    dof_start, dof_count, free = layout.dof_start, layout.dof_count, layout.free
+    f, band, folded = assembly.f, assembly.band, assembly.folded
+    r_free, jac, scale, r_max = equations.r_free, equations.jac, equations.scale, equations.r_max
+    tol = convergence.tol
     k = dof_start.size
-    predict_cases(u, u0, v0, du_prev, load, dt, dt_old, has_prev, status == 0, dof_start,
-                  dof_count, free, dynamic, pressure)
+    predict_cases(u, w, status == 0, layout, scheme.dynamic)
     done = status != 0
     best = np.full(k, np.inf)
     stalled = np.zeros(k, dtype=np.int64)
     flat = jac.reshape(-1)
     rhs = np.zeros(u.size)
+    du = np.zeros(u.size)
     singular = np.zeros(k, dtype=np.bool_)
-    for iteration in range(1, max_iterations + 1):
+    for iteration in range(1, convergence.max_iterations + 1):
         skip = done.copy()
         for c in range(k):
             if not skip[c]:
@@ -223,17 +177,12 @@ def iterate(u, u0, v0, a0, f0, du_prev, theta_p, gamma_p, load, dt, dt_old, has_
                 s0, m = dof_start[c], dof_count[c]
                 f[s0:s0 + m] = 0.0
                 band[:, s0:s0 + m] = 0.0
-        assemble_cases(u, Gr, Gt, element_dofs, dNdR, N, R_points, weights, force_weights,
-                       K, G, lam, tau, lam_psi, tension, cap, theta_p, gamma_p, el_start,
-                       el_count, skip, p, f, band, tau_r, tau_t, th_p_new, ga_p_new, plastic,
-                       yield_ratio, folded, force_scale)
+        assemble_cases(u, layout, material, w.theta_p, w.gamma_p, skip, assembly, response)
         for c in range(k):
             if not done[c] and folded[c]:
                 status[c] = 2
                 done[c] = True
-        step_equations(u, u0, v0, a0, f0, f, band, mass_band, dt, load, dof_start, dof_count,
-                       free, done, p, alpha_m, alpha_f, beta, dynamic, pressure, outer_fixed,
-                       R_dofs, force_scale, a, r_free, jac, scale, r_max)
+        step_equations(u, w, layout, scheme, assembly, done, equations)
         for c in range(k):
             if done[c]:
                 continue
@@ -245,18 +194,18 @@ def iterate(u, u0, v0, a0, f0, du_prev, theta_p, gamma_p, load, dt, dt_old, has_
                 iterations[c] = iteration - 1
                 done[c] = True
             elif iteration > 1 and stalls(r_max[c] / scale[c], best, stalled, c,
-                                          stall_iterations):
+                                          convergence.stall_iterations):
                 status[c] = 4
                 done[c] = True
         if done.all():
             return
-        flat[fixed_entries] = 0.0
-        flat[fixed_diagonal] = 1.0
+        flat[layout.fixed_entries] = 0.0
+        flat[layout.fixed_diagonal] = 1.0
         for i in range(u.size):
             rhs[i] = r_free[i] if free[i] else 0.0
             du[i] = 0.0
         singular[:] = False
-        solve_blocks(jac, rhs, p, dof_start, dof_count, ~done, du, singular)
+        solve_blocks(jac, rhs, layout.degree, dof_start, dof_count, ~done, du, singular)
         for c in range(k):
             if done[c]:
                 continue
@@ -282,15 +231,12 @@ def iterate(u, u0, v0, a0, f0, du_prev, theta_p, gamma_p, load, dt, dt_old, has_
 def predict(stack, w, dynamic):
     """First Newton iterate of every active case (:func:`predict_cases`), a new array."""
     u = np.empty(stack.ndof)
-    predict_cases(u, w.u0, w.v0, w.du_prev, w.load, w.dt, w.dt_old, w.has_prev, w.active,
-                  stack.dof_start, stack.dof_count, stack.free, dynamic,
-                  stack.pressure_control)
+    predict_cases(u, tuple(w), w.active, tuple(stack.layout), dynamic)
     return u
 
 
 @njit(cache=True, error_model="numpy")
-def predict_cases(u, u0, v0, du_prev, load, dt, dt_old, has_prev, active, dof_start, dof_count,
-                  free, dynamic, pressure):
+def predict_cases(u, w, active, layout, dynamic):
     """First Newton iterate of every active case; the wall at its prescribed displacement
     under displacement control.
 
@@ -305,17 +251,21 @@ def predict_cases(u, u0, v0, du_prev, load, dt, dt_old, has_prev, active, dof_st
 
     Written into ``u``; the prescribed dofs (and every dof of an inactive case) keep ``u0``,
     the wall its prescribed displacement ``load`` under displacement control."""
+    w, layout = StepStart(*w), Layout(*layout)
+    u0, v0, du_prev, load, dt = w.u0, w.v0, w.du_prev, w.load, w.dt
+    dof_start, dof_count, free, pressure = (layout.dof_start, layout.dof_count, layout.free,
+                                            layout.pressure)
     for c in range(dof_start.size):
         s0, m = dof_start[c], dof_count[c]
         if dynamic or pressure:
-            ratio = dt[c] / dt_old[c]
+            ratio = dt[c] / w.dt_old[c]
         else:
             ratio = (load[c] - u0[s0]) / du_prev[s0]
             if not np.isfinite(ratio):
                 ratio = 1.0
         for i in range(s0, s0 + m):
             if free[i] and active[c]:
-                if has_prev[c]:
+                if w.has_prev[c]:
                     u[i] = u0[i] + ratio * du_prev[i]
                 elif dynamic:
                     u[i] = u0[i] + dt[c] * v0[i]
@@ -327,34 +277,38 @@ def predict_cases(u, u0, v0, du_prev, load, dt, dt_old, has_prev, active, dof_st
                 u[i] = u0[i]
 
 
-def equations(stack, w, params, dynamic, u, f, band, force_scale, skip=None, out=None):
-    """``(a, r_free, jac, scale, r_max)`` of the step's equations at the iterate ``u`` (stack
-    layout; ``r_free`` is zero at the prescribed dofs; per case ``scale``, the largest of the
-    point force yardstick, the reactions and the wall load, and ``r_max = max |r_free|``, NaN
-    where the residual is not finite). ``jac`` is a buffer that :meth:`Stack.solve` may
-    overwrite. Cases with ``skip`` keep their values in ``out`` (the
-    previous call's result, reused in place)."""
+def equations(stack, w, scheme, u, assembly, skip=None, out=None):
+    """The :class:`~cavex.fem.records.Equations` ``(a, r_free, jac, scale, r_max)`` of the
+    step's equations at the iterate ``u`` with the element kernel's ``assembly`` (stack layout;
+    ``r_free`` is zero at the prescribed dofs; per case ``scale``, the largest of the point
+    force yardstick, the reactions and the wall load, and ``r_max = max |r_free|``, NaN where
+    the residual is not finite). ``jac`` is a buffer that :meth:`Stack.solve` may overwrite.
+    Cases with ``skip`` keep their values in ``out`` (the previous call's result, reused in
+    place)."""
     k = stack.n_cases
     if out is None:
-        out = (np.zeros(stack.ndof), np.zeros(stack.ndof), np.zeros_like(band), np.zeros(k),
-               np.zeros(k))
+        out = Equations(a=np.zeros(stack.ndof), r_free=np.zeros(stack.ndof),
+                        jac=np.zeros_like(assembly.band), scale=np.zeros(k), r_max=np.zeros(k))
     if skip is None:
         skip = np.zeros(k, dtype=bool)
-    a, r_free, jac, scale, r_max = out
-    p = params
-    step_equations(u, w.u0, w.v0, w.a0, w.f0, f, band, stack.mass_band, w.dt,
-                   w.load, stack.dof_start, stack.dof_count, stack.free, skip, stack.degree,
-                   p.alpha_m, p.alpha_f, p.beta, dynamic, stack.pressure_control,
-                   stack.outer_fixed, stack.R_dofs, force_scale, a, r_free, jac, scale, r_max)
+    step_equations(u, tuple(w), tuple(stack.layout), tuple(scheme), tuple(assembly), skip,
+                   tuple(out))
     return out
 
 
 @njit(cache=True, error_model="numpy")
-def step_equations(u, u0, v0, a0, f0, f, band, mass_band, dt, load, dof_start, dof_count, free,
-                   skip, p, alpha_m, alpha_f, beta, dynamic, pressure, outer_fixed, R_dofs,
-                   force_scale, a, r_free, jac, scale, r_max):
+def step_equations(u, w, layout, scheme, assembly, skip, out):
     """Compiled body of :func:`equations` (module docstring: the generalized-alpha residual
     and Newton matrix; the inertia from the banded mass matrix)."""
+    w, layout, scheme = StepStart(*w), Layout(*layout), Scheme(*scheme)
+    assembly, out = Assembly(*assembly), Equations(*out)
+    u0, v0, a0, f0, dt, load = w.u0, w.v0, w.a0, w.f0, w.dt, w.load
+    f, band, force_scale = assembly.f, assembly.band, assembly.force_scale
+    a, r_free, jac, scale, r_max = out.a, out.r_free, out.jac, out.scale, out.r_max
+    mass_band, dof_start, dof_count, free = (layout.mass_band, layout.dof_start,
+                                             layout.dof_count, layout.free)
+    p, pressure, R_dofs = layout.degree, layout.pressure, layout.R_dofs
+    alpha_m, alpha_f, beta, dynamic = scheme.alpha_m, scheme.alpha_f, scheme.beta, scheme.dynamic
     for c in range(dof_start.size):
         if skip[c]:
             continue
@@ -400,14 +354,10 @@ def step_equations(u, u0, v0, a0, f0, f, band, mass_band, dt, load, dof_start, d
         scale[c] = sc
 
 
-def copy_response(resp):
-    return SimpleNamespace(**{name: value.copy() for name, value in vars(resp).items()})
-
-
 def replace_points(response, where, other):
     """Overwrite the point arrays of ``response`` at ``where`` (elements) by ``other``'s."""
-    for name, value in vars(response).items():
-        value[where] = getattr(other, name)
+    for value, replacement in zip(response, other, strict=True):
+        value[where] = replacement
 
 
 # ------------------------------------------------------------------------- the line search
@@ -480,24 +430,23 @@ def _illinois(evaluate, x, d, g0, g1, out1):
     return s, out
 
 
-def newton_line_search(stack, w, params, dynamic, tol):
+def newton_line_search(stack, w, scheme, tol):
     """The Newton iteration of the one case of ``stack`` with the line search of
     :func:`line_search_newton`. Returns ``(u, a, f, response, iterations, reason)`` (reason
     None when converged)."""
-    start = predict(stack, w, dynamic)
+    start = predict(stack, w, scheme.dynamic)
     free = stack.free
 
     def evaluate(x):
         u = start.copy()
         u[free] = x
-        f, band, resp, folded, force_scale = stack.assemble(u, w.theta_p, w.gamma_p)
-        if folded[0]:
+        assembly, response = stack.assemble(u, w.theta_p, w.gamma_p)
+        if assembly.folded[0]:
             raise StepFailure("non-positive stretch")
-        a, r_free, jac, scale, r_max = equations(stack, w, params, dynamic, u, f, band,
-                                                 force_scale)
+        a, r_free, jac, scale, r_max = equations(stack, w, scheme, u, assembly)
         if np.isnan(r_max[0]):
             raise StepFailure("non-finite residual")
-        return r_free[free], scale[0], jac, u, a, f, resp
+        return r_free[free], scale[0], jac, u, a, assembly.f, response
 
     def solve(out, r):
         rhs = np.zeros(stack.ndof)

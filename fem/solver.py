@@ -28,19 +28,23 @@ import numpy as np
 from numba import njit
 
 from cavex.errors import CavexNumericalError
-from cavex.fem.newton import (
-    Newmark,
+from cavex.fem.newton import newton, newton_line_search, replace_points
+from cavex.fem.records import (
+    CaseState,
+    DofState,
+    Layout,
+    PointResponse,
+    PointState,
+    Rows,
+    Scheme,
     StepStart,
-    copy_response,
-    newton,
-    newton_line_search,
-    replace_points,
+    Trial,
 )
 from cavex.fem.stack import Stack
 
-DOF_STATE = ("u", "v", "a", "f", "du_prev")
-POINT_STATE = ("theta_p", "gamma_p", "eq_p", "plastic", "yield_ratio", "tau_r", "tau_t")
-CASE_STATE = ("t", "load", "dt_old", "wall_force", "work", "dissipated")
+DOF_STATE = DofState._fields
+POINT_STATE = PointState._fields
+CASE_STATE = CaseState._fields
 COUNTERS = ("steps", "newton_iterations", "cutbacks", "line_search_steps",
             "residual_evaluations")
 
@@ -53,16 +57,14 @@ def failure_message(depth, t, wall_radius, load, dt, plain, line_searched):
 
 
 @njit(cache=True, error_model="numpy")
-def commit_cases(ok, cases, dof_start, dof_count, el_start, el_count, root_dofs,
-                 root_elements, u, a, f, u0, v0, a0, f0, dt, theta_p0, gamma_p0, tau_r, tau_t,
-                 theta_p, gamma_p, plastic, yield_ratio, weights, wall_indptr, wall_indices,
-                 wall_data, dynamic, gamma, alpha_m, alpha_f, U, V, A, F, DU, THETA_P,
-                 GAMMA_P, EQ_P, PLASTIC, YIELD_RATIO, TAU_R, TAU_T, wall_force, work,
-                 dissipated):
+def commit_cases(ok, rows, trial, resp, w, layout, scheme, dofs, points, cases):
     r"""Accept step ``n -> n+1`` of every case ``c`` of a working stack with ``ok[c]``: its
-    trial state (``u, a, f`` per dof, the point response) is written into the solver's
-    state (upper-case arrays, rows ``root_dofs``/``root_elements`` of the working stack's
-    dofs/elements; per case row ``cases[c]``), with
+    :class:`~cavex.fem.records.Trial` state (``u, a, f`` per dof) and its point response
+    ``resp`` (a :class:`~cavex.fem.records.PointResponse`) are written into the solver's state
+    (``dofs``, ``points``, ``cases``:
+    :class:`~cavex.fem.records.DofState`, :class:`~cavex.fem.records.PointState`,
+    :class:`~cavex.fem.records.CaseState`; at the :class:`~cavex.fem.records.Rows` ``rows`` of
+    the working stack's dofs and elements, per case row ``rows.cases[c]``), with
 
     - the Newmark velocity ``v = v_n + dt[(1 - gamma) a_n + gamma a]`` (dynamic; else 0) and
       the increment ``du_prev = u - u_n``;
@@ -73,9 +75,27 @@ def commit_cases(ok, cases, dof_start, dof_count, el_start, el_count, root_dofs,
     - the dissipation ``sum W [-P (theta_p - theta_p,n) - (2/3) Q (gamma_p - gamma_p,n)]``
       with ``P = -(tau_r + 2 tau_t)/3``, ``Q = tau_t - tau_r``.
 
-    ``wall_*`` are the CSR rows of the mass matrix at the wall dofs (one per case), summed in
-    their stored order as scipy's product does. The start-of-step arrays (``u0`` ...) may be
-    views of the state: each value is read before its row is written."""
+    ``layout.wall_*`` are the CSR rows of the mass matrix at the wall dofs (one per case),
+    summed in their stored order as scipy's product does. The start-of-step arrays of ``w``
+    (a :class:`~cavex.fem.records.StepStart`) may be views of the state: each value is read
+    before its row is written. The records come as plain tuples (:mod:`cavex.fem.records`, the
+    boundary rule)."""
+    rows, trial, resp, w = Rows(*rows), Trial(*trial), PointResponse(*resp), StepStart(*w)
+    layout, scheme, dofs = Layout(*layout), Scheme(*scheme), DofState(*dofs)
+    points, cases = PointState(*points), CaseState(*cases)
+    u, a, f = trial.u, trial.a, trial.f
+    u0, v0, a0, f0, dt = w.u0, w.v0, w.a0, w.f0, w.dt
+    theta_p0, gamma_p0 = w.theta_p, w.gamma_p
+    tau_r, tau_t, theta_p, gamma_p = resp.tau_r, resp.tau_t, resp.theta_p, resp.gamma_p
+    dof_start, dof_count = layout.dof_start, layout.dof_count
+    el_start, el_count, weights = layout.el_start, layout.el_count, layout.weights
+    wall_indptr, wall_indices, wall_data = (layout.wall_indptr, layout.wall_indices,
+                                            layout.wall_data)
+    dynamic, gamma, alpha_m, alpha_f = scheme.dynamic, scheme.gamma, scheme.alpha_m, \
+        scheme.alpha_f
+    U, V, A, F, DU = dofs.u, dofs.v, dofs.a, dofs.f, dofs.du_prev
+    wall_force, work, dissipated = cases.wall_force, cases.work, cases.dissipated
+    root_dofs, root_elements = rows.dofs, rows.elements
     nq = weights.shape[1]
     for c in range(dof_start.size):
         if not ok[c]:
@@ -93,7 +113,7 @@ def commit_cases(ok, cases, dof_start, dof_count, el_start, el_count, root_dofs,
         else:
             mid_force = 0.5 * (f[s0] + f0[s0])
             end_force = f[s0]
-        k = cases[c]
+        k = rows.cases[c]
         wall_force[k] = end_force
         work[k] += mid_force * (u[s0] - u0[s0])
         h = dt[c]
@@ -112,13 +132,13 @@ def commit_cases(ok, cases, dof_start, dof_count, el_start, el_count, root_dofs,
                 Q = tau_t[e, q] - tau_r[e, q]
                 total += weights[e, q] * (-P * (theta_p[e, q] - theta_p0[e, q])
                                           - (2.0 / 3.0) * Q * (gamma_p[e, q] - gamma_p0[e, q]))
-                EQ_P[row, q] += abs(gamma_p[e, q] - gamma_p0[e, q]) * (2.0 / 3.0)
-                THETA_P[row, q] = theta_p[e, q]
-                GAMMA_P[row, q] = gamma_p[e, q]
-                PLASTIC[row, q] = plastic[e, q]
-                YIELD_RATIO[row, q] = yield_ratio[e, q]
-                TAU_R[row, q] = tau_r[e, q]
-                TAU_T[row, q] = tau_t[e, q]
+                points.eq_p[row, q] += abs(gamma_p[e, q] - gamma_p0[e, q]) * (2.0 / 3.0)
+                points.theta_p[row, q] = theta_p[e, q]
+                points.gamma_p[row, q] = gamma_p[e, q]
+                points.plastic[row, q] = resp.plastic[e, q]
+                points.yield_ratio[row, q] = resp.yield_ratio[e, q]
+                points.tau_r[row, q] = tau_r[e, q]
+                points.tau_t[row, q] = tau_t[e, q]
         dissipated[k] += total
 
 
@@ -158,7 +178,7 @@ class RadialSolver:
         discs = [discs] if not isinstance(discs, (list, tuple)) else list(discs)
         self.stack = root = Stack(discs, outer_fixed=outer == "fixed", wall_control=wall_control)
         self.dynamic = dynamic
-        self.params = Newmark.from_rho_inf(rho_inf)
+        self.params = Scheme.from_rho_inf(rho_inf, dynamic)
         self.newton_tol = newton_tol
         self.max_cutbacks = max_cutbacks
         k = root.n_cases
@@ -166,9 +186,9 @@ class RadialSolver:
         self.dofs["v"][root.wall] = wall_velocity
         shape = root.R_points.shape
         self.points = {name: np.zeros(shape) for name in POINT_STATE}
-        f, _, resp, _, _ = root.assemble(self.dofs["u"], self.points["theta_p"],
-                                         self.points["gamma_p"])
-        self.dofs["f"] = f
+        assembly, resp = root.assemble(self.dofs["u"], self.points["theta_p"],
+                                       self.points["gamma_p"])
+        self.dofs["f"] = assembly.f
         self.points.update(plastic=resp.plastic, yield_ratio=resp.yield_ratio,
                            tau_r=resp.tau_r, tau_t=resp.tau_t)
         self.cases = {name: np.zeros(k) for name in CASE_STATE}
@@ -282,40 +302,35 @@ class RadialSolver:
 
     def _attempt(self, stack, w, active, search):
         """One Newton attempt of the active cases (the line-searched ones case by case).
-        Returns ``((u, a, f, response), ok, iterations, reasons, evaluations)`` on the working
+        Returns ``((trial, response), ok, iterations, reasons, evaluations)`` on the working
         stack (``evaluations``: plain Newton's residual evaluations per case)."""
         u, a, f, resp, iterations, reasons, evaluations = newton(
-            stack, w, self.params, self.dynamic, self.newton_tol)
+            stack, w, self.params, self.newton_tol)
         if search.any():
             u, a, f = u.copy(), a.copy(), f.copy()
-            resp = copy_response(resp)
+            resp = resp.copy()
             for i in np.flatnonzero(search):
                 sub, sdofs, selements = stack.subset([i])
                 sw = w.subset(sdofs, selements, [i])
                 su, sa, sf, sresp, iterations[i], reasons[i] = newton_line_search(
-                    sub, sw, self.params, self.dynamic, self.newton_tol)
+                    sub, sw, self.params, self.newton_tol)
                 if reasons[i] is None:
                     u[sdofs], a[sdofs], f[sdofs] = su, sa, sf
                     replace_points(resp, selements, sresp)
         ok = active & np.array([r is None for r in reasons])
-        return (u, a, f, resp), ok, iterations, reasons, evaluations
+        return (Trial(u, a, f), resp), ok, iterations, reasons, evaluations
 
     def _commit(self, stack, cases, dofs, elements, ok, w, trial):
         """Accept the converged cases ``ok`` of the working ``stack`` (compiled:
         :func:`commit_cases`): velocities, plastic state, energies, wall reaction."""
-        u, a, f, resp = trial
-        p = self.params
-        root_dofs = self._rows if isinstance(dofs, slice) else dofs
-        root_elements = self._point_rows if isinstance(elements, slice) else elements
-        wall_mass = stack.wall_mass  # the wall rows of the mass matrix: the wall forces
-        commit_cases(ok, cases, stack.dof_start, stack.dof_count, stack.el_start,
-                     stack.el_count, root_dofs, root_elements, u, a, f, w.u0, w.v0, w.a0,
-                     w.f0, w.dt, w.theta_p, w.gamma_p, resp.tau_r, resp.tau_t, resp.theta_p,
-                     resp.gamma_p, resp.plastic, resp.yield_ratio, stack.weights,
-                     wall_mass.indptr, wall_mass.indices, wall_mass.data, self.dynamic,
-                     p.gamma, p.alpha_m, p.alpha_f, *(self.dofs[name] for name in DOF_STATE),
-                     *(self.points[name] for name in POINT_STATE),
-                     *(self.cases[name] for name in ("wall_force", "work", "dissipated")))
+        rows = (cases, self._rows if isinstance(dofs, slice) else dofs,
+                self._point_rows if isinstance(elements, slice) else elements)  # Rows
+        state = (tuple(self.dofs[name] for name in DOF_STATE),
+                 tuple(self.points[name] for name in POINT_STATE),
+                 tuple(self.cases[name] for name in CASE_STATE))
+        trial, response = trial
+        commit_cases(ok, rows, tuple(trial), tuple(response), tuple(w), tuple(stack.layout),
+                     tuple(self.params), *state)
 
     def start_under_load(self, load):
         """Consistent start for a wall pressure ``load`` applied suddenly at ``t = 0+``.
@@ -364,9 +379,9 @@ class RadialSolver:
         eps_r, eps_t = np.log1p(g_r), np.log1p(g_t)
         theta_e = eps_r + 2.0 * eps_t - one.state["theta_p"]
         gamma_e = eps_r - eps_t - one.state["gamma_p"]
-        m = disc.material
-        return float(np.sum(disc.weights * (0.5 * m.K * theta_e ** 2
-                                            + (2.0 / 3.0) * m.G * gamma_e ** 2)))
+        K, G = disc.material["K"][:, None], disc.material["G"][:, None]  # per element
+        return float(np.sum(disc.weights * (0.5 * K * theta_e ** 2
+                                            + (2.0 / 3.0) * G * gamma_e ** 2)))
 
     # single-case shorthands (the solver of one problem)
     u = property(lambda self: self.case().u)

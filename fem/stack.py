@@ -9,14 +9,12 @@ become identity rows and columns. Every block is factorised with the same operat
 a case gives the same bits alone and inside any stack.
 """
 
-from types import SimpleNamespace
-
 import numpy as np
 from scipy.sparse import csr_matrix
 
 from cavex.fem.banded import solve_blocks
-from cavex.fem.constitutive import PointMaterial
 from cavex.fem.element import assemble_cases
+from cavex.fem.records import Assembly, Layout, PointResponse
 
 
 def ranges(starts, counts):
@@ -66,9 +64,7 @@ class Stack:
         for name in ("dNdR", "R_points", "weights", "force_weights", "R_dofs", "mass_band"):
             setattr(self, name, np.concatenate([getattr(d, name) for d in discs],
                                                axis=1 if name == "mass_band" else 0))
-        self.material = PointMaterial(**{name: np.concatenate([getattr(d.material, name)
-                                                               for d in discs])
-                                         for name in vars(d0.material)})
+        self.material = np.concatenate([d.material for d in discs])  # one record per element
         self.element_case = np.repeat(np.arange(k), self.el_count)
         self.dof_case = np.repeat(np.arange(k), self.dof_count)
         nnz = np.array([d.mass.nnz for d in discs])
@@ -97,6 +93,15 @@ class Stack:
         row_entries = ((p + fixed[None, :] - j) * n + j)[(j >= 0) & (j < n)]
         self.fixed_entries = np.concatenate([col_entries, row_entries])
         self.fixed_diagonal = p * n + fixed
+        self.layout = Layout(
+            element_dofs=self.element_dofs, dNdR=self.dNdR, N=self.N, R_points=self.R_points,
+            weights=self.weights, force_weights=self.force_weights, el_start=self.el_start,
+            el_count=self.el_count, dof_start=self.dof_start, dof_count=self.dof_count,
+            free=self.free, R_dofs=self.R_dofs, mass_band=self.mass_band,
+            fixed_entries=self.fixed_entries, fixed_diagonal=self.fixed_diagonal,
+            wall_indptr=self.wall_mass.indptr, wall_indices=self.wall_mass.indices,
+            wall_data=self.wall_mass.data, degree=int(p), pressure=self.pressure_control,
+            outer_fixed=bool(outer_fixed))
 
     def subset(self, cases):
         """``(stack, dof_map, element_map)`` of the cases ``cases`` (indices into this stack)."""
@@ -114,39 +119,35 @@ class Stack:
         return slice(self.el_start[c], self.el_start[c] + self.el_count[c])
 
     def new_buffers(self):
-        """Output arrays of :meth:`assemble`: ``(f, band, response, folded, force_scale)``."""
+        """Output arrays of :meth:`assemble`: an :class:`~cavex.fem.records.Assembly` and a
+        :class:`~cavex.fem.records.PointResponse`."""
         shape = self.R_points.shape
-        response = SimpleNamespace(tau_r=np.zeros(shape), tau_t=np.zeros(shape),
-                                   theta_p=np.zeros(shape), gamma_p=np.zeros(shape),
-                                   plastic=np.zeros(shape, dtype=bool),
-                                   yield_ratio=np.zeros(shape))
-        return (np.zeros(self.ndof), np.zeros((2 * self.degree + 1, self.ndof)), response,
-                np.zeros(self.n_cases, dtype=bool), np.zeros(self.n_cases))
+        return (Assembly(f=np.zeros(self.ndof), band=np.zeros((2 * self.degree + 1, self.ndof)),
+                         folded=np.zeros(self.n_cases, dtype=bool),
+                         force_scale=np.zeros(self.n_cases), Gr=np.zeros(shape),
+                         Gt=np.zeros(shape)),
+                PointResponse.zeros(shape))
 
     def assemble(self, u, theta_p, gamma_p, skip=None, out=None):
-        """``(f, band, response, folded, force_scale)`` at ``u`` for the start-of-step plastic
-        strains; cases with ``skip`` set keep the values they have in ``out`` (the previous
-        call's result, reused in place; new arrays when None)."""
+        """``(assembly, response)`` at ``u`` for the start-of-step plastic strains: the
+        :class:`~cavex.fem.records.Assembly` (``f, band, folded, force_scale``, gradients) and
+        the :class:`~cavex.fem.records.PointResponse`; cases with ``skip`` set keep the values
+        they have in ``out`` (the previous call's result, reused in place; new arrays when
+        None)."""
         if out is None:
             out = self.new_buffers()
         if skip is None:
             skip = np.zeros(self.n_cases, dtype=bool)
-        f, band, resp, folded, scale = out
+        assembly, response = out
         if skip.any():
             keep = ~skip[self.dof_case]
-            f[keep] = 0.0
-            band[:, keep] = 0.0
+            assembly.f[keep] = 0.0
+            assembly.band[:, keep] = 0.0
         else:
-            f[:] = 0.0
-            band[:] = 0.0
-        m = self.material
-        if not hasattr(self, "_gradients"):
-            self._gradients = (np.zeros(self.R_points.shape), np.zeros(self.R_points.shape))
-        assemble_cases(u, *self._gradients, self.element_dofs, self.dNdR, self.N, self.R_points,
-                       self.weights, self.force_weights, m.K, m.G, m.lam, m.tau, m.lam_psi,
-                       m.tension, m.cap, theta_p, gamma_p, self.el_start, self.el_count, skip,
-                       self.degree, f, band, resp.tau_r, resp.tau_t, resp.theta_p,
-                       resp.gamma_p, resp.plastic, resp.yield_ratio, folded, scale)
+            assembly.f[:] = 0.0
+            assembly.band[:] = 0.0
+        assemble_cases(u, tuple(self.layout), self.material, theta_p, gamma_p, skip,
+                       tuple(assembly), tuple(response))
         return out
 
     def per_case_all(self, dof_flags):

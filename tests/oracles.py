@@ -61,7 +61,8 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat, groups=None):
         Total logarithmic strains at the points.
     theta_p, gamma_p : ndarray
         Plastic volumetric and deviatoric log strains at the start of the step.
-    mat : PointMaterial
+    mat : record array of :data:`cavex.fem.material_records.MATERIAL`
+        Broadcast to the points, with attribute access (``mat.K``).
     groups : ndarray of int, optional
         Group (independent model, e.g. one case of a batch) of every point. The Mohr-Coulomb-
         only return is used for all points unless some point needs the multi-surface one;
@@ -236,7 +237,9 @@ def assemble_forms(disc, u, theta_p, gamma_p):
     numpy return map (radial dof order, LAPACK band storage)."""
     field = disc.basis.interpolate(to_skfem(disc, u))
     g_r, g_t = field.grad[0], np.asarray(field) / disc.R_points
-    resp = hencky_mohr_coulomb(np.log1p(g_r), np.log1p(g_t), theta_p, gamma_p, disc.material)
+    # one material record per element, at every point
+    points = np.broadcast_to(disc.material[:, None], g_r.shape).view(np.recarray)
+    resp = hencky_mohr_coulomb(np.log1p(g_r), np.log1p(g_t), theta_p, gamma_p, points)
     fields = {"lam_r": 1.0 + g_r, "lam_t": 1.0 + g_t, "tau_r": resp.tau_r, "tau_t": resp.tau_t}
     f = np.empty(disc.ndof)
     f[disc.radial] = asm(internal_force, disc.basis, **fields)

@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 import pytest
-from fem_helpers import advance, return_map
+from fem_helpers import advance, point_material, return_map
 from scipy.optimize import brentq
 from skfem import MeshLine
 
@@ -29,7 +29,6 @@ from cavex.analytic.concrete_cavity import ConcreteCavity, solve
 from cavex.config import default_config_text, parse_target, target_table
 from cavex.errors import CavexInputError
 from cavex.fem import expand_cavity
-from cavex.fem.constitutive import PointMaterial
 from cavex.fem.discretisation import Discretisation
 from cavex.fem.fields import wall_stress
 from cavex.fem.solver import RadialSolver
@@ -85,7 +84,7 @@ def test_cap_return_satisfies_kuhn_tucker_and_its_tangent_is_exact(dilatancy):
     layers = [Material(E=E_C, nu=0.2, rho=RHO, lam=1.525, sigma_c=FC, tau_max=3.0 * FC,
                        tensile_strength=4e6),
               Material(E=E_C, nu=0.3, rho=RHO, lam=0.6, sigma_c=FC, tau_max=1.2 * FC)]
-    m = PointMaterial.from_layers(layers, rng.integers(0, 2, n), dilatancy)
+    m = point_material(layers, rng.integers(0, 2, n), dilatancy)
     eps_r, eps_t, theta_p, gamma_p = _random_points(rng, n, m)
     out = return_map(eps_r, eps_t, theta_p, gamma_p, m)
     theta, gamma = eps_r + 2 * eps_t, eps_r - eps_t

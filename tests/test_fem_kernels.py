@@ -11,11 +11,10 @@ measured <= 1.1e-15 of the largest entry (P1 and P2): bound 1e-12.
 
 import numpy as np
 import pytest
-from fem_helpers import advance, return_map
+from fem_helpers import advance, point_material, return_map
 from oracles import assemble_forms, hencky_mohr_coulomb
 
 from cavex import load_config
-from cavex.fem.constitutive import PointMaterial
 from cavex.fem.expansion import build_model
 from cavex.fem.settings import Numerics
 from cavex.fem.solver import RadialSolver
@@ -39,7 +38,7 @@ def random_points(rng, n, material):
 def test_point_kernel_equals_the_numpy_return_map(dilatancy, cutoff):
     rng = np.random.default_rng(7)
     n = 200_000
-    material = PointMaterial.from_layers(LAYERS, rng.integers(0, 3, n), dilatancy, cutoff)
+    material = point_material(LAYERS, rng.integers(0, 3, n), dilatancy, cutoff)
     eps_r, eps_t, theta_p, gamma_p = random_points(rng, n, material)
     kernel = return_map(eps_r, eps_t, theta_p, gamma_p, material)
     # each point its own group: the oracle chooses the multi-surface return per point, as the
@@ -99,8 +98,8 @@ def test_element_kernel_equals_the_scikit_fem_forms():
         one = solver.case()
         rng = np.random.default_rng(3)
         u = one.u * (1.0 + 0.01 * rng.normal(size=one.u.size))  # a Newton iterate
-        f, band, resp, folded, _ = solver.stack.assemble(u, one.state["theta_p"],
-                                                         one.state["gamma_p"])
+        assembly, resp = solver.stack.assemble(u, one.state["theta_p"], one.state["gamma_p"])
+        f, band, folded = assembly.f, assembly.band, assembly.folded
         f_ref, band_ref, resp_ref = assemble_forms(disc, u, one.state["theta_p"],
                                                    one.state["gamma_p"])
         assert not folded[0] and resp_ref.plastic.any() and not resp_ref.plastic.all()
