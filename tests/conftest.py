@@ -14,11 +14,8 @@ import shutil
 import tempfile
 
 import pytest
-from libm_noise import install as install_libm_noise
 
-install_libm_noise()  # CAVEX_TEST_LIBM_NOISE: a model of another CPU's libm (libm_noise.py)
-
-from cavex.verification.fedata.table_cache import CACHE_ENV  # noqa: E402
+from cavex.verification.fedata.table_cache import CACHE_ENV
 
 _SESSION_CACHE = tempfile.mkdtemp(prefix="cavex-test-cache-")
 os.environ[CACHE_ENV] = _SESSION_CACHE
