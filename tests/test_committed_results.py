@@ -8,10 +8,10 @@ differently on some arguments; the model here multiplies each force evaluation b
 seed. The trajectory rows sit at the integrator's steps, so their positions move with it (the
 spreads and the quanta they set: verification/output/number_format.py).
 
-Measured (16 seeds; tests/test_committed_results.py's model): with 6 significant digits
-everywhere 43 trajectory values changed (29 velocities near the stop of the derived model's
-first layer, the 0.952771 against 0.95264 m/s another CPU wrote); with the quanta of
-``TRAJECTORY_QUANTA`` none did, except in one file:
+Measured (16 seeds of this model): with 6 significant digits everywhere 40 values of the
+three other trajectory files changed (29 velocities near the stop of the derived model's first
+layer, the 0.952771 against 0.95264 m/s another CPU wrote; 9 of the paper model's first layer;
+2 times); with the quanta of ``TRAJECTORY_QUANTA`` none did. One file is not reproducible:
 
 - ``results/penetration_paper/trajectory_runway.csv`` is not reproducible this way: in 15 of the
   16 seeds its number of rows changes (phase ``Eq. 21 (b)`` takes 12 to 16 steps: the short
