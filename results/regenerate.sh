@@ -11,6 +11,13 @@
 #   NUMBA_CACHE_DIR=$(mktemp -d) CAVEX_CACHE_DIR=$(mktemp -d) bash results/regenerate.sh
 # (2026-11-26, numpy 2.4.6 on an AVX-512 machine, 27 min: every file byte-identical but one
 # 6th digit of results/concrete/grid_depths.csv, since written with 4; docs/concrete.md)
+# The emulation leaves Python's scalar libm (math.exp, math.log ...) as it is, which the 1-D
+# penetration runs on: it rewrote results/penetration* byte for byte (2026-11-27), yet another
+# CPU changed their velocities near the stop. tests/test_committed_results.py reruns them under
+# a model of another libm (1-ulp changes of the force); the trajectory CSVs are written
+# to the quanta number_format.TRAJECTORY_QUANTA sets from that spread. Its rows are the
+# integrator's steps: results/penetration_paper/trajectory_runway.csv changes its number of rows
+# under that model (a short phase's first step), and may still differ on another CPU.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cavex penetrate --out results/penetration > results/penetration/summary.txt

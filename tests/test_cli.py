@@ -22,6 +22,7 @@ from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.config import default_config_text, load_config
 from cavex.verification.cli import main
+from cavex.verification.output.number_format import TRAJECTORY_QUANTA
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 TRAJECTORY_COLUMNS = ["t_s", "depth_m", "velocity_m_s", "deceleration_m_s2", "phase"]
@@ -90,8 +91,10 @@ def test_penetrate_json_outputs_and_files(capsys, tmp_path, default):
     assert len(rows) == len(trajectory.t)
     columns = list(zip(*rows, strict=True))
     for name, column in zip(header, columns, strict=True):
+        quantum = TRAJECTORY_QUANTA.get(name)  # the coarser of 6 digits and this (number_format)
+        half = 0.0 if quantum is None else 0.5 * 10.0 ** -int(quantum) * (1 + 1e-6)
         assert [float(v) for v in column] == pytest.approx(
-            list(trajectory.as_columns()[name]), rel=CSV_ROUNDING, abs=0.0)
+            list(trajectory.as_columns()[name]), rel=CSV_ROUNDING, abs=half)
     header, rows = _read_csv(out_dir / "trajectory_first_layer_only.csv")
     assert header == TRAJECTORY_COLUMNS and len(rows) > 10
     assert float(rows[-1][2]) == 0.0  # velocity at the stop

@@ -83,18 +83,19 @@ def _work_mismatch(result):
 def test_held_work_is_the_kinetic_energy_lost(default):
     """Force, moment and power of the held kernel agree: the work of the surface forces
     equals the kinetic energy lost, to the integrator's global error: friction 0.1, spin,
-    attack out of plane, concrete alone, plain law, at rtol 1e-3 and 1e-5 (measured 3.4e-5,
-    4.9e-5; 5.8e-5 at 1e-4: flat, where the ramp's falls from 6.5e-4 to 5.6e-5,
-    tests/test_oblique.py), and the debonded runway at rtol 1e-3 (the zones open; 5.6e-7).
-    Bound: 4 x the largest measured, 2e-4."""
+    attack out of plane, concrete alone, plain law, at rtol 1e-3 and 1e-4 (measured 3.4e-5,
+    5.8e-5; 4.9e-5 at 1e-5, which this test ran before at a tenth of the suite's summed
+    durations: flat, where the ramp's falls from 6.5e-4 to 5.6e-5, tests/test_oblique.py),
+    and the debonded runway at rtol 1e-3 (the zones open; 5.6e-7). Bound: 4 x the largest
+    measured, 2e-4."""
     target, projectile = default
     strike = Strike(700.0, 30.0, attack=3.0, attack_plane=40.0, spin=500.0)
     runs = [fly(target.single(0), replace(projectile, mu=0.1), strike, "law", law_A=2e8,
                 law_B=2500.0, contact_hold=1e-6, rtol=rtol, atol=1e-3 * rtol)
-            for rtol in (1e-3, 1e-5)]
+            for rtol in (1e-3, 1e-4)]
     debonded = fly(target.with_interfaces("debonded"), projectile, strike, contact_hold=1e-6)
     mismatch = [_work_mismatch(r) for r in (*runs, debonded)]
-    print("work-energy mismatch (friction 1e-3, 1e-5; debonded):", mismatch)
+    print("work-energy mismatch (friction 1e-3, 1e-4; debonded):", mismatch)
     assert abs(runs[0].history["yaw_deg"]).max() > 0.1  # a genuinely 3-D shot
     assert len(debonded.model.opened) >= 2
     assert all(abs(m) < 2e-4 for m in mismatch)

@@ -326,18 +326,23 @@ def test_debonded_shot_mirrors_to_the_last_bit(debonded):
 def test_debonded_work_is_the_kinetic_energy_lost(debonded):
     """The zones switch the load at events, not inside a step: the work of the surface
     forces still balances the kinetic energy lost, to the integrator's global error (the
-    bonded bound of tests/test_oblique.py at rtol 1e-5: 5e-4)."""
+    bonded bound of tests/test_oblique.py at rtol 1e-5: 5e-4), and the mismatch falls with the
+    tolerance: measured 4.2e-6 and 1.2e-7 at rtol 1e-3 and 1e-4 (5 s and 28 s of CPU; rtol
+    1e-5, which this test ran before, took 22 % of the suite's summed durations)."""
     from cavex.analytic.models import fly
     from cavex.analytic.penetration.oblique import Strike
 
     target, projectile = debonded
-    result = fly(target, projectile, Strike(700.0, 30.0, attack=3.0, attack_plane=40.0,
-                                            spin=500.0), rtol=1e-5, atol=1e-8)
-    assert len(result.model.opened) >= 2
-    y0, y1 = result.solutions[0].y[:, 0], result.solutions[-1].y[:, -1]
-    mismatch = -y1[13] / (result.model.energy(y0) - result.model.energy(y1)) - 1.0
-    print("work-energy mismatch:", mismatch)
-    assert abs(mismatch) < 5e-4
+    mismatch = []
+    for rtol in (1e-3, 1e-4):
+        result = fly(target, projectile, Strike(700.0, 30.0, attack=3.0, attack_plane=40.0,
+                                                spin=500.0), rtol=rtol, atol=1e-3 * rtol)
+        assert len(result.model.opened) >= 2
+        y0, y1 = result.solutions[0].y[:, 0], result.solutions[-1].y[:, -1]
+        mismatch.append(-y1[13] / (result.model.energy(y0) - result.model.energy(y1)) - 1.0)
+    print("work-energy mismatch at rtol 1e-3, 1e-4:", mismatch)
+    assert all(abs(m) < 5e-4 for m in mismatch)
+    assert abs(mismatch[1]) < abs(mismatch[0])
 
 
 def test_trajectory_json_peaks_and_pitch_change_per_phase(capsys, tmp_path):

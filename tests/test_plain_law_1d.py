@@ -18,6 +18,20 @@ Measured on this machine (the numbers the tolerances below rest on):
 - 1-D against the 3-D model at normal incidence (same rings, same law; the 3-D stops at 1e-6 of
   its kinetic energy, 1 m/s, and the travel left, 1.07e-5 m, is added): 3-D defaults
   (rtol 1e-3) -5.4e-4; rtol 1e-6 with 16 and 32 azimuths -1.2e-7 and -3.9e-7.
+
+Across CPUs: another x86-64 CPU (AVX-512) measured 4e-9 and 3.6e-12 where this one measured
+1.7e-11 and 2.8e-14 (the tolerances were then 1e-9 and 1e-12). The model of another CPU's libm
+in tests/test_committed_results.py (each force evaluation times ``1 + k eps``, ``k`` in -1, 0, +1
+by a hash of its arguments), 12 seeds, with the integrator's tolerance also at 2e-9 and 5e-10,
+reproduces both: the largest spreads are
+
+- two layers of one law against one, no crater: end time 4.0e-9, depth 2.5e-10 (with the
+  crater 3.4e-11, 6.3e-11; the runway under one global law 6.5e-11): ``SAME_RUN_TOL`` = 4e-8,
+  ten times the largest;
+- the runway against the run stopped at every jump: 2.7e-8, 9.3e-10, 6.6e-12 at rtol 1e-9,
+  1e-11, 1e-13 (the last is the force's round-off carried through some 10^4 steps);
+- Forrestal's crater exit velocity and depth: 1.7e-13 and 4.1e-12 (no seed changed them by
+  more than 1e-14).
 """
 
 import json
@@ -49,6 +63,7 @@ NAMES = ("concrete", "macadam", "soil")  # the default runway's layers
 LAWS = [(20.0, 1.0), (12.0, 1.2), (8.0, 1.5)]  # Forrestal-like S for concrete, then softer
 RTOL = 1e-9  # the 1-D integrator's relative tolerance (integrator.RTOL)
 EVENT_DEPTH_TOL = 1e-9  # m: phase ends located by brentq, as in test_penetration
+SAME_RUN_TOL = 4e-8  # two runs of the same physics at RTOL: 10x the largest spread (docstring)
 EPS = np.finfo(float).eps
 
 
@@ -164,7 +179,8 @@ def test_one_layer_with_crater_is_forrestals_closed_form(runway, crater):
 def test_two_layers_of_one_law_are_one_layer(runway, crater):
     """The same material and law in two layers: the same force everywhere, so the same
     trajectory to the integrator's tolerance (the two-layer run restarts at its phase ends);
-    its phases are per layer."""
+    its phases are per layer. Within ``SAME_RUN_TOL``: the two runs take different steps, and
+    where those steps land moves across CPUs (largest spread 4.0e-9, the no-crater end time)."""
     target, projectile = runway
     concrete = target.layers[0]
     two = Target((replace(concrete, name="upper"), replace(concrete, name="lower")), (0.3,),
@@ -173,8 +189,8 @@ def test_two_layers_of_one_law_are_one_layer(runway, crater):
     a = penetrate(two, projectile, PlainLawResistance(two, projectile), crater=crater)
     b = penetrate(one, projectile, PlainLawResistance(one, projectile), crater=crater)
     print(crater, a.depth[-1] / b.depth[-1] - 1.0, a.t[-1] / b.t[-1] - 1.0)
-    assert a.depth[-1] == pytest.approx(b.depth[-1], rel=RTOL)
-    assert a.t[-1] == pytest.approx(b.t[-1], rel=RTOL)
+    assert a.depth[-1] == pytest.approx(b.depth[-1], rel=SAME_RUN_TOL)
+    assert a.t[-1] == pytest.approx(b.t[-1], rel=SAME_RUN_TOL)
     labels = [p.label for p in a.phases if p.stage == "tunnel"]
     assert labels[-3:] == ["upper (law)", "upper + lower (law)", "lower (law)"]
 
@@ -191,7 +207,7 @@ def test_runway_under_one_global_law_is_its_first_layer(runway):
                   plain_laws=[(A / m.tau, B / m.rho) for m in target.layers])
     keys = penetrate(same, projectile, PlainLawResistance(same, projectile))
     for run in (whole, keys):
-        assert run.depth[-1] == pytest.approx(first.depth[-1], rel=RTOL)
+        assert run.depth[-1] == pytest.approx(first.depth[-1], rel=SAME_RUN_TOL)
     assert [p.label for p in whole.phases][-2:] == ["macadam + soil (law)", "soil (law)"]
 
 
@@ -254,13 +270,14 @@ def _stopped_at_every_jump(resistance, projectile, rtol):
 def test_integrator_steps_end_at_the_force_jumps(runway):
     """The integrator lands a step on every ring crossing (``force_jumps``), so that the
     tolerance governs: against the reference stopped at every jump the run converges with
-    the tolerance (measured 1.0e-8, 7.4e-10, 2.8e-14 at rtol 1e-9, 1e-11, 1e-13: bounds 1e-7,
-    1e-8, 1e-12, ten times the measured), and the default is within 1e-6 (the 6 significant
+    the tolerance (measured 1.0e-8, 7.4e-10, 2.8e-14 at rtol 1e-9, 1e-11, 1e-13; across CPUs,
+    modelled: 2.7e-8, 9.3e-10, 6.6e-12: bounds 3e-7, 1e-8, 7e-11, ten times the largest),
+    and the default is within 1e-6 (the 6 significant
     digits written; measured 1.0e-7) of the run at rtol 1e-13."""
     target, projectile = runway
     resistance = PlainLawResistance(target, projectile)
     depths = {}
-    for rtol, bound in ((1e-9, 1e-7), (1e-11, 1e-8), (1e-13, 1e-12)):
+    for rtol, bound in ((1e-9, 3e-7), (1e-11, 1e-8), (1e-13, 7e-11)):
         run = penetrate(target, projectile, resistance, crater=None, rtol=rtol,
                         atol=rtol * 1e-3)
         reference = _stopped_at_every_jump(resistance, projectile, rtol)

@@ -22,6 +22,7 @@ from cavex.verification.commands.options import (
 )
 from cavex.verification.commands.shared_options import add_config_option, add_figures_option
 from cavex.verification.output.files import write_columns_csv
+from cavex.verification.output.number_format import TRAJECTORY_QUANTA
 from cavex.verification.output.paths import check_output_dir, write_staged
 from cavex.verification.studies.table2 import not_reproduced_line, table2_comparison
 
@@ -181,7 +182,8 @@ def write_outputs(job, out_dir, draw=True):
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, trajectory in job["runs"].items():
-        written.append(write_columns_csv(out / f"trajectory_{name}.csv", trajectory.as_columns()))
+        written.append(write_columns_csv(out / f"trajectory_{name}.csv", trajectory.as_columns(),
+                                         TRAJECTORY_QUANTA))
     rows = phases_as_dicts(job["runs"]["runway"])
     if not job["debonded"]:  # the stage column only where there is more than one tunnel
         rows = [{k: v for k, v in row.items() if k != "stage"} for row in rows]

@@ -27,15 +27,17 @@ def write_text_atomic(path, text, durable=True):
     os.replace(tmp, path)
 
 
-def write_columns_csv(path, columns):
+def write_columns_csv(path, columns, quanta=None):
     """``columns`` (name -> sequence) as CSV, atomically, every number through
-    :func:`~cavex.verification.output.number_format.format_number`; returns ``path``."""
+    :func:`~cavex.verification.output.number_format.format_number`, with the absolute quantum
+    ``quanta[name]`` where given; returns ``path``."""
     from cavex.verification.output.number_format import format_number
 
     text = io.StringIO(newline="")
     writer = csv.writer(text)
     writer.writerow(columns)
-    writer.writerows([format_number(x) for x in row]
+    column_quanta = [(quanta or {}).get(name) for name in columns]
+    writer.writerows([format_number(x, quantum=q) for x, q in zip(row, column_quanta, strict=True)]
                      for row in zip(*columns.values(), strict=True))
     write_text_atomic(path, text.getvalue())
     return path

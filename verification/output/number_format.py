@@ -42,6 +42,17 @@ justification each:
 - other relative differences against FE (``relative_difference_*``): 6, the FE's digits.
 - any other float variable: 6 (unknown provenance, treated as FE output).
 
+Trajectory CSVs of ``cavex penetrate`` (:data:`TRAJECTORY_QUANTA`): a row sits at a step of the
+integrator, and where that step lands is not reproducible: a 1-ulp change of the force (a model of
+another CPU's libm: each force evaluation times ``1 + k eps``, ``k`` in -1, 0, +1 by a hash of its
+arguments, 16 seeds; tests/test_committed_results.py) moves the steps near the stop by up to
+5.8e-9 s (1.6e-6 relative) and so the velocity there by ``a dt``, up to 9.3e-4 m/s (at
+0.95 m/s: 1e-3 relative, the 0.952771 against 0.95264 m/s that another CPU wrote). Such a
+column is written to the coarser of :data:`TRAJECTORY_DIGITS` significant digits and an absolute
+quantum that is 10 or more of those spreads wide: ``t_s`` 1e-7 s (17 spreads), ``velocity_m_s``
+1e-2 m/s (10 spreads; 1e-3 m/s changed 10 values in the 16 seeds, 1e-2 none). Depth and
+deceleration keep 6 digits (spreads 5e-8 m, 4e-8 relative: none changed).
+
 Coordinates (velocity, depth) are inputs, not results, and are never rounded (the switch nodes
 sit 1e-9 m past the switch depths); integer, boolean and string variables are written as they
 are.
@@ -77,6 +88,10 @@ class Decimals(int):
 
 
 ESTIMATE = Decimals(ESTIMATE_DECIMALS)
+
+# Absolute quanta of ``cavex penetrate``'s trajectory columns (module docstring): each such value
+# is written to the coarser of TRAJECTORY_DIGITS significant digits and this quantum.
+TRAJECTORY_QUANTA = {"t_s": Decimals(7), "velocity_m_s": Decimals(2)}
 
 # (variable-name pattern, significant digits, Decimals or KEPT); the first matching pattern
 # decides.
@@ -146,14 +161,28 @@ def round_rule(values, rule):
     return round_significant(values, rule)
 
 
-def format_number(value, digits=TRAJECTORY_DIGITS):
+def format_number(value, digits=TRAJECTORY_DIGITS, quantum=None):
     """Text of one value for a CSV cell: floats with ``digits`` significant digits (``%g``
-    style), integers, booleans and strings as they are."""
+    style), or, with ``quantum`` (a :class:`Decimals` ``n``), to the coarser of those digits
+    and the absolute quantum ``10**-n`` (for a quantity whose spread is absolute: near zero it
+    keeps no digit the numerics do not support); integers, booleans and strings as they are."""
     if isinstance(value, (str, bool, np.bool_, numbers.Integral)):
         return str(value)
     if isinstance(value, numbers.Real):
-        return format(float(value), f".{digits}g")
+        x = float(value)
+        if quantum is not None and np.isfinite(x) and _finer_than(x, digits, int(quantum)):
+            x = round_decimals(x, int(quantum))
+        return format(x, f".{digits}g")
     return str(value)
+
+
+def _finer_than(x, digits, decimals):
+    """Whether the last of ``digits`` significant digits of ``x`` is finer than ``10**-decimals``
+    (from the decimal exponent of the correctly rounded text, no libm)."""
+    if x == 0.0:
+        return False
+    exponent = int(format(x, f".{digits - 1}e").rsplit("e", 1)[1])
+    return exponent - (digits - 1) < -decimals
 
 
 def round_nested(value, digits=TRAJECTORY_DIGITS):
