@@ -9,6 +9,11 @@ from cavex.analytic.models.registry import Model, register
 
 class Concrete(Model):
     name = "concrete"
+    report_words = ("the concrete cavity-expansion model (docs/concrete.md): Mohr-Coulomb "
+                    "capped at 7 f_c, radial cracking, compaction to lock-up, every constant "
+                    "published (none fitted to shots), its own crater (Li and Chen 2003); it does "
+                    "not use the mapping below")
+    recommendation_reason = "uncalibrated, every constant published, none fitted to shots"
     predicts_shots = True
     prediction_seconds = 6.3e-3  # the integrator a shot, besides its table (docs/concrete.md)
     # one concrete's table of 33 cavity solutions: docs/concrete.md measured 15 s for the 96

@@ -9,6 +9,8 @@ from cavex.analytic.models.registry import Model, register
 
 class Derived(Model):
     name = "derived"
+    report_words = ("cavex's incompressible closed forms with the penetration integrator "
+                    "(crater 4.5 r from the nose base)")
     help = "the derived closed form (--boundary)"
     flies = flies_3d = closed_form = predicts_shots = fits_mapping = True
     boundaries = ("quasi-static", "dynamic")  # the order of its labels

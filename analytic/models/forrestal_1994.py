@@ -6,6 +6,9 @@ from cavex.analytic.models.registry import Model, register
 
 class Forrestal1994(Model):
     name = "forrestal-1994"
+    report_words = ("S = 82.6 f_c^-0.544 (f_c in MPa), crater of two calibres (Forrestal "
+                    "et al. 1994). Forrestal et al. fitted S to their own shots, so on their data "
+                    "it is not an out-of-sample prediction")
     predicts_shots = True
     prediction_seconds = 0.0
 

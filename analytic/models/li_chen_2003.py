@@ -6,6 +6,8 @@ from cavex.analytic.models.registry import Model, register
 
 class LiChen2003(Model):
     name = "li-chen-2003"
+    report_words = ("S = 72 f_c^-0.5 (f_c in MPa), crater 0.707 + h/d calibres (Li and Chen "
+                    "2003, fitted by them to published shots)")
     predicts_shots = True
     prediction_seconds = 0.0
 

@@ -16,6 +16,11 @@ SPLIT_STRENGTH = 100e6
 
 class LiChenConcrete(Model):
     name = "li-chen-concrete"
+    report_words = ("`li-chen-2003` for f_c <= 100 MPa, `concrete` above (no constant "
+                    "fitted; the split chosen on the development shots, docs/validation.md)")
+    recommendation_reason = ("`li-chen-2003` at normal strength, f_c <= 100 MPa, `concrete` "
+                             "above, each where it is the better on the development shots; "
+                             "no constant fitted by cavex")
     predicts_shots = recommended = True
     parts = ("li-chen-2003", "concrete")  # below and above SPLIT_STRENGTH
     prediction_seconds = 6.3e-3

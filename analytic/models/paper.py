@@ -6,6 +6,8 @@ from cavex.analytic.models.registry import Model, register
 
 class Paper(Model):
     name = "paper"
+    report_words = ("cavex's incompressible closed forms with the penetration integrator "
+                    "(crater 4.5 r from the nose base)")
     help = "the paper's printed model"
     flies = flies_3d = closed_form = predicts_shots = fits_mapping = True
     default_boundary = "quasi-static"  # its own, and no other

@@ -67,6 +67,11 @@ class Model:
         ``cavex validate``'s recommended model (one model has it).
     parts : tuple of str
         A model that predicts each shot with one of these models (:meth:`part`).
+    report_words : str
+        What the model is, for ``validate``'s report (``{nu}`` is the mapping's Poisson's
+        ratio); consecutive models with the same words share one line.
+    recommendation_reason : str
+        Why the model is recommended, in words, where it is.
     prediction_seconds, concrete_table_seconds : float
         Time of one shot's prediction, and of one concrete's cavity table where the model
         needs one (``validate``'s run estimate).
@@ -81,6 +86,8 @@ class Model:
     takes_table = takes_epsilon = takes_law = False
     first_layer = None
     recommended = False
+    report_words = ""
+    recommendation_reason = "uncalibrated, no constant fitted to the shots"
     parts = ()
     prediction_seconds = 2.5e-3  # a closed form, measured on the development shots
     concrete_table_seconds = 0.0

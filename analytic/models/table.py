@@ -11,6 +11,8 @@ from cavex.errors import require
 
 class Table(Model):
     name = "table"
+    report_words = ("the FE-tabulated resistance, compressible (nu = {nu:g}) and "
+                    "finite-strain, one FE table per distinct target")
     help = "an FE table (--table)"
     flies = flies_3d = predicts_shots = fits_mapping = True
     takes_table = True

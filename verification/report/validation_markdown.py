@@ -7,7 +7,8 @@ from the shots."""
 
 import numpy as np
 
-from cavex.verification.validation.predict import CONCRETE, EMPIRICAL, FE_MODEL, LI_CHEN, SPLIT
+from cavex.analytic.models import get, models
+from cavex.verification.validation.predict import EMPIRICAL, FE_MODEL
 from cavex.verification.validation.regimes import NON_RIGID, REGIME_TITLES
 
 
@@ -37,11 +38,20 @@ def verdict(summary, calibrations):
             f"{EMPIRICAL}'s {empirical:.4f}")
 
 
-#: why a model is recommended, in words (:func:`recommendation`)
-RECOMMENDATION_REASONS = {
-    SPLIT: f"`{LI_CHEN}` at normal strength, f_c <= 100 MPa, `{CONCRETE}` above, each where "
-           "it is the better on the development shots; no constant fitted by cavex",
-    CONCRETE: "uncalibrated, every constant published, none fitted to shots"}
+def model_lines(mapping):
+    """The report's list of the models, in the registry's words (``report_words``; the models
+    that share words share a line; ``nu``: the mapping's Poisson's ratio)."""
+    groups = []  # [labels, words, recommended]
+    for model in models(predicts_shots=True):
+        words = (model.report_words or model.help or "a registered model").format(
+            nu=mapping["nu"])
+        if groups and groups[-1][1] == words:
+            groups[-1][0].extend(model.labels())
+        else:
+            groups.append([list(model.labels()), words, model.recommended])
+    return [f"- {', '.join(f'`{label}`' for label in labels)}"
+            + (" (recommended)" if recommended else "") + f": {words};"
+            for labels, words, recommended in groups]
 
 
 def recommendation(model, summary):
@@ -50,7 +60,7 @@ def recommendation(model, summary):
     ours = summary.get(model, {}).get("mean_abs_log_ratio")
     if ours is None:
         return None
-    why = RECOMMENDATION_REASONS.get(model, "uncalibrated, no constant fitted to the shots")
+    why = get(model).recommendation_reason
     sentence = (f"Recommended model: `{model}` ({why}; docs/validation.md); on these "
                 f"{summary[model]['n']} shots its mean abs ln ratio is {ours:.4f}")
     empirical = summary.get(EMPIRICAL, {}).get("mean_abs_log_ratio")
@@ -98,22 +108,7 @@ def report_markdown(result, figures=True):
     lines += [f"Shots: `{info['path']}`, {info['n']} shots. Its header:", ""]
     lines += [f"> {c}" for c in info["comments"]] + [""]
     lines += ["## Models", "",
-              "- `derived-quasi-static`, `derived-dynamic`, `paper`: cavex's incompressible "
-              "closed forms with the penetration integrator (crater 4.5 r from the nose base);",
-              f"- `{FE_MODEL}`: the FE-tabulated resistance, compressible (nu = "
-              f"{mapping['nu']:g}) and finite-strain, one FE table per distinct target;",
-              f"- `{CONCRETE}`: the concrete cavity-expansion model (docs/concrete.md): "
-              "Mohr-Coulomb capped at 7 f_c, radial cracking, compaction to lock-up, every "
-              "constant published (none fitted to shots), its own crater (Li and Chen 2003); "
-              "it does not use the mapping below;",
-              f"- `{LI_CHEN}`: S = 72 f_c^-0.5 (f_c in MPa), crater 0.707 + h/d calibres "
-              "(Li and Chen 2003, fitted by them to published shots);",
-              f"- `{SPLIT}` (recommended): `{LI_CHEN}` for f_c <= 100 MPa, `{CONCRETE}` "
-              "above (no constant fitted; the split chosen on the development shots, "
-              "docs/validation.md);",
-              f"- `{EMPIRICAL}`: S = 82.6 f_c^-0.544 (f_c in MPa), crater of two calibres "
-              "(Forrestal et al. 1994). Forrestal et al. fitted S to their own shots, so on "
-              "their data it is not an out-of-sample prediction;",
+              *model_lines(mapping),
               "- `<model> calibrated`: the model with the fitted mapping of a calibration file.",
               "",
               "Uncalibrated mapping (docs/validation.md): lam = "
