@@ -41,6 +41,7 @@ from cavex.netcdf3 import PlainDataset
 
 COMMITTED = "results/verification/grid.nc"
 LEVELS = 3  # coarsenings of the committed table per axis
+FITTED = 3  # the rate is fitted to the finest three changes (four levels)
 
 
 def midpoints(x):
@@ -126,11 +127,18 @@ def study(target, projectile, tables_by_axis):
                          "estimate_m": estimate["estimate_m"]})
         depths = [r["final_depth_m"] for r in rows]
         changes = np.abs(np.diff(depths))  # |d(2h) - d(h)|, finest pair first
-        h = 2.0 ** np.arange(changes.size)
-        rate = (float(np.polyfit(np.log(h), np.log(changes), 1)[0]) if changes.size >= 2
-                and np.all(changes > 0) else None)
-        result[axis] = {"rows": rows, "rate": rate, "changes_m": changes.tolist()}
+        result[axis] = {"rows": rows, "rate": fitted_rate(changes[:FITTED]),
+                        "local_rates": np.log2(changes[1:] / changes[:-1]).tolist(),
+                        "changes_m": changes.tolist()}
     return result
+
+
+def fitted_rate(changes):
+    """``p`` of ``|d(2h) - d(h)| = C h^p`` by ``np.polyfit`` in log-log (finest first)."""
+    h = 2.0 ** np.arange(changes.size)
+    if changes.size < 2 or not np.all(changes > 0):
+        return None
+    return float(np.polyfit(np.log(h), np.log(changes), 1)[0])
 
 
 def markdown(result):
@@ -150,9 +158,11 @@ def markdown(result):
     lines.append("")
     for axis, r in result.items():
         rate = "n/a" if r["rate"] is None else f"{r['rate']:.2f}"
+        local = ", ".join(f"{p:.2f}" for p in r["local_rates"])
         lines.append(f"- {axis}: changes |d(2h) - d(h)| = "
                      f"{', '.join(f'{c:.2e}' for c in r['changes_m'])} m (finest first); "
-                     f"fitted rate {rate}")
+                     f"rate fitted to the finest {FITTED} changes {rate}; local rates "
+                     f"log2 of successive ratios {local}")
     return "\n".join(lines)
 
 

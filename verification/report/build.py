@@ -190,10 +190,11 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     ----------
     target, projectile : Target, Projectile
     quick : bool
-        A small grid (3 velocities x 4 depths from the crater's end to past the last switch
+        A small grid (5 velocities x 4 depths from the crater's end to past the last switch
         depth, :func:`quick_axes`, plus the table's switch depths) at half the FE resolution and
         without refinement, instead of the default (11 velocities 0-1200 m/s x 36 depths, plus
-        the switch depths).
+        the switch depths); its first conclusion line names its FE-table shot as the quick
+        one, with the table's interpolation-error estimate (:func:`table_interpolation_error`).
     out_dir : str or path
         Output folder (created).
     scheduler, workers
@@ -219,7 +220,8 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     dict
         ``out_dir``, ``files``, ``quick``, ``cells``, ``failed``, ``wall_time_s``,
         ``table_wall_time_s``, ``created`` (the FE table's creation time), ``conclusions``
-        (list of str), ``picture`` (message), ``stats``. The wall times and the creation time
+        (list of str), ``picture`` (message), ``stats``, ``table_interpolation_error`` (the
+        FE-table shot's estimate, :func:`table_interpolation_error`; None without that shot). The wall times and the creation time
         are not written into any file (they would differ on every run).
     """
     started = time.perf_counter()
