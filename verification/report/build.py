@@ -221,8 +221,9 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
         ``out_dir``, ``files``, ``quick``, ``cells``, ``failed``, ``wall_time_s``,
         ``table_wall_time_s``, ``created`` (the FE table's creation time), ``conclusions``
         (list of str), ``picture`` (message), ``stats``, ``table_interpolation_error`` (the
-        FE-table shot's estimate, :func:`table_interpolation_error`; None without that shot). The wall times and the creation time
-        are not written into any file (they would differ on every run).
+        FE-table shot's estimate, :func:`table_interpolation_error`; None without that shot).
+        The wall times and the creation time are not written into any file (they would differ
+        on every run).
     """
     started = time.perf_counter()
     out = Path(out_dir)
