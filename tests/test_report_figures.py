@@ -149,7 +149,7 @@ def test_every_report_figure_is_written(grid, runway, tmp_path):
 def test_quick_axes_reach_the_crater_and_the_striking_velocity(runway):
     target, projectile = runway
     velocities, depths = quick_axes(target, projectile)
-    assert velocities == (0.0, 600.0, 1000.0)
+    assert velocities == (0.0, 100.0, 300.0, 600.0, 1000.0)  # 0, 0.1, 0.3, 0.6, 1 V0
     assert depths[0] <= crater_depth(projectile) < depths[1]
     assert depths[-1] > switch_depths(target, projectile)[-1]
     assert len(depths) == 4

@@ -13,7 +13,9 @@ r"""Penetration resistance from an FE table of the cavity-wall stress ``sigma_r(
   The table must contain ``V = 0``: the nose tip sees ``V cos(phi) -> 0`` and nothing is
   extrapolated.
 
-Measured interpolation errors are in ``docs/verification.md`` and ``tests/test_table.py``.
+Measured interpolation errors are in ``docs/verification.md`` and ``tests/test_table.py``; a
+shot's own estimate (the table with every other node in ``V`` and in ``L``) is
+:func:`cavex.analytic.penetration.table_error.interpolation_error`.
 The crater stage uses the table's first-layer-alone column, as the closed form uses the
 single-medium model of the first layer (paper Eq. 34).
 

@@ -88,6 +88,9 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
                 single, projectile, closed, boundary, epsilon, **laws), crater=crater)}
     paper = (target.with_interfaces("bonded"), projectile) == load_config()
     settings = {"law": law_echo(target, law_A, law_B)} if law else {}
+    if model.takes_table:
+        settings["interpolation_error"] = table_error(target, projectile, table, crater,
+                                                      runs["runway"])
     return {**settings, "model": label, "interfaces": interface_summary(target, projectile),
             "first_layer_model": first, "resistance": resistance,
             "boundary": boundary, "epsilon": epsilon,
@@ -99,6 +102,20 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
             "interface_depths": target.interface_depths,
             "title": model.describe(boundary, epsilon, table, settings.get("law")),
             "layer_names": target.layer_names()}
+
+
+def table_error(target, projectile, table, crater, runway):
+    """The runway's FE-table interpolation-error estimate
+    (:func:`cavex.analytic.penetration.table_error.interpolation_error`: the table with every
+    other node in V and in L, the final-depth changes added)."""
+    from cavex.analytic.penetration.table_error import interpolation_error
+    from cavex.analytic.penetration.tabulated import read_table
+
+    data = table if hasattr(table, "attrs") else read_table(table)
+    reference = {"final_depth_m": float(runway.depth[-1]),
+                 "phase_end_velocities_m_s": [float(p.end_velocity) for p in runway.phases],
+                 "phase_labels": [p.label for p in runway.phases]}
+    return interpolation_error(target, projectile, data, crater, reference)
 
 
 SETTINGS = ("model", "first_layer_model", "resistance", "boundary", "epsilon", "table",
@@ -117,9 +134,13 @@ def summary(job):
     """What ``cavex penetrate --json`` prints: the settings, the runway's phases, the rows
     beside the paper's Table 2 (None for another target) and the files written
     (``job["outputs"]``, none before they are)."""
+    error = job.get("interpolation_error")  # an FE table's only
+    estimate = {} if error is None else {
+        "interpolation_error_estimate_m": error["estimate_m"],
+        "interpolation_error": {axis: error[axis] for axis in ("velocity", "depth")}}
     return {**{key: job[key] for key in SETTINGS if key in job},
             "phases": phases_as_dicts(job["runs"]["runway"]), "table2": job["table2"],
-            "outputs": list(job.get("outputs", ()))}
+            "outputs": list(job.get("outputs", ())), **estimate}
 
 
 def text(job):
@@ -139,6 +160,8 @@ def text(job):
     lines += [f"{p['phase']:>2}{stage(p)} {p['label']:<24} {p['end_depth_m']:8.4f} "
               f"{p['end_velocity_m_s']:9.2f} {p['end_time_s'] * 1e3:8.3f}  {p['end_reason']}"
               for p in s["phases"]]
+    if "interpolation_error_estimate_m" in s:
+        lines.append(interpolation_line(s))
     if s["table2"] is not None:
         lines += ["", "beside the paper's Table 2:",
                   f"{'row':<32} {'L ours':>7} {'paper':>6} {'V ours':>8} {'paper':>7} "
@@ -153,6 +176,16 @@ def text(job):
         lines.append(not_reproduced_line(s["table2"]))
     lines += ["", "wrote: " + ", ".join(s["outputs"])]
     return "\n".join(lines)
+
+
+def interpolation_line(s):
+    """The FE table's interpolation-error estimate of the final depth, in words."""
+    if s["interpolation_error_estimate_m"] is None:
+        return "FE-table interpolation error: no estimate (the table cannot be coarsened)"
+    parts = ", ".join(f"every other {axis} node {e['difference_m']:+.4f} m"
+                      for axis, e in s["interpolation_error"].items() if e is not None)
+    return (f"FE-table interpolation error of the final depth: estimate "
+            f"{s['interpolation_error_estimate_m']:.4f} m ({parts})")
 
 
 def crater_notes(target, projectile, crater):

@@ -69,7 +69,7 @@ def summary(job):
     :func:`cavex.verification.report.analysis.accuracy_records`)."""
     return {k: job[k] for k in ("out_dir", "files", "quick", "cells", "failed", "picture",
                                 "accuracy", "conclusions", "wall_time_s", "table_wall_time_s",
-                                "created")}
+                                "created", "table_interpolation_error")}
 
 
 def text(summary):

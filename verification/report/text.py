@@ -192,6 +192,23 @@ CELL_HEADER = ["V (m/s)", "L (m)", "wall layer", "FE sigma_r (MPa)", "FE error e
                "quasi-static b (mm)", "flags"]
 
 
+def quick_reference_line(estimate):
+    """The quick report's warning: its FE-table shot is on the quick grid, with the table's
+    interpolation-error estimate (:func:`~cavex.verification.report.build.
+    table_interpolation_error`), and the full ``cavex verify`` is the reference."""
+    if estimate is None or estimate["estimate_m"] is None:
+        error = "no interpolation-error estimate (the table cannot be coarsened)"
+    else:
+        parts = ", ".join(f"{axis} {estimate[axis]['difference_m']:+.4f} m"
+                          for axis in ("velocity", "depth") if estimate[axis] is not None)
+        error = (f"final depth {estimate['final_depth_m']:.4f} m with an interpolation-error "
+                 f"estimate of {estimate['estimate_m']:.4f} m (the table with every other "
+                 f"node: {parts})")
+    return ("**Quick report**: its FE table is the quick grid, and so is the FE-table shot "
+            f"compared with the closed forms: {error}; the full `cavex verify` is the "
+            "reference.")
+
+
 def trajectory_section(trajectories):
     """Summary and phase tables of :func:`compare_trajectories`, or its one-line failure."""
     if isinstance(trajectories, str):
