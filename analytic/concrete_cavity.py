@@ -92,8 +92,9 @@ STRUCTURES = {ELASTIC_PLASTIC: "elastic-comminuted", CRACKED: "elastic-cracked-c
               SUPERSEISMIC: "comminuted shock into undisturbed concrete"}
 DEFAULT_STEPS = 256  # RK4 steps across the comminuted zone (see the convergence test)
 # columns of the parameter vector of the compiled functions
-(E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, LOCKED, TENSILE, W, WB, PHI, POWER_B, POWER_N) = range(14)
-NPAR = 14
+(E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, LOCKED, TENSILE, W, WB, PHI, POWER_B, POWER_N,
+ S_CAP, S_LOCK) = range(16)
+NPAR = 16  # S_CAP, S_LOCK: the kinks (kink_stresses), computed once per parameter vector
 
 
 @dataclass(frozen=True)
@@ -189,6 +190,7 @@ class ConcreteCavity:
         p[ETA], p[LOCKED], p[TENSILE] = self.eta_lock, self.bulk_locked, self.tensile
         p[W], p[WB], p[PHI] = w, wb, phi
         p[POWER_B], p[POWER_N] = self.power_B, self.power_N
+        p[S_CAP], p[S_LOCK] = kink_stresses(p)
         return p
 
 
@@ -324,9 +326,9 @@ def constitutive(p, s, branch=np.nan):
     locking pressure) are chosen at ``branch`` (default ``s``), so that a step ending or
     starting at a kink stays on one side of it."""
     b = s if math.isnan(branch) else branch
-    capped = b > kink_stresses(p)[0]
+    capped = b > p[S_CAP]
     D, pressure, dp = strength(p, s, capped)
-    b_pressure = strength(p, b, capped)[1]
+    b_pressure = pressure if b == s else strength(p, b, capped)[1]
     eta, compliance = hydrostat(p, pressure, b_pressure)
     if eta >= 1.0:
         return D, np.nan, np.nan
@@ -445,7 +447,7 @@ def integrate(p, beta, s, U, steps):
     t0 = math.log(beta)
     h = -t0 / steps
     t = t0
-    kinks = kink_stresses(p)
+    kinks = (p[S_CAP], p[S_LOCK])
     shocks = 0
     for k in range(steps):
         t_end = t0 + (k + 1) * h

@@ -46,7 +46,7 @@ from scipy.interpolate import PchipInterpolator
 from cavex.analytic.concrete_cavity import ConcreteCavity, fit_AB, wall_stress
 from cavex.analytic.penetration.integrator import crater_exit, penetrate
 from cavex.analytic.penetration.nose import nose_rule
-from cavex.errors import require
+from cavex.errors import CavexNumericalError, require
 from cavex.materials import Material, Projectile, Target
 from cavex.verification.validation import empirical
 from cavex.verification.validation.concrete import DEFAULT_NU, aci_modulus, mohr_coulomb_lambda
@@ -135,7 +135,12 @@ class TableResistance:
         self.shot = shot
         self.material = concrete_cavity(shot.fc, shot.rho, constants)
         self.phi_max = shot.rho * shot.V0 ** 2 / shot.fc
-        phi, self.S = material_table(self.material, table_top(self.phi_max))
+        try:
+            phi, self.S = material_table(self.material, table_top(self.phi_max))
+        except CavexNumericalError as exc:  # a failed node: every shot into this concrete
+            raise CavexNumericalError(
+                f"concrete f_c = {shot.fc / 1e6:g} MPa, rho = {shot.rho:g} kg/m^3: its cavity "
+                f"table fails, so does every shot into it: {exc}") from exc
         used = max(3, int(np.searchsorted(phi, self.phi_max, side="right")))
         self.A, self.B = fit_AB(phi[:used], self.S[:used])
         self._stress = PchipInterpolator(np.sqrt(phi * shot.fc / shot.rho), shot.fc * self.S)
