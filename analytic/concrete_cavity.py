@@ -642,8 +642,10 @@ def cracked(p, gamma, steps):
 XTOL = 1e-14
 BRACKET_POINTS = 96
 EDGE_HALVINGS = 50
-SUBDIVISIONS = 8  # points a bracket is split into where the residual is NaN inside it
-SUBDIVISION_DEPTH = 4
+REFINE_DEPTH = 8  # NaN pockets cut out of one bracket at most
+# |U(1) - 1| accepted at a root: Brent's bracket of 1e-14 leaves ~1e-13; where the residual
+# jumps across zero (measured: -0.48 to +3.97) it stays at the size of the jump
+RESIDUAL_TOLERANCE = 1e-9
 
 
 class NoSolution(CavexNumericalError):
@@ -679,43 +681,58 @@ def _finite_edge(residual, finite, beyond, halvings=EDGE_HALVINGS):
 
 def _brent(residual, a, b):
     """Brent's method (scipy ``brentq``, ``xtol = rtol = XTOL``) on a sign change; raises
-    :class:`_NaNResidual` where the residual is NaN."""
+    :class:`_NaNResidual` (with the point) where the residual is NaN."""
     from scipy.optimize import brentq
 
     def finite(x):
         value = residual(x)
         if not math.isfinite(value):
-            raise _NaNResidual
+            raise _NaNResidual(x)
         return value
 
     return brentq(finite, a, b, xtol=XTOL, rtol=XTOL, maxiter=200)
 
 
+def _last_finite(residual, finite, nan, halvings=EDGE_HALVINGS):
+    """``(x, value)``: the finite point next to the NaN one ``nan``, by bisection between a finite
+    ``(x, value)`` and ``nan`` on whether the residual is finite."""
+    (x0, v0), x1 = finite, nan
+    for _ in range(halvings):
+        mid = 0.5 * (x0 + x1)
+        value = residual(mid)
+        if math.isfinite(value):
+            x0, v0 = mid, value
+        else:
+            x1 = mid
+    return x0, v0
+
+
 def _refine(residual, lower, upper, depth=0):
     """The first root (going outward) in the bracket ``lower = (a, f(a))``, ``upper = (b, f(b))``
-    (``f(a) f(b) <= 0``), or None. Brent's method; where it meets a NaN inside the bracket, the
-    bracket is split into :data:`SUBDIVISIONS` parts and each sign change among its finite
-    points is refined in turn (to :data:`SUBDIVISION_DEPTH` levels)."""
+    (``f(a) f(b) <= 0``), or None. Brent's method, its root kept where ``|f| <=``
+    :data:`RESIDUAL_TOLERANCE` (not at a jump of ``f`` across zero); where it meets a NaN at
+    ``c`` inside the bracket, the NaN pocket around ``c`` is cut out (its finite edges
+    ``c_-``, ``c_+`` by bisection) and the sign change is refined in ``(a, c_-)`` or
+    ``(c_+, b)``; None when it lies inside the pocket (to :data:`REFINE_DEPTH` pockets)."""
     (a, fa), (b, fb) = lower, upper
     if fa == 0.0:
         return a
     if fb == 0.0:
         return b
     try:
-        return _brent(residual, a, b)
-    except _NaNResidual:
-        pass
-    if depth >= SUBDIVISION_DEPTH:
+        root = _brent(residual, a, b)
+    except _NaNResidual as exc:
+        c = exc.args[0]
+    else:  # a jump of the residual across zero is no root (the front's state changes branch)
+        return root if abs(residual(root)) <= RESIDUAL_TOLERANCE else None
+    if depth >= REFINE_DEPTH:
         return None
-    previous = lower
-    for x in np.linspace(a, b, SUBDIVISIONS + 1)[1:]:
-        value = fb if x == b else residual(x)
-        if math.isfinite(value):
-            if value * previous[1] <= 0.0:
-                root = _refine(residual, previous, (x, value), depth + 1)
-                if root is not None:
-                    return root
-            previous = (x, value)
+    left = _last_finite(residual, lower, c)
+    if left[1] * fa <= 0.0:
+        return _refine(residual, lower, left, depth + 1)
+    right = _last_finite(residual, upper, c)
+    if right[1] * fb <= 0.0:
+        return _refine(residual, right, upper, depth + 1)
     return None
 
 
@@ -793,10 +810,25 @@ def solve(material, phi, steps=DEFAULT_STEPS):
         No structure's wall condition has a root on its scan (the reason per structure in
         ``reasons``).
     CavexNumericalError
-        A structure's wall condition changes sign but no root could be evaluated.
+        A structure's wall condition changes sign but no root could be evaluated, at ``steps``
+        nor at 2 and 4 times as many RK4 steps (tried in turn: the NaN pockets of the residual
+        move with the step count).
     """
     require(is_finite_number(phi) and phi >= 0.0, "phi", "rho V^2/f_c, a finite number >= 0", phi)
-    return _solve(material, float(phi), int(steps))
+    try:
+        return _solve(material, float(phi), int(steps))
+    except NoSolution:
+        raise
+    except CavexNumericalError as failure:
+        # a root inside a NaN pocket of the residual: the pockets (a sonic point the integration
+        # cannot place, next to the cap) move with the step count, the root does not (within
+        # the step tolerance, docs/concrete.md "Root finding"): the finer counts are tried
+        for finer in (2 * int(steps), 4 * int(steps)):
+            try:
+                return _solve(material, float(phi), finer)
+            except CavexNumericalError:
+                continue
+        raise failure
 
 
 @lru_cache(maxsize=65536)
