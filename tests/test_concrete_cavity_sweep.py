@@ -50,28 +50,33 @@ def test_every_point_is_solved(sweep):
     assert np.all(S > 0.0)
 
 
-def _slope_ratios(S, axis):
-    """``ln`` of the ratio of neighbouring finite-difference slopes along ``axis``: 0 on a
-    straight line, ``O(h)`` on a smooth curve, large at a jump of ``S``."""
-    slope = np.diff(S, axis=axis)
-    return np.log(np.take(slope, range(1, slope.shape[axis]), axis=axis)
-                  / np.take(slope, range(0, slope.shape[axis] - 1), axis=axis))
+def _spikes(S, axis):
+    """``|S_i - (S_{i-1} + S_{i+1})/2| / S_i`` along ``axis``: ``O(h^2 S''/S)`` on a smooth
+    curve, half a jump's relative size at a step of ``S``, the size of the error at a wrong
+    root between right ones."""
+    S = np.moveaxis(S, axis, 0)
+    return np.abs(S[1:-1] - 0.5 * (S[:-2] + S[2:])) / S[1:-1]
+
+
+def _changes(structure, axis):
+    """Where the structure changes next to a point (the points of :func:`_spikes`)."""
+    st = np.moveaxis(structure, axis, 0)
+    return (st[1:-1] != st[:-2]) | (st[1:-1] != st[2:])
 
 
 def test_wall_stress_is_continuous_along_the_sweep(sweep):
-    """``S`` rises with ``phi`` and falls with ``f_c`` at every step of the sweep, and the
-    slope between neighbouring steps changes by at most the measured spread: along ``phi``
-    |ln(slope ratio)| <= 0.12 where the structure is one (measured 0.085), <= 0.25 across a
-    change of structure (measured 0.17; a kink, not a jump: a jump of S by one step's rise
-    would give ln 2 = 0.69); along ``f_c`` (measured 0.055) <= 0.08."""
+    """``S`` rises with ``phi`` everywhere, and no point stands off its two neighbours by more
+    than the measured spread (:func:`_spikes`): along ``phi`` 0.0152 (at the first step from
+    rest, where ``S`` bends most), along ``f_c`` 0.0084, at a change of structure 0.0051 (the
+    structures meet with a kink, or a step of at most 0.66 % of ``S`` where the joint front
+    gives way to the cracked one); asserted at 0.02, 0.012, 0.008. Before the residual check of
+    ``_refine`` three points sat at jumps of the residual (S 35-47 % low: spikes 0.54-0.91)."""
     S, structure, _ = sweep
     assert np.all(np.diff(S, axis=1) > 0.0)
-    assert np.all(np.diff(S, axis=0) < 0.0)
-    along_phi = np.abs(_slope_ratios(S, 1))
-    change = (structure[:, 2:] != structure[:, 1:-1]) | (structure[:, 1:-1] != structure[:, :-2])
-    assert along_phi[~change].max() <= 0.12
-    assert along_phi[change].max() <= 0.25
-    assert np.abs(_slope_ratios(S, 0)).max() <= 0.08
+    for axis, bound in ((1, 0.02), (0, 0.012)):
+        spikes, changes = _spikes(S, axis), _changes(structure, axis)
+        assert spikes[~changes].max() <= bound
+        assert spikes[changes].max() <= 0.008
 
 
 def test_sweep_time(sweep):
@@ -111,7 +116,8 @@ def test_no_spurious_sign_change_near_the_cap():
                                           (180e6, RHO, 37.0), (60e6, RHO, 50.0)])
 def test_step_count_refinement(fc, rho, phi):
     """RK4 at 64 ... 512 steps against 2048: the structure is the same, the fitted order 4
-    (np.polyfit; measured 3.74-4.35 over 30 points of the sweep), and the default 256 steps
+    (np.polyfit; measured 3.85-3.98 here; 3.3-4.4 on 32 ... 512 steps over 30 points of the
+    sweep), and the default 256 steps
     within STEP_TOLERANCE (worst measured 3.5e-10). Below 64 steps the structure can change
     (180 MPa, phi = 37: 16 and 32 steps find another structure, S off by 77 %), so the default
     stays 256: 4 times the smallest safe count, 1e-9 at most."""
