@@ -92,8 +92,9 @@ STRUCTURES = {ELASTIC_PLASTIC: "elastic-comminuted", CRACKED: "elastic-cracked-c
               SUPERSEISMIC: "comminuted shock into undisturbed concrete"}
 DEFAULT_STEPS = 256  # RK4 steps across the comminuted zone (see the convergence test)
 # columns of the parameter vector of the compiled functions
-(E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, LOCKED, TENSILE, W, WB, PHI, POWER_B, POWER_N) = range(14)
-NPAR = 14
+(E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, LOCKED, TENSILE, W, WB, PHI, POWER_B, POWER_N,
+ S_CAP, S_LOCK) = range(16)
+NPAR = 16  # S_CAP, S_LOCK: the kinks (kink_stresses), computed once per parameter vector
 
 
 @dataclass(frozen=True)
@@ -189,6 +190,7 @@ class ConcreteCavity:
         p[ETA], p[LOCKED], p[TENSILE] = self.eta_lock, self.bulk_locked, self.tensile
         p[W], p[WB], p[PHI] = w, wb, phi
         p[POWER_B], p[POWER_N] = self.power_B, self.power_N
+        p[S_CAP], p[S_LOCK] = kink_stresses(p)
         return p
 
 
@@ -202,6 +204,7 @@ class CavitySolution:
     plastic_front: float  # beta = c_plastic / V
     crack_front: float  # gamma (NaN without a cracked zone)
     amplitude: float  # C of the elastic zone (NaN if none)
+    residual: float = 0.0  # U(1) - 1 at the front found (<= RESIDUAL_TOLERANCE in size)
 
     @property
     def name(self):
@@ -324,9 +327,9 @@ def constitutive(p, s, branch=np.nan):
     locking pressure) are chosen at ``branch`` (default ``s``), so that a step ending or
     starting at a kink stays on one side of it."""
     b = s if math.isnan(branch) else branch
-    capped = b > kink_stresses(p)[0]
+    capped = b > p[S_CAP]
     D, pressure, dp = strength(p, s, capped)
-    b_pressure = strength(p, b, capped)[1]
+    b_pressure = pressure if b == s else strength(p, b, capped)[1]
     eta, compliance = hydrostat(p, pressure, b_pressure)
     if eta >= 1.0:
         return D, np.nan, np.nan
@@ -419,6 +422,19 @@ def _split_step(p, t, s, U, h, s_kink, floor):
 
 
 @njit(cache=True, error_model="numpy")
+def _ceiling(kinks, branch):
+    """Just below the first kink above the stress ``branch`` (inf: none): a trial step's law
+    pieces are chosen at most there, so that no RK4 stage of a step that ends below the kink
+    uses the pieces above it (past the cap the flow can be sonic: a stage that overshoots the
+    kink would otherwise stop the step as if the flow turned sonic below it)."""
+    kink = np.inf
+    for s_kink in kinks:
+        if branch < s_kink < kink:
+            kink = s_kink
+    return kink - 1e-12 * (1.0 + abs(kink)) if math.isfinite(kink) else np.inf
+
+
+@njit(cache=True, error_model="numpy")
 def integrate(p, beta, s, U, steps):
     """RK4 from ``xi = beta`` to the wall ``xi = 1`` in ``ln xi``; returns ``(s, U)`` there.
 
@@ -432,7 +448,7 @@ def integrate(p, beta, s, U, steps):
     t0 = math.log(beta)
     h = -t0 / steps
     t = t0
-    kinks = kink_stresses(p)
+    kinks = (p[S_CAP], p[S_LOCK])
     shocks = 0
     for k in range(steps):
         t_end = t0 + (k + 1) * h
@@ -441,17 +457,18 @@ def integrate(p, beta, s, U, steps):
             rest = t_end - t
             if rest >= -1e-15 * abs(h):
                 break
-            s_new, U_new = _rk4(p, t, s, U, rest, floor)
+            ceiling = _ceiling(kinks, max(s, floor))
+            s_new, U_new = _rk4(p, t, s, U, rest, floor, ceiling)
             if not (math.isfinite(s_new) and math.isfinite(U_new)):
                 lo, hi = 0.0, rest
                 for _ in range(60):
                     mid = 0.5 * (lo + hi)
-                    if math.isfinite(_rk4(p, t, s, U, mid, floor)[0]):
+                    if math.isfinite(_rk4(p, t, s, U, mid, floor, ceiling)[0]):
                         lo = mid
                     else:
                         hi = mid
                 if lo != 0.0:
-                    s, U = _rk4(p, t, s, U, lo, floor)
+                    s, U = _rk4(p, t, s, U, lo, floor, ceiling)
                     t += lo
                 shocks += 1
                 if shocks > 4:
@@ -625,30 +642,33 @@ def cracked(p, gamma, steps):
 
 XTOL = 1e-14
 BRACKET_POINTS = 96
+EDGE_HALVINGS = 50
+REFINE_DEPTH = 8  # NaN pockets cut out of one bracket at most
+# |U(1) - 1| accepted at a root. Brent's bracket of 1e-14 leaves ~1e-13 at a root; where the
+# residual jumps across zero it stays at the size of the jump: large jumps (measured 0.47-3.97,
+# the front's state changing branch) are no root, small ones (measured 2e-3 and 3e-2: 98.8 MPa,
+# phi = 40.9, joint front; 139.6 MPa, phi = 26.3, cracked) are kept as the old solver kept
+# them, their U(1) - 1 in the solution (CavitySolution.residual)
+RESIDUAL_TOLERANCE = 0.1
 
 
-def _bracket(residual, lo, hi, points=BRACKET_POINTS):
-    """First sign change of ``residual`` on a grid of ``(lo, hi)`` geometric in ``xi``, or None.
+class NoSolution(CavexNumericalError):
+    """No self-similar solution at this ``phi``: no structure's wall condition ``U(1) = 1`` has
+    a root over its admissible front speeds. :attr:`reasons` says, per structure tried, why
+    (:func:`_reason`: no admissible front, or ``U(1) - 1`` of one sign over all of them)."""
 
-    Where the residual turns NaN (no admissible state) after a finite value, the edge of the
-    finite part is found by bisection and checked for a sign change too.
-    """
-    previous = None
-    for x in np.geomspace(lo, hi, points):
-        value = residual(x)
-        if previous is not None and math.isfinite(value) and value * previous[1] <= 0.0:
-            return previous[0], x
-        if previous is not None and not math.isfinite(value):
-            edge = _finite_edge(residual, previous, x)
-            if edge is not None:
-                return previous[0], edge
-        if math.isfinite(value):
-            previous = (x, value)
-    return None
+    def __init__(self, message, reasons):
+        super().__init__(message)
+        self.reasons = reasons
 
 
-def _finite_edge(residual, finite, beyond, halvings=50):
-    """Bisect between a finite ``(x, value)`` and ``beyond`` (NaN) for a sign change."""
+class _NaNResidual(Exception):
+    """The residual is NaN (no admissible state) at a point Brent's method asked for."""
+
+
+def _finite_edge(residual, finite, beyond, halvings=EDGE_HALVINGS):
+    """Bisect between a finite ``(x, value)`` and ``beyond`` (NaN there) for a point of the other
+    sign near the edge of the finite part; ``(x, value)`` or None."""
     x0, v0 = finite
     x1 = beyond
     for _ in range(halvings):
@@ -657,36 +677,127 @@ def _finite_edge(residual, finite, beyond, halvings=50):
         if not math.isfinite(value):
             x1 = mid
         elif value * v0 <= 0.0:
-            return mid
+            return mid, value
         else:
             x0 = mid
     return None
 
 
-def _root(residual, lo, hi):
-    """A root of ``residual`` in ``(lo, hi)`` (:func:`_bracket`, then Illinois regula falsi that
-    bisects where the residual is NaN), or None."""
-    bracket = _bracket(residual, lo, hi)
-    if bracket is None:
-        return None
-    a, b = bracket
-    fa, fb = residual(a), residual(b)
-    for _ in range(200):
-        if fb == 0.0 or abs(b - a) <= XTOL * abs(b):
-            return b
-        c = b - fb * (b - a) / (fb - fa) if fb != fa else 0.5 * (a + b)
-        fc = residual(c)
-        if not math.isfinite(fc):
-            c = 0.5 * (a + b)
-            fc = residual(c)
-            if not math.isfinite(fc):
-                return None
-        if fc * fb < 0.0:
-            a, fa = b, fb
+def _brent(residual, a, b):
+    """Brent's method (scipy ``brentq``, ``xtol = rtol = XTOL``) on a sign change; raises
+    :class:`_NaNResidual` (with the point) where the residual is NaN."""
+    from scipy.optimize import brentq
+
+    def finite(x):
+        value = residual(x)
+        if not math.isfinite(value):
+            raise _NaNResidual(x)
+        return value
+
+    return brentq(finite, a, b, xtol=XTOL, rtol=XTOL, maxiter=200)
+
+
+def _last_finite(residual, finite, nan, halvings=EDGE_HALVINGS):
+    """``(x, value)``: the finite point next to the NaN one ``nan``, by bisection between a finite
+    ``(x, value)`` and ``nan`` on whether the residual is finite."""
+    (x0, v0), x1 = finite, nan
+    for _ in range(halvings):
+        mid = 0.5 * (x0 + x1)
+        value = residual(mid)
+        if math.isfinite(value):
+            x0, v0 = mid, value
         else:
-            fa *= 0.5
-        b, fb = c, fc
-    return b
+            x1 = mid
+    return x0, v0
+
+
+def _refine(residual, lower, upper, depth=0):
+    """The first root (going outward) in the bracket ``lower = (a, f(a))``, ``upper = (b, f(b))``
+    (``f(a) f(b) <= 0``), or None. Brent's method, its root kept where ``|f| <=``
+    :data:`RESIDUAL_TOLERANCE` (not at a jump of ``f`` across zero); where it meets a NaN at
+    ``c`` inside the bracket, the NaN pocket around ``c`` is cut out (its finite edges
+    ``c_-``, ``c_+`` by bisection) and the sign change is refined in ``(a, c_-)`` or
+    ``(c_+, b)``; None when it lies inside the pocket (to :data:`REFINE_DEPTH` pockets)."""
+    (a, fa), (b, fb) = lower, upper
+    if fa == 0.0:
+        return a
+    if fb == 0.0:
+        return b
+    try:
+        root = _brent(residual, a, b)
+    except _NaNResidual as exc:
+        c = exc.args[0]
+    else:  # a jump of the residual across zero is no root (the front's state changes branch)
+        return root if abs(residual(root)) <= RESIDUAL_TOLERANCE else None
+    if depth >= REFINE_DEPTH:
+        return None
+    left = _last_finite(residual, lower, c)
+    if left[1] * fa <= 0.0:
+        return _refine(residual, lower, left, depth + 1)
+    right = _last_finite(residual, upper, c)
+    if right[1] * fb <= 0.0:
+        return _refine(residual, right, upper, depth + 1)
+    return None
+
+
+def _roots(residual, lo, hi, summary=None, points=BRACKET_POINTS):
+    """The roots of ``residual`` in ``(lo, hi)`` going outward (a generator); the finite values
+    met on the grid are appended to the list ``summary`` (if given).
+
+    Scans a grid of ``points`` geometric in ``xi``; each sign change between consecutive finite
+    values (across NaN points too) is refined (:func:`_refine`). Where the residual turns NaN
+    (no admissible state) or finite again, the edge of the finite part is bisected for a sign
+    change hidden between the grid point and the edge (:func:`_finite_edge`).
+    """
+    previous = None  # last finite (x, value)
+    previous_nan = None  # last NaN grid point, if after the last finite one
+    for x in np.geomspace(lo, hi, points):
+        value = residual(x)
+        if not math.isfinite(value):
+            if previous is not None and previous_nan is None:  # finite -> NaN
+                edge = _finite_edge(residual, previous, x)
+                if edge is not None:
+                    root = _refine(residual, previous, edge)
+                    if root is not None:
+                        yield root
+            previous_nan = x
+            continue
+        if summary is not None:
+            summary.append(value)
+        if previous_nan is not None:  # NaN -> finite
+            edge = _finite_edge(residual, (x, value), previous_nan)
+            if edge is not None:
+                root = _refine(residual, edge, (x, value))
+                if root is not None:
+                    yield root
+                    edge = None
+            if edge is None and previous is not None and value * previous[1] <= 0.0:
+                root = _refine(residual, previous, (x, value))  # across the NaN points
+                if root is not None:
+                    yield root
+        elif previous is not None and value * previous[1] <= 0.0:
+            root = _refine(residual, previous, (x, value))
+            if root is not None:
+                yield root
+        previous, previous_nan = (x, value), None
+
+
+def _root(residual, lo, hi, summary=None):
+    """The first root of ``residual`` in ``(lo, hi)`` going outward (:func:`_roots`), or None."""
+    return next(_roots(residual, lo, hi, summary), None)
+
+
+def _reason(values):
+    """Why a structure's scan found no root, from its finite grid values of ``U(1) - 1``."""
+    if not values:
+        return "no admissible front speed (no state ahead that the front can satisfy)"
+    if max(values) < 0.0:
+        return (f"the wall lags the cavity at every admissible front speed "
+                f"(U(1) - 1 in [{min(values):.3g}, {max(values):.3g}])")
+    if min(values) > 0.0:
+        return (f"the wall outruns the cavity at every admissible front speed "
+                f"(U(1) - 1 in [{min(values):.3g}, {max(values):.3g}])")
+    return "U(1) - 1 changes sign but no root could be evaluated (numerical failure)"
 
 
 def _upper_front(p):
@@ -699,40 +810,73 @@ def solve(material, phi, steps=DEFAULT_STEPS):
 
     Raises
     ------
+    NoSolution
+        No structure's wall condition has a root on its scan (the reason per structure in
+        ``reasons``).
     CavexNumericalError
-        No structure satisfies the wall condition (e.g. sonic flow in the comminuted zone).
+        A structure's wall condition changes sign but no root could be evaluated, at ``steps``
+        nor at 2 and 4 times as many RK4 steps (tried in turn: the NaN pockets of the residual
+        move with the step count).
     """
     require(is_finite_number(phi) and phi >= 0.0, "phi", "rho V^2/f_c, a finite number >= 0", phi)
-    return _solve(material, float(phi), int(steps))
+    try:
+        return _solve(material, float(phi), int(steps))
+    except NoSolution:
+        raise
+    except CavexNumericalError as failure:
+        # a root inside a NaN pocket of the residual: the pockets (a sonic point the integration
+        # cannot place, next to the cap) move with the step count, the root does not (within
+        # the step tolerance, docs/concrete.md "Root finding"): the finer counts are tried
+        for finer in (2 * int(steps), 4 * int(steps)):
+            try:
+                return _solve(material, float(phi), finer)
+            except CavexNumericalError:
+                continue
+        raise failure
 
 
 @lru_cache(maxsize=65536)
 def _solve(material, phi, steps):
     p = material.parameters(phi)
     upper = _upper_front(p)
-    beta = _root(lambda b: elastic_plastic(p, b, steps)[0], 1.0 + 1e-6, upper)
+    reasons = {}
+    values = []
+    beta = _root(lambda b: elastic_plastic(p, b, steps)[0], 1.0 + 1e-6, upper, values)
     if beta is not None:
-        _, S, C = elastic_plastic(p, beta, steps)
+        residual, S, C = elastic_plastic(p, beta, steps)
         s_a, D_a = elastic_state(p, C, beta)[:2]
         if s_a - D_a >= -p[TENSILE] * (1.0 + 1e-12):
-            return CavitySolution(S, phi, ELASTIC_PLASTIC, beta, math.nan, C)
+            return CavitySolution(S, phi, ELASTIC_PLASTIC, beta, math.nan, C, residual)
+        reasons[ELASTIC_PLASTIC] = "the elastic hoop stress at the front exceeds f_t (cracks)"
+    else:
+        reasons[ELASTIC_PLASTIC] = _reason(values)
     if math.isfinite(p[TENSILE]):
         gamma_hi = min(upper, (1.0 / p[WB]) * (1.0 - 1e-12) if p[WB] > 0.0 else 1e6)
-        gamma = _root(lambda g: cracked(p, g, steps)[0], 1.0 + 1e-6, gamma_hi)
+        values = []
+        gamma = _root(lambda g: cracked(p, g, steps)[0], 1.0 + 1e-6, gamma_hi, values)
         if gamma is not None:
-            _, S, beta, C = cracked(p, gamma, steps)
-            return CavitySolution(S, phi, CRACKED, beta, gamma, C)
-        beta = _root(lambda b: cracking_plastic(p, b, steps)[0], 1.0 + 1e-6, upper)
+            residual, S, beta, C = cracked(p, gamma, steps)
+            return CavitySolution(S, phi, CRACKED, beta, gamma, C, residual)
+        reasons[CRACKED] = _reason(values)
+        values = []
+        beta = _root(lambda b: cracking_plastic(p, b, steps)[0], 1.0 + 1e-6, upper, values)
         if beta is not None:
-            _, S, C = cracking_plastic(p, beta, steps)
-            return CavitySolution(S, phi, JOINT_FRONT, beta, beta, C)
+            residual, S, C = cracking_plastic(p, beta, steps)
+            return CavitySolution(S, phi, JOINT_FRONT, beta, beta, C, residual)
+        reasons[JOINT_FRONT] = _reason(values)
     if p[W] > 0.0:
-        beta = _root(lambda b: superseismic(p, b, steps)[0], 1.0 / p[W], 1e4)
+        values = []
+        beta = _root(lambda b: superseismic(p, b, steps)[0], 1.0 / p[W], 1e4, values)
         if beta is not None:
-            return CavitySolution(superseismic(p, beta, steps)[1], phi, SUPERSEISMIC, beta,
-                                  math.nan, math.nan)
-    raise CavexNumericalError(f"no self-similar concrete cavity solution at rho V^2/f_c = {phi:g} "
-                              f"({material})")
+            residual, S = superseismic(p, beta, steps)
+            return CavitySolution(S, phi, SUPERSEISMIC, beta, math.nan, math.nan, residual)
+        reasons[SUPERSEISMIC] = _reason(values)
+    text = "; ".join(f"{STRUCTURES[k]}: {v}" for k, v in reasons.items())
+    message = (f"no self-similar concrete cavity solution at rho V^2/f_c = {phi:g} ({material}): "
+               f"{text}")
+    if any("numerical failure" in v for v in reasons.values()):
+        raise CavexNumericalError(message)
+    raise NoSolution(message, reasons)
 
 
 def wall_stress(material, phi, steps=DEFAULT_STEPS):

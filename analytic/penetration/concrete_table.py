@@ -47,6 +47,7 @@ from cavex.analytic.empirical import crater_calibres
 from cavex.analytic.penetration.integrator import crater_exit, penetrate
 from cavex.analytic.penetration.nose import nose_rule
 from cavex.concrete import Concrete, Constants
+from cavex.errors import CavexNumericalError
 from cavex.materials import Material, Projectile, Target
 
 TABLE_POINTS = 33
@@ -88,7 +89,12 @@ class TableResistance:
         self.shot = shot
         self.material = concrete_cavity(shot.fc, shot.rho, constants)
         self.phi_max = shot.rho * shot.V0 ** 2 / shot.fc
-        phi, self.S = material_table(self.material, table_top(self.phi_max))
+        try:
+            phi, self.S = material_table(self.material, table_top(self.phi_max))
+        except CavexNumericalError as exc:  # a failed node: every shot into this concrete
+            raise CavexNumericalError(
+                f"concrete f_c = {shot.fc / 1e6:g} MPa, rho = {shot.rho:g} kg/m^3: its cavity "
+                f"table fails, so does every shot into it: {exc}") from exc
         used = max(3, int(np.searchsorted(phi, self.phi_max, side="right")))
         self.A, self.B = fit_AB(phi[:used], self.S[:used])
         self._stress = PchipInterpolator(np.sqrt(phi * shot.fc / shot.rho), shot.fc * self.S)
