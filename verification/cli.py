@@ -152,6 +152,10 @@ def build_parser():
                             "over this push into its wall, then it cuts (m in [1e-7, 1e-5]; "
                             "not with --contact-ramp or --tangency-psi; default: off, the "
                             "velocity ramp; docs/oblique.md)")
+    trajectory.add_argument("--estimate", action="store_true",
+                            help="fly each run again with every discretisation parameter "
+                            "refined and report the change of each reported quantity as its "
+                            "estimate (summary.json 'estimate'; docs/oblique.md)")
     trajectory.add_argument("--tunnel-wall", dest="tunnel_wall", type=float, default=None,
                             help="factor in [0, 1] on the shank's load in every layer (a "
                             "sensitivity setting, uncalibrated; default: each layer's "

@@ -204,7 +204,7 @@ def summary(job, written=None):
                                   "rate)") from None
     main = runs["runway"]
     document = {"end": main["end"], "phases": main["phases"], "settings": job["settings"],
-                "runs": runs}
+                "runs": runs, **({"estimate": job["estimate"]} if "estimate" in job else {})}
     return document if written is None else {**document, "outputs": written}
 
 
@@ -218,7 +218,8 @@ def write_outputs(job, out, draw=True):
                for name, result in job["runs"].items()]
     path = folder / "summary.json"
     document = summary(job)
-    text = json.dumps({"settings": document["settings"], "runs": document["runs"]}, indent=2)
+    text = json.dumps({k: document[k] for k in ("settings", "runs", "estimate") if k in document},
+                      indent=2)
     write_text_atomic(path, text + "\n")
     written.append(str(path))
     if draw:
@@ -618,6 +619,9 @@ def run(args, target, projectile):
                 f"the {name} trajectory " + ("is not finite" if not finite else
                 "ended at t = 0 s: the integrator could not advance (a shot too slow, or "
                 "forces far beyond the projectile's mass and inertia)"))
+    if getattr(args, "estimate", False):  # one refined rerun (analytic/penetration/refinement)
+        from cavex.analytic.penetration.refinement import estimate_runs
+        job["estimate"] = estimate_runs(job["runs"])
     summary(job)  # the peaks and rates are finite too, before anything is written
     written = write_staged(folder, lambda stage: write_outputs(job, stage, draw=args.figures))
     document = summary(job, written)
@@ -639,5 +643,8 @@ def text(summary):
         lines.append(f"end: {e['state']}, nose tip ({tip}) m, pitch "
                      f"{e['pitch_deg']:.2f} deg; peaks: axial {s['max_axial_g']:.0f} g, "
                      f"lateral {s['max_lateral_g']:.0f} g")
+    if "estimate" in summary:
+        from cavex.analytic.penetration.refinement import verdict
+        lines += ["", *verdict(summary["estimate"])]
     lines += ["", "wrote: " + ", ".join(summary["outputs"])]
     return "\n".join(lines)
