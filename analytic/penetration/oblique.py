@@ -40,7 +40,7 @@ from cavex.analytic.penetration.surface_force import (
     rotation_matrix,
     surface_loads,
 )
-from cavex.analytic.penetration.zones import open_zones, union
+from cavex.analytic.penetration.zones import CRATER_RATIO, open_zones, union
 from cavex.errors import CavexNumericalError, is_finite_number, require
 
 G = 9.80665  # m/s^2, for overloads in g
@@ -150,7 +150,7 @@ class ObliqueModel:
     def __init__(self, target, projectile, law, *, body=None, bottom=None, rtol=RTOL,
                  atol=ATOL, method=METHOD, contact_ramp=None, crater="nose-base",
                  tangency_psi=0.0, entry_crater=False, contact_hold=0.0,
-                 hold_time=None):
+                 hold_time=None, crater_ratio=CRATER_RATIO):
         self.target, self.projectile, self.law = target, projectile, law
         self.body = body or build_body(projectile)
         self.bottom = bottom
@@ -169,7 +169,8 @@ class ObliqueModel:
         require(not (self.contact_hold and tangency_psi), "tangency_psi",
                 "0 with the held contact (the attenuation is a velocity ramp)", tangency_psi)
         self.mu = float(projectile.mu)
-        self.crater, self.tangency_psi = crater, tangency_psi  # (kept for a refined rerun)
+        # (kept for a refined rerun; crater_ratio: zones.crater_depth's, a study's setting)
+        self.crater, self.tangency_psi, self.crater_ratio = crater, tangency_psi, crater_ratio
         require(is_finite_number(tangency_psi) and 0.0 <= tangency_psi <= 30.0,
                 "tangency_psi", "in [0, 30] degrees", tangency_psi)
         # OFPM's attenuation within psi of tangency (docs/oblique.md "Tunnel wall"; 0: none)
@@ -187,7 +188,8 @@ class ObliqueModel:
         # entry crater [0, L_c] comes first and is open from the start (the nose tip starts on
         # the surface, its top)
         self.entry_crater = bool(entry_crater)
-        self.zones = (open_zones(target, projectile, crater, entry=self.entry_crater)
+        self.zones = (open_zones(target, projectile, crater, entry=self.entry_crater,
+                                 ratio=crater_ratio)
                       if target.debonded or self.entry_crater else [])
         tops = [top for top, _ in self.zones[int(self.entry_crater):]]
         self._zone_tops = sorted({t for t in tops if t not in target.interface_depths})

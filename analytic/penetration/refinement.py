@@ -20,8 +20,16 @@ exceeds its tolerance (or the refined run ends otherwise or has other phases). d
 "Convergence" measures how far one refinement is from the converged value.
 """
 
-from cavex.analytic.penetration.body import build_body
-from cavex.analytic.penetration.oblique import PEAK_SPAN, ObliqueModel, overload_peaks, peaks
+from cavex.analytic.penetration.body import AZIMUTHS, NOSE_POINTS, SHANK_RINGS, build_body
+from cavex.analytic.penetration.oblique import (
+    ATOL,
+    CONTACT_RAMP,
+    PEAK_SPAN,
+    RTOL,
+    ObliqueModel,
+    overload_peaks,
+    peaks,
+)
 
 RTOL_FACTOR = 3.0  # rtol and atol of the refined run: the run's / this
 RAMP_FACTOR = 2.0  # contact ramp (or held contact's depth) of the refined run: the run's / this
@@ -57,7 +65,16 @@ def refined_model(model):
         rtol=model.rtol / RTOL_FACTOR, atol=model.atol / RTOL_FACTOR, method=model.method,
         contact_ramp=model.contact_ramp / RAMP_FACTOR, crater=model.crater,
         tangency_psi=model.tangency_psi, entry_crater=model.entry_crater,
-        contact_hold=model.contact_hold / RAMP_FACTOR, hold_time=model.hold_time)
+        contact_hold=model.contact_hold / RAMP_FACTOR, hold_time=model.hold_time,
+        crater_ratio=model.crater_ratio)
+
+
+def refined_options(projectile):
+    """The refined rerun's discretisation as keywords of
+    :func:`cavex.analytic.penetration.oblique.fly` (from the defaults)."""
+    return {"body": build_body(projectile, 2 * NOSE_POINTS, 2 * AZIMUTHS, 2 * SHANK_RINGS),
+            "rtol": RTOL / RTOL_FACTOR, "atol": ATOL / RTOL_FACTOR,
+            "contact_ramp": CONTACT_RAMP / RAMP_FACTOR}
 
 
 def reported(result):
