@@ -103,3 +103,14 @@ def test_debonded_study_marks_rows_that_move_one_ulp_faster():
     assert "lateral peak over one nose length" in report
     bonded = table_csv(nominal)  # bonded: no low-pass or ulp columns
     assert "one_ulp_stable" not in bonded and "low_pass" not in bonded
+
+
+def test_committed_debonded_low_pass_peaks():
+    """results/oblique/debonded/study.csv: every shot at both levels, and the peak of a running
+    mean never exceeds the raw peak (both written to 3 digits)."""
+    path = Path(__file__).resolve().parents[1] / "results" / "oblique" / "debonded" / "study.csv"
+    rows = list(csv.DictReader(path.open()))
+    assert len(rows) == 96 and {r["discretisation"] for r in rows} == {"default", "refined"}
+    for row in rows:
+        raw, mean = float(row["max_lateral_g"]), float(row["max_lateral_low_pass_g"])
+        assert mean <= raw * (1.0 + 1e-2) + 1.0  # 3 digits each; 1 g the noise floor
