@@ -12,7 +12,8 @@ Prints
   the integrator tolerance and the contact regularisation ``contact_ramp``, with the relative
   change of the depth against the last level.
 
-Run as ``python benchmarks/oblique_speed.py [--quick]``.
+Run as ``python benchmarks/oblique_speed.py [--quick | --paired]`` (``--paired``: the default
+shot before and after issue 30's 16-point nose rule, interleaved).
 """
 
 import statistics
@@ -70,6 +71,26 @@ def timing(target, projectile, law, repeats):
                   f"over {repeats}")
 
 
+def paired(target, projectile, law, repeats):
+    """The default shot in-process before and after issue 30's default surface rule (8 nose
+    points before, :data:`NOSE_POINTS` now; the same code otherwise), interleaved runs,
+    medians of wall and CPU time and their ratio."""
+    bodies = {"before (8 nose points)": build_body(projectile, 8),
+              f"now ({NOSE_POINTS} nose points)": build_body(projectile)}
+    times = {name: ([], []) for name in bodies}
+    for _ in range(repeats):
+        for name, body in bodies.items():
+            _, _, steps, wall, cpu = run(target, projectile, law, body=body)
+            times[name][0].append(wall)
+            times[name][1].append(cpu)
+    medians = {name: (statistics.median(w), statistics.median(c))
+               for name, (w, c) in times.items()}
+    for name, (wall, cpu) in medians.items():
+        print(f"paired, {name}: median {wall:.3f} s wall ({cpu:.3f} s CPU) over {repeats}")
+    (w0, c0), (w1, c1) = medians.values()
+    print(f"paired ratio now / before: {w1 / w0:.2f} wall, {c1 / c0:.2f} CPU")
+
+
 def series(label, rows):
     depth = np.array([r[1] for r in rows])
     print(f"\n{label}:")
@@ -91,9 +112,13 @@ def spread(target, projectile, law):
           f"pitch {np.ptp(pitch):.2e} deg")
 
 
-def main(quick=False):
+def main(quick=False, pair=False):
     target, projectile = load_config()
     law = make_law(target, projectile, "derived")
+    if pair:
+        run(target, projectile, law)  # compiled and warm
+        paired(target, projectile, law, 11)
+        return
     timing(target, projectile, law, 5)
     if quick:
         return
@@ -131,4 +156,4 @@ def main(quick=False):
 
 
 if __name__ == "__main__":
-    main(quick="--quick" in sys.argv)
+    main(quick="--quick" in sys.argv, pair="--paired" in sys.argv)

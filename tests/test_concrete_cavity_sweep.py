@@ -13,7 +13,7 @@ import pytest
 
 from cavex.analytic import concrete_cavity as cc
 from cavex.analytic.concrete_cavity import CRACKED, NoSolution, solve
-from cavex.verification.validation.concrete_model import concrete_cavity
+from cavex.analytic.penetration.concrete_table import concrete_cavity
 
 RHO = 2400.0
 STRENGTHS = np.linspace(10e6, 250e6, 101)

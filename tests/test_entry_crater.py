@@ -119,7 +119,7 @@ def test_entry_crater_off_is_the_committed_study(default):
     result = fly(target, projectile, SHOT, entry_crater=False)
     assert result.model.zones == [] and result.model.opened.shape == (0, 2)
     case = {"target": "runway", "obliquity_deg": 20.0, "speed_m_s": 600.0,
-            "contact_ramp_m_s": 0.01}
+            "discretisation": "default"}
     row = _row({**case, **shot_summary(result, target.interface_depths[0] - APPROACH,
                                                 nose_length(projectile))})
     study = Path(__file__).resolve().parents[1] / "results" / "oblique" / "study.csv"

@@ -15,8 +15,10 @@ The shank is the cylinder ``rho = r`` from ``l_n`` to the overall length, normal
 it meets target material only in a tail slap or a ricochet, outside this model).
 
 Surface quadrature: Gauss-Legendre in ``phi`` (:func:`cavex.analytic.penetration.nose.angle_rule`,
-the rule of the 1-D nose force :func:`~cavex.analytic.penetration.nose.nose_rule`, so that an
-axisymmetric stress field gives the 1-D nose force to round-off), the midpoint rule in ``theta``
+the rule of the 1-D nose force :func:`~cavex.analytic.penetration.nose.nose_rule`, which with
+its 8 points gives the 1-D nose force to round-off in an axisymmetric stress field; the 3-D
+default is 16 points: at 8 the turn at a debonded interface is a discretisation artefact,
+docs/oblique.md "Convergence"), the midpoint rule in ``theta``
 and in the shank's axial coordinate. The azimuths are placed in mirror pairs
 ``theta_k = (k + 1/2) 2 pi / n`` and ``-theta_k`` (computed as the negative, so that the pair's
 coordinates are exact mirrors); ``partners`` maps each element to its mirror image. Each
@@ -35,10 +37,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import quad
 
-from cavex.analytic.penetration.nose import QUADRATURE_POINTS, angle_rule
+from cavex.analytic.penetration.nose import angle_rule
 from cavex.errors import require
 
-NOSE_POINTS = QUADRATURE_POINTS  # the 1-D nose force's rule: the same nodes in phi
+NOSE_POINTS = 16  # Gauss points in phi; convergence: docs/oblique.md "Convergence"
 AZIMUTHS = 16
 SHANK_RINGS = 16
 
@@ -80,6 +82,8 @@ class Body:
     nose: np.ndarray
     partners: np.ndarray
     outline: np.ndarray
+    #: ``(nose_points, azimuths, shank_rings)`` of the surface rule
+    shape: tuple = (0, 0, 0)
 
     @property
     def inertia(self):
@@ -177,4 +181,4 @@ def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rin
         partners=np.concatenate([(ring * azimuths + mirror[None, :]).ravel()
                                  for ring in (np.arange(nose_points)[:, None],
                                               nose_points + np.arange(shank_rings)[:, None])]),
-        outline=outline)
+        outline=outline, shape=(nose_points, azimuths, shank_rings))

@@ -40,7 +40,7 @@ from cavex.analytic.penetration.surface_force import (
     rotation_matrix,
     surface_loads,
 )
-from cavex.analytic.penetration.zones import open_zones, union
+from cavex.analytic.penetration.zones import CRATER_RATIO, open_zones, union
 from cavex.errors import CavexNumericalError, is_finite_number, require
 
 G = 9.80665  # m/s^2, for overloads in g
@@ -112,6 +112,7 @@ class Result:
     end: dict
     solutions: list = field(default_factory=list, repr=False)
     model: object = field(default=None, repr=False)
+    strike: object = field(default=None, repr=False)
 
     def state(self, t):
         """State vector at time ``t`` (dense output of the phase that contains it)."""
@@ -149,7 +150,7 @@ class ObliqueModel:
     def __init__(self, target, projectile, law, *, body=None, bottom=None, rtol=RTOL,
                  atol=ATOL, method=METHOD, contact_ramp=None, crater="nose-base",
                  tangency_psi=0.0, entry_crater=False, contact_hold=0.0,
-                 hold_time=None):
+                 hold_time=None, crater_ratio=CRATER_RATIO):
         self.target, self.projectile, self.law = target, projectile, law
         self.body = body or build_body(projectile)
         self.bottom = bottom
@@ -168,6 +169,8 @@ class ObliqueModel:
         require(not (self.contact_hold and tangency_psi), "tangency_psi",
                 "0 with the held contact (the attenuation is a velocity ramp)", tangency_psi)
         self.mu = float(projectile.mu)
+        # (kept for a refined rerun; crater_ratio: zones.crater_depth's, a study's setting)
+        self.crater, self.tangency_psi, self.crater_ratio = crater, tangency_psi, crater_ratio
         require(is_finite_number(tangency_psi) and 0.0 <= tangency_psi <= 30.0,
                 "tangency_psi", "in [0, 30] degrees", tangency_psi)
         # OFPM's attenuation within psi of tangency (docs/oblique.md "Tunnel wall"; 0: none)
@@ -185,7 +188,8 @@ class ObliqueModel:
         # entry crater [0, L_c] comes first and is open from the start (the nose tip starts on
         # the surface, its top)
         self.entry_crater = bool(entry_crater)
-        self.zones = (open_zones(target, projectile, crater, entry=self.entry_crater)
+        self.zones = (open_zones(target, projectile, crater, entry=self.entry_crater,
+                                 ratio=crater_ratio)
                       if target.debonded or self.entry_crater else [])
         tops = [top for top, _ in self.zones[int(self.entry_crater):]]
         self._zone_tops = sorted({t for t in tops if t not in target.interface_depths})
@@ -337,7 +341,7 @@ class ObliqueModel:
             raise CavexNumericalError(f"more than {max_phases} phases")
         history = self._history(sols, surfaces)
         return Result(history=history, phases=phases, end=self._end_state(y, t0, reason),
-                      solutions=sols, model=self)
+                      solutions=sols, model=self, strike=strike)
 
     def _compiled_phase(self, t0, y, directions, args, progress):
         """One phase with the compiled ROS2 integrator
@@ -464,13 +468,20 @@ PEAK_SPAN = 0.04  # m of nose-tip travel, about the nose length (0.0415 m for Ta
 
 
 def overload_peaks(history, rise=PEAK_RISE, span=PEAK_SPAN):
-    """Nose-tip depths (m) and values (g) of the peaks of the axial overload: samples ``g_i``
-    that are the largest over the next ``span`` of nose-tip travel (``[z_i, z_i + span]``),
-    rise above the dip before them, the smallest over ``[z_i - span, z_i]``, by at least
-    ``rise`` x ``g_i``, and reach ``rise`` x the shot's largest overload. A peak counts by the
-    rise it makes, not by what follows (a peak entering a stronger layer is not hidden by a
-    larger overload later); the forward span drops the ripples of a rising overload (the nose's
-    element rings entering one by one) and keeps one peak per nose length of travel."""
+    """Nose-tip depths (m) and values (g) of the peaks of the axial overload, one per event
+    (:func:`merge_peaks` of :func:`peak_candidates`)."""
+    return merge_peaks(peak_candidates(history, rise, span), span)
+
+
+def peak_candidates(history, rise=PEAK_RISE, span=PEAK_SPAN):
+    """Local maxima ``g_i`` of the axial overload that are the largest over the next ``span``
+    of nose-tip travel (``[z_i, z_i + span]``), rise above the dip before them, the smallest
+    over ``[z_i - span, z_i]``, by at least ``rise`` x ``g_i``, and reach ``rise`` x the shot's
+    largest overload. A peak counts by the rise it makes, not by what follows (a peak entering
+    a stronger layer is not hidden by a larger overload later); the forward span drops the
+    ripples of a rising overload (the nose's element rings entering one by one). The ripples
+    of a falling overload pass (each is the largest ahead and high above the dip before the
+    event): :func:`merge_peaks` makes them one."""
     g, z = np.asarray(history["axial_g"]), np.asarray(history["tip_z_m"])
     found = []
     for i in range(1, g.size - 1):
@@ -483,6 +494,29 @@ def overload_peaks(history, rise=PEAK_RISE, span=PEAK_SPAN):
         if g[ahead].max() <= g[i] and g[i] - g[before].min() >= rise * g[i]:
             found.append((float(z[i]), float(g[i])))
     return found
+
+
+def merge_peaks(found, span=PEAK_SPAN):
+    """The peaks ``[(z, g), ...]`` (in the order of travel) with the ripples of one event
+    merged: a peak within ``span`` of nose-tip depth of the first peak of the current group
+    joins it, and the group is reported as its largest peak.
+
+    Why ``span`` (the nose length): an event is the nose meeting a face (the free surface, an
+    interface, the edge of an open zone), and the nose's load changes while its length ``l_n``
+    crosses that face, i.e. over ``l_n`` of nose-tip travel; within it the overload ripples
+    as the element rings of the surface rule cross the face one by one (their number and depth
+    change with the rule, docs/oblique.md). Distinct events are further apart: the runway's
+    layers are 0.45 m and more, and a rear zone's top is 2.12 d = 0.053 m above its interface
+    (Table 1: l_n = 0.0415 m)."""
+    merged, start = [], None
+    for z, g in found:
+        if merged and abs(z - start) <= span:
+            if g > merged[-1][1]:
+                merged[-1] = (z, g)
+        else:
+            merged.append((z, g))
+            start = z
+    return merged
 
 
 def peaks(history):

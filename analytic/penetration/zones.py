@@ -38,10 +38,11 @@ SCAB_CALIBRES = 2.12
 STAGES = ("crater", "tunnel", "rear face")
 
 
-def crater_depth(projectile, crater="nose-base"):
-    """Nose-tip travel ``L_c`` (m) of a crater stage from the face it starts at."""
+def crater_depth(projectile, crater="nose-base", ratio=CRATER_RATIO):
+    """Nose-tip travel ``L_c`` (m) of a crater stage from the face it starts at (``ratio``: the
+    crater depth in shank radii, the paper's 4.5; a sensitivity setting of the 3-D study)."""
     require_choice(crater, CRATER_MODES, "crater")
-    length = CRATER_RATIO * projectile.r
+    length = ratio * projectile.r
     return length + projectile.l if crater == "nose-base" else length
 
 
@@ -54,19 +55,19 @@ def scab_depth(target, projectile, j):
     return min(SCAB_CALIBRES * 2.0 * projectile.r, target.thicknesses[j])
 
 
-def open_zones(target, projectile, crater="nose-base", entry=False):
+def open_zones(target, projectile, crater="nose-base", entry=False, ratio=CRATER_RATIO):
     """``[(top, bottom), ...]`` (m) of the 3-D model's zones, each opening when the nose tip
     crosses ``top``: for every debonded interface ``H_j`` the rear zone ``[H_j - s_j, H_j]``
     and the crater ``[H_j, H_j + L_c]``; with ``entry`` the entry crater ``[0, L_c]``. The
     crater bands are cut at the next interface."""
-    zones = [(0.0, min(crater_depth(projectile, crater), *target.interface_depths[:1],
+    zones = [(0.0, min(crater_depth(projectile, crater, ratio), *target.interface_depths[:1],
                        float("inf")))] if entry else []
     depths = target.interface_depths
     for j in target.debonded:
         H = depths[j]
         below = depths[j + 1] if j + 1 < len(depths) else float("inf")
         zones.append((H - scab_depth(target, projectile, j), H))
-        zones.append((H, min(H + crater_depth(projectile, crater), below)))
+        zones.append((H, min(H + crater_depth(projectile, crater, ratio), below)))
     return zones
 
 

@@ -73,6 +73,10 @@ def add_arguments(parser):
                         "each element's load rises over this push into its wall, then it cuts "
                         "(m in [1e-7, 1e-5]; not with --contact-ramp or --tangency-psi; default: "
                         "off, the velocity ramp; docs/oblique.md)")
+    parser.add_argument("--estimate", action="store_true",
+                        help="fly each run again with every discretisation parameter refined and "
+                        "report the change of each reported quantity as its estimate "
+                        "(summary.json 'estimate'; docs/oblique.md)")
     parser.add_argument("--tunnel-wall", type=float, help="factor in [0, 1] on the shank's load "
                         "in every layer (a sensitivity setting, uncalibrated; default: each "
                         "layer's tunnel_wall key, else 1; docs/oblique.md)")
@@ -247,7 +251,7 @@ def summary(job):
                                   "rate)") from None
     main = runs["runway"]
     document = {"end": main["end"], "phases": main["phases"], "settings": job["settings"],
-                "runs": runs}
+                "runs": runs, **({"estimate": job["estimate"]} if "estimate" in job else {})}
     return document if "outputs" not in job else {**document, "outputs": job["outputs"]}
 
 
@@ -261,7 +265,8 @@ def write_outputs(job, out, draw=True):
                for name, result in job["runs"].items()]
     path = folder / "summary.json"
     document = summary(job)
-    text = json.dumps({"settings": document["settings"], "runs": document["runs"]}, indent=2)
+    text = json.dumps({k: document[k] for k in ("settings", "runs", "estimate") if k in document},
+                      indent=2)
     write_text_atomic(path, text + "\n")
     written.append(str(path))
     if draw:
@@ -322,6 +327,9 @@ def run(args, target, projectile):
                 f"the {name} trajectory " + ("is not finite" if not finite else
                 "ended at t = 0 s: the integrator could not advance (a shot too slow, or "
                 "forces far beyond the projectile's mass and inertia)"))
+    if getattr(args, "estimate", False):  # one refined rerun (analytic/penetration/refinement)
+        from cavex.analytic.penetration.refinement import estimate_runs
+        job["estimate"] = estimate_runs(job["runs"])
     summary(job)  # the peaks and rates are finite too, before anything is written
     job["outputs"] = write_staged(folder,
                                   lambda stage: write_outputs(job, stage, draw=args.figures))
@@ -344,5 +352,8 @@ def text(job):
         lines.append(f"end: {e['state']}, nose tip ({tip}) m, pitch "
                      f"{e['pitch_deg']:.2f} deg; peaks: axial {s['max_axial_g']:.0f} g, "
                      f"lateral {s['max_lateral_g']:.0f} g")
+    if "estimate" in document:
+        from cavex.analytic.penetration.refinement import verdict
+        lines += ["", *verdict(document["estimate"])]
     lines += ["", "wrote: " + ", ".join(document["outputs"])]
     return "\n".join(lines)

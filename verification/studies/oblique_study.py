@@ -5,8 +5,11 @@ paper's two 3-D findings?
 lower the striking velocity; (ii) the overload history has a peak at each interface.
 
 Every shot of the grid (obliquities x striking velocities, zero angle of attack, derived
-dynamic resistance with the free surface, the default contact regularisation) is flown into
-the runway and into its first layer alone (the paper's comparison). Per shot: end state,
+dynamic resistance with the free surface, the default discretisation) is flown into
+the runway and into its first layer alone (the paper's comparison), and again refined (every
+discretisation parameter at once, :mod:`cavex.analytic.penetration.refinement`): each number
+is reported with its estimate, the change under that refinement, and an overload peak only
+if it survives it. Per shot: end state,
 final nose tip, final pitch, pitch change, largest pitch rate, overload peaks (local maxima of
 the axial overload that rise above the dip before them by 5 % of their value,
 :func:`cavex.analytic.penetration.oblique.overload_peaks`) and their nose-tip depths.
@@ -27,7 +30,13 @@ import sys
 import numpy as np
 
 from cavex.analytic.models import fly
-from cavex.analytic.penetration.oblique import CONTACT_RAMP, Strike, overload_peaks, peaks
+from cavex.analytic.penetration.oblique import PEAK_SPAN, Strike, overload_peaks, peaks
+from cavex.analytic.penetration.refinement import (
+    PEAK_TOLERANCE,
+    angle_tolerance,
+    matched_peaks,
+    refined_options,
+)
 from cavex.config import load_config
 from cavex.verification.fedata.runner import run_cases
 from cavex.verification.output.files import save_figure, write_text_atomic
@@ -46,28 +55,25 @@ PEAK_WINDOW = (0.1, 0.166)
 # the attitude change "at the interfaces" is counted from a nose-tip depth this far above the
 # first interface (the same window): before it, layered and concrete-only shots are alike
 APPROACH = PEAK_WINDOW[0]
-# every shot at the default contact regularisation and at three times it: the attitude change
-# at the interfaces is first order in the ramp, and is extrapolated to ramp -> 0
-RAMPS = (CONTACT_RAMP, 3.0 * CONTACT_RAMP)
+# every shot at the default discretisation and refined (refinement.refined_options)
+LEVELS = ("default", "refined")
 # run-to-run spread of the added change (layered - concrete, twice the measured 8.5e-6 deg of
-# each, see DECIMALS) and of its linear extrapolation 1.5 fine - 0.5 coarse: an extrapolated
-# value counts as non-zero only beyond its estimate plus this spread
+# each, see DECIMALS): an added change counts as non-zero only beyond its estimate plus this
 ADDED_SPREAD_DEG = 2.0 * 8.5e-6
-EXTRAPOLATION_SPREAD_DEG = ADDED_SPREAD_DEG * (1.0 + 2.0 * RAMPS[0] / (RAMPS[1] - RAMPS[0]))
 DEFAULT_DIR = "results/oblique"
 
 
-def study_cases(obliquities=OBLIQUITIES, velocities=VELOCITIES, ramps=RAMPS,
-                interfaces="bonded"):
-    """The shots of the grid; ``interfaces``: the runway's interfaces, all bonded or all
-    debonded (docs/oblique.md "Debonded interfaces")."""
-    cases = [{"id": f"{'layered' if t == 'runway' else 'homogeneous'}_{o:g}deg_{v:g}_{r:g}",
-              "target": t, "obliquity_deg": o, "speed_m_s": v, "contact_ramp_m_s": r,
+def study_cases(obliquities=OBLIQUITIES, velocities=VELOCITIES, interfaces="bonded"):
+    """The shots of the grid, each at the default discretisation and refined; ``interfaces``:
+    the runway's interfaces, all bonded or all debonded (docs/oblique.md "Debonded
+    interfaces")."""
+    cases = [{"id": f"{'layered' if t == 'runway' else 'homogeneous'}_{o:g}deg_{v:g}_{d}",
+              "target": t, "obliquity_deg": o, "speed_m_s": v, "discretisation": d,
               "interfaces": interfaces}
-             for o in obliquities for v in velocities for t in TARGETS for r in ramps]
-    if interfaces == "debonded":  # each runway shot again one ulp faster: does its row hold?
+             for o in obliquities for v in velocities for t in TARGETS for d in LEVELS]
+    if interfaces == "debonded":  # each default runway shot again one ulp faster
         cases += [{**c, "id": c["id"] + "_ulp", "ulp": True} for c in cases
-                  if c["target"] == "runway"]
+                  if c["target"] == "runway" and c["discretisation"] == "default"]
     return cases
 
 
@@ -109,76 +115,92 @@ def study_chunk(chunk):
             if case.get("ulp"):
                 speed = float(np.nextafter(speed, np.inf))
             strike = Strike(speed, obliquity=case["obliquity_deg"])
-            out.append(shot_summary(fly(t, projectile, strike,
-                                        contact_ramp=case["contact_ramp_m_s"]), approach,
+            options = (refined_options(projectile) if case["discretisation"] == "refined"
+                       else {})
+            out.append(shot_summary(fly(t, projectile, strike, **options), approach,
                                     nose_length(projectile)))
         except Exception as exc:  # noqa: BLE001 (reported per case)
             out.append(exc)
     return out
 
 
-def _pairs(results, ramp=CONTACT_RAMP):
-    """``(obliquity, V, layered, concrete only)`` of every shot at contact ramp ``ramp``."""
+def _pairs(results, level="default"):
+    """``(obliquity, V, layered, concrete only)`` of every shot at discretisation ``level``."""
     by = {(r["obliquity_deg"], r["speed_m_s"], r["target"]): r for r in results
-          if r["contact_ramp_m_s"] == ramp}
+          if r["discretisation"] == level}
     keys = sorted({(r["obliquity_deg"], r["speed_m_s"]) for r in results})
     return [(o, v, by[(o, v, "runway")], by[(o, v, "first layer only")]) for o, v in keys]
 
 
-def _added(results, ramp):
+def _added(results, level):
     """Added pitch change near the interfaces (layered - concrete, deg) of every oblique shot
-    that reaches the approach depth in both targets, at contact ramp ``ramp``."""
+    that reaches the approach depth in both targets, at discretisation ``level``."""
     return {(o, v): lay["pitch_change_deep_deg"] - hom["pitch_change_deep_deg"]
-            for o, v, lay, hom in _pairs(results, ramp)
+            for o, v, lay, hom in _pairs(results, level)
             if o > 0.0 and lay["pitch_change_deep_deg"] is not None
             and hom["pitch_change_deep_deg"] is not None}
 
 
-def extrapolated_added(results):
-    """``{(obliquity, V): (added change at V_r -> 0, its estimate)}``: linear (first-order)
-    extrapolation from the default contact ramp and three times it (the added change is
-    first order in the ramp, docs/oblique.md); the estimate is the distance of the default's
-    value from the extrapolated one."""
-    fine, coarse = _added(results, RAMPS[0]), _added(results, RAMPS[1])
-    out = {}
-    for key in fine.keys() & coarse.keys():
-        limit = fine[key] - (coarse[key] - fine[key]) * RAMPS[0] / (RAMPS[1] - RAMPS[0])
-        out[key] = (limit, abs(fine[key] - limit))
-    return out
+def estimated_added(results):
+    """``{(obliquity, V): (added change at the default discretisation, its estimate)}``: the
+    estimate is the change under the refinement (refinement.refined_options)."""
+    default, fine = _added(results, "default"), _added(results, "refined")
+    return {key: (default[key], abs(default[key] - fine[key]))
+            for key in default.keys() & fine.keys()}
+
+
+def surviving_peaks(lay, fine):
+    """The overload peaks of the default run ``lay`` that survive the refinement (a peak of
+    the refined run ``fine`` within one nose length): ``[(z, g, estimate)]``, and the others
+    ``[(z, g)]``."""
+    kept, lost = [], []
+    for (z, g), match in matched_peaks(lay["overload_peaks"], fine["overload_peaks"]):
+        if match is None:
+            lost.append((z, g))
+        else:
+            kept.append((z, g, abs(g - match[1])))
+    return kept, lost
 
 
 def faster_results(results, faster):
-    """``results`` with every runway row replaced by the one flown one ulp faster."""
-    return [faster[(r["obliquity_deg"], r["speed_m_s"], r["contact_ramp_m_s"])]
-            if r["target"] == "runway" else r for r in results]
+    """``results`` with every default runway row replaced by the one flown one ulp faster."""
+    return [faster[(r["obliquity_deg"], r["speed_m_s"], r["discretisation"])]
+            if r["target"] == "runway" and r["discretisation"] == "default" else r
+            for r in results]
 
 
 def findings(results, interfaces, faster=None):
-    """Answers to (i) and (ii) computed from the shots (dict of numbers); with ``faster``
-    (:func:`split_ulp`) an extrapolated added change counts as resolved only beyond its
-    estimate plus the larger of the bonded spread and its own change one ulp faster."""
-    # (i): attitude change from the approach depth on, layered against concrete alone, in the
-    # oblique shots whose nose reaches that depth in both targets; at the default ramp and
-    # extrapolated to ramp -> 0
-    added = _added(results, CONTACT_RAMP)
-    limits = extrapolated_added(results)
+    """Answers to (i) and (ii) computed from the shots (dict of numbers). (i): an added change
+    counts as resolved when it exceeds its estimate (the change under the refinement) plus its
+    run-to-run spread (with ``faster``, :func:`split_ulp`, the larger of the bonded spread and
+    its own change one ulp faster). (ii): a crossing has a peak when the default run has one
+    in the window that survives the refinement (:func:`surviving_peaks`); resolved when its
+    estimate is within 3 %."""
+    estimated = estimated_added(results)
+    added = {k: x for k, (x, _) in estimated.items()}
     stops_before = sorted({(o, v) for o, v, lay, _ in _pairs(results)
                            if o > 0.0 and lay["pitch_change_deep_deg"] is None})
-    spread = dict.fromkeys(limits, EXTRAPOLATION_SPREAD_DEG)
+    spread = dict.fromkeys(estimated, ADDED_SPREAD_DEG)
     if faster:
-        for key, (x, _) in extrapolated_added(faster_results(results, faster)).items():
+        for key, x in _added(faster_results(results, faster), "default").items():
             if key in spread:
-                spread[key] = max(spread[key], abs(x - limits[key][0]))
-    resolved = {k: x for k, (x, e) in limits.items() if abs(x) > e + spread[k]}
-    # (ii): an overload peak near each interface the nose tip crossed
-    crossed = peaked = 0
-    for _, _, lay, _ in _pairs(results):
+                spread[key] = max(spread[key], abs(x - added[key]))
+    resolved = {k: x for k, (x, e) in estimated.items() if abs(x) > e + spread[k]}
+    within = {k for k, (x, e) in estimated.items() if e <= angle_tolerance(x)}
+    fine = {(o, v): lay for o, v, lay, _ in _pairs(results, "refined")}
+    crossed = peaked = lost = resolved_peaks = 0
+    for o, v, lay, _ in _pairs(results):
+        kept, gone = surviving_peaks(lay, fine[(o, v)])
         for H in interfaces:
             if lay["tip_z_m"] > H:
                 crossed += 1
-                if any(H - PEAK_WINDOW[0] <= z <= H + PEAK_WINDOW[1]
-                       for z, _ in lay["overload_peaks"]):
-                    peaked += 1
+                near = [(z, g, e) for z, g, e in kept
+                        if H - PEAK_WINDOW[0] <= z <= H + PEAK_WINDOW[1]]
+                peaked += bool(near)
+                resolved_peaks += bool(near) and all(e <= PEAK_TOLERANCE * g
+                                                      for _, g, e in near)
+                lost += any(H - PEAK_WINDOW[0] <= z <= H + PEAK_WINDOW[1] for z, _ in gone)
+
     def span(values):
         return [min(values), max(values)] if values else None
 
@@ -186,20 +208,21 @@ def findings(results, interfaces, faster=None):
             "stop_before_the_interface": [f"{o:g} deg {v:g} m/s" for o, v in stops_before],
             "added_change_range_deg": span(list(added.values())),
             "toward_the_normal": sum(1 for x in added.values() if x < 0.0),
-            "extrapolated_added_change_range_deg": span([x for x, _ in limits.values()]),
-            "largest_extrapolation_estimate_deg": max((e for _, e in limits.values()),
-                                                      default=None),
-            "resolved_nonzero_after_extrapolation": len(resolved),
+            "largest_estimate_deg": max((e for _, e in estimated.values()), default=None),
+            "within_tolerance": len(within),
+            "resolved_nonzero": len(resolved),
             "largest_spread_deg": max(spread.values(), default=None),
             "interfaces_crossed": crossed, "interfaces_with_a_peak": peaked,
-            "added_change_deg": {f"{o:g} deg, {v:g} m/s": x
-                                 for (o, v), x in sorted(added.items())}}
+            "interface_peaks_resolved": resolved_peaks,
+            "interface_peaks_not_surviving": lost,
+            "added_change_deg": {f"{o:g} deg, {v:g} m/s": [x, e]
+                                 for (o, v), (x, e) in sorted(estimated.items())}}
 
 
 # --- output -----------------------------------------------------------------------------------
 
-INPUTS = ("obliquity_deg", "speed_m_s", "contact_ramp_m_s")  # written as given
-COLUMNS = ("obliquity_deg", "speed_m_s", "contact_ramp_m_s", "target", "state", "tip_x_m",
+INPUTS = ("obliquity_deg", "speed_m_s", "discretisation")  # written as given
+COLUMNS = ("obliquity_deg", "speed_m_s", "discretisation", "target", "state", "tip_x_m",
            "tip_z_m", "pitch_deg", "pitch_change_deg", "pitch_change_deep_deg",
            "max_pitch_rate_deg_s", "max_axial_g", "max_lateral_g")
 # the debonded study's further columns (issue 20; the bonded study.csv keeps its bytes): the
@@ -210,14 +233,15 @@ DEBONDED_COLUMNS = ("max_lateral_low_pass_g",)
 
 def _row(r, columns=COLUMNS):
     peaks = " ".join(_g(z, "_m") for z, _ in r["overload_peaks"])
-    return (",".join(f"{r[c]:g}" if c in INPUTS else _g(r[c], c) for c in columns)
+    return (",".join(f"{r[c]}" if c == "discretisation" else f"{r[c]:g}" if c in INPUTS
+                     else _g(r[c], c) for c in columns)
             + f",{peaks}")
 
 
 def split_ulp(results):
     """``(results, {(obliquity, V, ramp): the row one ulp faster})``: the debonded study flies
     every runway shot again at the next larger striking speed (:func:`study_cases`)."""
-    faster = {(r["obliquity_deg"], r["speed_m_s"], r["contact_ramp_m_s"]): r
+    faster = {(r["obliquity_deg"], r["speed_m_s"], r["discretisation"]): r
               for r in results if r.get("ulp")}
     return [r for r in results if not r.get("ulp")], faster
 
@@ -230,12 +254,12 @@ def table_csv(results, faster=None):
     lines = [",".join(columns) + ",overload_peak_depths_m"
              + (",one_ulp_stable" if faster else "")]
     for r in sorted(results, key=lambda r: (r["obliquity_deg"], r["speed_m_s"],
-                                            r["contact_ramp_m_s"], r["target"])):
+                                            r["discretisation"], r["target"])):
         line = _row(r, columns)
         if faster:
-            key = (r["obliquity_deg"], r["speed_m_s"], r["contact_ramp_m_s"])
+            key = (r["obliquity_deg"], r["speed_m_s"], r["discretisation"])
             line += ("," + ("yes" if _row(faster[key], columns) == line else "no")
-                     if r["target"] == "runway" else ",")
+                     if key in faster and r["target"] == "runway" else ",")
         lines.append(line)
     return "\n".join(lines) + "\n"
 
@@ -280,14 +304,29 @@ def _span(values):
     return "-" if values is None else " to ".join(_g(x, "_deg") for x in values)
 
 
-def report_md(results, answers, interfaces, faster=None):
+def _pm(value, fine, column):
+    """``value +- |value - fine|`` as written (the estimate to the value's digits)."""
+    if value is None:
+        return "-"
+    if fine is None:
+        return _g(value, column) + " +- ?"
+    return f"{_g(value, column)} +- {_g(abs(value - fine), column)}"
+
+
+def report_md(results, answers, interfaces, faster=None, sensitivity=None):
+    fine = {(o, v): (lay, hom) for o, v, lay, hom in _pairs(results, "refined")}
     lines = ["# Oblique penetration study (generated by `python -m "
              "cavex.verification.studies.oblique_study`)", "",
              f"Default runway (the paper's Table 1) with {results[0].get('interfaces', 'bonded')} "
              "interfaces (docs/oblique.md), zero angle of attack, derived dynamic "
-             f"resistance with the free surface, contact ramp {_g(RAMPS[0])} m/s (the default; "
-             f"every shot is also run at {_g(RAMPS[1])} m/s for the extrapolation); layered "
-             "against the first layer (concrete) alone. Depths are nose-tip depths; pitch is the "
+             "resistance with the free surface, the default discretisation (16 nose points, 16 "
+             "azimuths, 16 shank rings, rtol 1e-3, contact ramp 0.01 m/s); layered against the "
+             "first layer (concrete) alone. Every shot was flown again refined (32 / 32 / 32, "
+             "rtol 3.3e-4, ramp 0.005 m/s; `cavex trajectory --estimate`): each number is "
+             "written `value +- estimate`, the estimate being its change under that "
+             "refinement, and an overload peak is listed only if the refined run has one within "
+             "a nose length of it (docs/oblique.md \"Convergence\" measures how far one "
+             "refinement is from the converged value). Depths are nose-tip depths; pitch is the "
              "axis angle from the target normal, positive toward the striking direction. "
              "Digits: each quantity is rounded well above its measured run-to-run spread "
              "(`DECIMALS`, `SIGNIFICANT` in verification/studies/oblique_study.py).", "",
@@ -298,56 +337,61 @@ def report_md(results, answers, interfaces, faster=None):
              "| lateral peak layered / concrete (g) | "
              + ("lateral peak over one nose length of travel layered / concrete (g) | "
                 if faster else "")
-             + "layered overload peaks at tip depth (m) | "
-             "added pitch change at the interfaces, contact ramp -> 0 (deg) |",
+             + "layered overload peaks (tip depth m: g), surviving the refinement | "
+             "added pitch change at the interfaces (deg) |",
              "|---|---|---|---|---|---|---|---|---|---|---|" + ("---|" if faster else "")]
     quantities = ("tip_z_m", "pitch_deg", "pitch_change_deg", "pitch_change_deep_deg",
                   "max_pitch_rate_deg_s", "max_axial_g", "max_lateral_g",
                   *(DEBONDED_COLUMNS if faster else ()))
-    limits = extrapolated_added(results)
+    estimated = estimated_added(results)
     for o, v, lay, hom in _pairs(results):
-        peaks = ", ".join(_g(z, "_m") for z, _ in lay["overload_peaks"]) or "-"
-        limit = (f"{_g(limits[(o, v)][0], '_deg')} +- {_g(limits[(o, v)][1], '_deg')}"
-                 if (o, v) in limits else "-")
+        flay, fhom = fine[(o, v)]
+        kept, lost = surviving_peaks(lay, flay)
+        peaks = ", ".join(f"{_g(z, '_m')}: {_g(g, '_g')} +- {_g(e, '_g')}"
+                          for z, g, e in kept) or "-"
+        if lost:
+            peaks += " (not surviving: " + ", ".join(_g(z, "_m") for z, _ in lost) + ")"
+        added = (f"{_g(estimated[(o, v)][0], '_deg')} +- {_g(estimated[(o, v)][1], '_deg')}"
+                 if (o, v) in estimated else "-")
         lines.append(
             f"| {o:g} | {v:g} | " + " | ".join(
-                f"{_g(lay[c], c)} / {_g(hom[c], c)}" for c in quantities)
-            + f" | {peaks} | {limit} |")
+                f"{_pm(lay[c], flay[c], c)} / {_pm(hom[c], fhom[c], c)}" for c in quantities)
+            + f" | {peaks} | {added} |")
     a = answers
     lines += ["", "## Answers computed from the table", "",
               f"- (i) attitude: {a['shots_reaching_the_interface']} oblique shots reach "
               f"{_g(APPROACH)} m above the first interface (the others stop in concrete: "
-              f"{', '.join(a['stop_before_the_interface']) or 'none'}). From there on, at the "
-              f"default contact ramp ({_g(RAMPS[0])} m/s), the layered runway changes the pitch "
-              "by " + _span(a["added_change_range_deg"]) + " deg more than concrete alone "
-              "(the integrator's run-to-run spread of this difference is up to "
-              + (f"{ADDED_SPREAD_DEG:.1e} deg). " if not faster else
-                 f"{ADDED_SPREAD_DEG:.1e} deg bonded; debonded, see Reproducibility). ")
-              + "This added change is first order in the "
-              f"contact ramp: extrapolated to ramp -> 0 from {_g(RAMPS[0])} and "
-              f"{_g(RAMPS[1])} m/s it is " + _span(a["extrapolated_added_change_range_deg"])
-              + " deg (largest estimate " + _g(a["largest_extrapolation_estimate_deg"], "_deg")
-              + " deg), non-zero beyond its estimate plus the spread "
-              + (f"({EXTRAPOLATION_SPREAD_DEG:.1e} deg) in " if not faster else
-                 "(each shot's own: the change of its extrapolated value one ulp faster, "
-                 f"at least {EXTRAPOLATION_SPREAD_DEG:.1e} deg; largest "
-                 f"{_g(a['largest_spread_deg'], '_deg')} deg) in ")
-              + f"{a['resolved_nonzero_after_extrapolation']} of "
-              f"{a['shots_reaching_the_interface']} shots.",
+              f"{', '.join(a['stop_before_the_interface']) or 'none'}). From there on the "
+              "layered runway changes the pitch by " + _span(a["added_change_range_deg"])
+              + " deg more than concrete alone (largest estimate "
+              + _g(a["largest_estimate_deg"], "_deg") + " deg; within the tolerance "
+              f"max(0.01 deg, 3 %) in {a['within_tolerance']} of "
+              f"{a['shots_reaching_the_interface']}); non-zero beyond its estimate plus the "
+              "run-to-run spread "
+              + (f"({ADDED_SPREAD_DEG:.1e} deg) " if not faster else
+                 "(each shot's own: its change one ulp faster, at least "
+                 f"{ADDED_SPREAD_DEG:.1e} deg; largest {_g(a['largest_spread_deg'], '_deg')} "
+                 "deg) ")
+              + f"in {a['resolved_nonzero']} of {a['shots_reaching_the_interface']} shots.",
               f"- (ii) overload: of {a['interfaces_crossed']} interface crossings by the nose tip "
               f"(interfaces at {', '.join(_g(H) for H in interfaces)} m), "
-              f"{a['interfaces_with_a_peak']} have an axial overload peak at nose-tip depths from "
-              f"{_g(PEAK_WINDOW[0])} m before to {_g(PEAK_WINDOW[1])} m past the interface.",
-              ""]
+              f"{a['interfaces_with_a_peak']} have an axial overload peak that survives the "
+              f"refinement at nose-tip depths from {_g(PEAK_WINDOW[0])} m before to "
+              f"{_g(PEAK_WINDOW[1])} m past the interface ({a['interface_peaks_resolved']} of "
+              "them with an estimate within 3 %); "
+              f"{a['interface_peaks_not_surviving']} crossings have a peak there that does not "
+              "survive the refinement (not counted).", ""]
+    if sensitivity:
+        lines += sensitivity_md(sensitivity)
     if faster:
-        runway = {(r["obliquity_deg"], r["speed_m_s"], r["contact_ramp_m_s"]): r
+        runway = {(r["obliquity_deg"], r["speed_m_s"], r["discretisation"]): r
                   for r in results if r["target"] == "runway"}
-        moved = [f"{o:g} deg {v:g} m/s (ramp {ramp:g} m/s)"
-                 for (o, v, ramp), r in sorted(faster.items())
-                 if _row(runway[(o, v, ramp)]) != _row(r)]
+        moved = [f"{o:g} deg {v:g} m/s"
+                 for (o, v, level), r in sorted(faster.items())
+                 if _row(runway[(o, v, level)]) != _row(r)]
         lines += ["## Reproducibility", "",
-                  "Every runway shot was flown again one ulp faster (`one_ulp_stable` in "
-                  "study.csv). Rows whose written digits change under that change of the "
+                  "Every default runway shot was flown again one ulp faster (`one_ulp_stable` "
+                  "in study.csv). Rows whose written digits change under that change of the "
                   "striking speed do not reproduce to those digits on another CPU (open "
                   "interfaces leave the body unsupported, and its turn amplifies the "
                   "integrator's step decisions): "
@@ -370,23 +414,19 @@ def figures(results, folder, interfaces, runs):
                      label=f"{o:g} deg layered")
         axes[0].plot(v, [p[3]["pitch_change_deg"] for p in pairs], "s--", color=f"C{k}",
                      mfc="none", label=f"{o:g} deg concrete only")
-        for ramp, style in zip(RAMPS, ("o-", "^:"), strict=True):
-            added = _added(results, ramp)
+        for level, style in zip(LEVELS, ("o-", "s--"), strict=True):
+            added = _added(results, level)
             rows = sorted((v, x) for (q, v), x in added.items() if q == o)
             if rows:
                 axes[1].plot(*zip(*rows, strict=True), style, color=f"C{k}",
-                             label=f"{o:g} deg, ramp {ramp:g} m/s")
-        limits = sorted((v, x) for (q, v), (x, _) in extrapolated_added(results).items()
-                        if q == o)
-        if limits:
-            axes[1].plot(*zip(*limits, strict=True), "s--", color=f"C{k}", mfc="none",
-                         label=f"{o:g} deg, ramp -> 0")
+                             mfc="none" if level == "refined" else None,
+                             label=f"{o:g} deg, {level}")
     axes[0].set_ylabel("final pitch - initial pitch (deg)")
     axes[0].set_title("whole path: layered (solid) against concrete alone (dashed)",
                       fontsize=9)
     axes[1].set_ylabel("added pitch change, layered - concrete (deg)")
     axes[1].set_title(f"from {APPROACH:g} m above the first interface on (shots that get "
-                      "there), by contact ramp", fontsize=9)
+                      "there): default and refined discretisation", fontsize=9)
     for a in axes:
         a.set_xlabel("striking velocity (m/s)")
         a.legend(fontsize=7, ncol=2)
@@ -442,28 +482,96 @@ def low_pass(history, length):
 
 
 SHOT = Strike(600.0, obliquity=20.0)  # the paper's shot that reaches the first interface
+# the uncalibrated zone sizes across their ranges (docs/oblique.md "Convergence"): the rear
+# zone in calibres (the modified NDRC constant 2.12, zones.SCAB_CALIBRES) and the crater depth
+# in shank radii (the paper's 4.5; Forrestal et al. 1994: 2 d = 4 r; Li and Chen 2003:
+# (0.707 + l_n / d) d = 4.7 r for this nose)
 SCAB_CALIBRES = (1.5, 2.12, 2.5, 3.0, 3.5)
-WALL_FACTORS = (0.25, 0.5, 0.75, 1.0)
+CRATER_RATIOS = (3.0, 4.0, 4.5, 5.0, 6.0)
 
 
-def interface_figures(folder, target, projectile):
-    """Figures of the debonded study (issue 20): the 600 m/s, 20 deg shot's pitch and
-    overloads against nose-tip depth (bonded, debonded, concrete alone; the open zones
-    shaded), and the sensitivity of its added turn at the first interface to the rear-zone
-    depth, the crater depth and the tunnel-wall factor. Returns the files and the numbers."""
+def interface_peak(result_peaks, H):
+    """The largest overload peak ``(z, g)`` within the window of interface ``H``, or None."""
+    near = [(z, g) for z, g in result_peaks if H - PEAK_WINDOW[0] <= z <= H + PEAK_WINDOW[1]]
+    return max(near, key=lambda p: p[1]) if near else None
+
+
+def zone_sensitivity(target, projectile):
+    """The 600 m/s, 20 deg shot's answers to (i) and (ii) against the zone sizes, default and
+    refined: ``{(setting, value): {"added": (default, refined), "peak": (default (z, g) or
+    None, refined)}}``; (i) the added turn at the first interface (debonded - bonded,
+    :func:`turn_after_interface`), (ii) the axial overload peak at it."""
+    from cavex.analytic.models import make_law
+    from cavex.analytic.penetration.oblique import ObliqueModel
+    from cavex.materials import Target
+
+    H = target.interface_depths[0]
+    levels = ({}, refined_options(projectile))
+    bonded = target.with_interfaces("bonded")
+    base = [turn_after_interface(fly(bonded, projectile, SHOT, **o)) for o in levels]
+    n = len(target.thicknesses)
+    out = {}
+    for key, values in (("rear zone (calibres)", SCAB_CALIBRES),
+                        ("crater (shank radii)", CRATER_RATIOS)):
+        for value in values:
+            scab = value if key.startswith("rear") else 2.12
+            ratio = value if key.startswith("crater") else 4.5
+            runway = Target(target.layers, target.thicknesses, ("debonded",) * n,
+                            (scab * 2.0 * projectile.r,) * n)
+            turns, found = [], []
+            for options, turn0 in zip(levels, base, strict=True):
+                model = ObliqueModel(runway, projectile, make_law(runway, projectile),
+                                     crater_ratio=ratio, **options)
+                result = model.run(SHOT)
+                turn = turn_after_interface(result)
+                turns.append(None if turn is None or turn0 is None else turn - turn0)
+                found.append(interface_peak(overload_peaks(result.history), H))
+            out[(key, value)] = {"added": tuple(turns), "peak": tuple(found)}
+    return out
+
+
+def sensitivity_md(numbers):
+    """The table of :func:`zone_sensitivity` (report.md)."""
+    lines = ["## How the answers move with the uncalibrated zone sizes", "",
+             f"{SHOT.speed:g} m/s at {SHOT.obliquity:g} deg, debonded, each zone size varied "
+             "with the other at its default (rear zone 2.12 calibres, crater 4.5 r from the nose "
+             "base): (i) the added turn at the first interface (debonded - bonded, the phase "
+             "after the crossing) and (ii) the largest axial overload peak within the window of "
+             "the first interface, each `default +- estimate` (the change under the "
+             "refinement); a peak is listed only if the refined run has one within a nose "
+             "length.", "",
+             "| zone | size | (i) added turn (deg) | (ii) interface peak: tip depth (m), g |",
+             "|---|---|---|---|"]
+    for (key, value), entry in numbers.items():
+        a, fine = entry["added"]
+        peak, fine_peak = entry["peak"]
+        if peak is None:
+            text = "none" + ("" if fine_peak is None else
+                             f" (refined: {_g(fine_peak[1], '_g')} g at "
+                             f"{_g(fine_peak[0], '_m')} m)")
+        elif fine_peak is None or abs(fine_peak[0] - peak[0]) > PEAK_SPAN:
+            text = f"none surviving ({_g(peak[1], '_g')} g at {_g(peak[0], '_m')} m)"
+        else:
+            text = (f"{_g(peak[0], '_m')}, {_g(peak[1], '_g')} +- "
+                    f"{_g(abs(peak[1] - fine_peak[1]), '_g')}")
+        lines.append(f"| {key} | {value:g} | {_pm(a, fine, '_deg')} | {text} |")
+    return lines + [""]
+
+
+def interface_figures(folder, target, projectile, numbers):
+    """Figures of the debonded study: the 600 m/s, 20 deg shot's pitch and overloads against
+    nose-tip depth (bonded, debonded, concrete alone; the open zones shaded), and the answers
+    of :func:`zone_sensitivity` (``numbers``) against the zone sizes. Returns the files."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from cavex.analytic.models import make_law
-    from cavex.analytic.penetration.oblique import ObliqueModel
     from cavex.analytic.penetration.zones import open_zones
-    from cavex.materials import Target
 
-    bonded = target.with_interfaces("bonded")
     debonded = target.with_interfaces("debonded")
-    runs = {"bonded": fly(bonded, projectile, SHOT), "debonded": fly(debonded, projectile, SHOT),
+    runs = {"bonded": fly(target.with_interfaces("bonded"), projectile, SHOT),
+            "debonded": fly(debonded, projectile, SHOT),
             "concrete alone": fly(target.single(0), projectile, SHOT)}
     length = nose_length(projectile)
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.4), layout="constrained")
@@ -492,70 +600,62 @@ def interface_figures(folder, target, projectile):
     fig.suptitle(f"{SHOT.speed:g} m/s at {SHOT.obliquity:g} deg: bonded and debonded "
                  "interfaces, and the concrete alone", fontsize=10)
     written = [save_figure(fig, folder / "interface_shot.png", dpi=120, bbox_inches="tight")]
-
-    def added(runway, *, crater="nose-base"):
-        turns = []
-        for t in (runway.with_interfaces("bonded"), runway):
-            model = ObliqueModel(t, projectile, make_law(t, projectile), crater=crater)
-            turns.append(turn_after_interface(model.run(SHOT)))
-        return None if None in turns else turns[1] - turns[0]
-
-    numbers = {"scab_calibres": {}, "tunnel_wall": {}, "crater": {}}
-    n = len(target.thicknesses)
-    for c in SCAB_CALIBRES:
-        scabbed = Target(target.layers, target.thicknesses, ("debonded",) * n,
-                         (c * 2.0 * projectile.r,) * n)
-        numbers["scab_calibres"][c] = added(scabbed)
-    for f in WALL_FACTORS:
-        numbers["tunnel_wall"][f] = added(debonded.with_tunnel_wall(f))
-    for crater in ("nose-tip", "nose-base"):
-        numbers["crater"][crater] = added(debonded, crater=crater)
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4.0), layout="constrained")
-    for a, (key, label) in zip(axes, (("scab_calibres", "rear-zone depth (calibres)"),
-                                      ("tunnel_wall", "tunnel-wall factor"),
-                                      ("crater", "crater depth rule (4.5 r from ...)")),
-                               strict=True):
-        items = [(k, v) for k, v in numbers[key].items() if v is not None]
-        x = list(range(len(items))) if key == "crater" else [k for k, _ in items]
-        a.plot(x, [v for _, v in items], "o" if key == "crater" else "o-")
-        for xi, (_, v) in zip(x, items, strict=True):
-            a.annotate(f"{v:+.2f}", (xi, v), textcoords="offset points", xytext=(4, 4),
-                       fontsize=7)
-        if key == "crater":
-            a.set_xticks(x, [k for k, _ in items])
-            a.set_xlim(-0.5, len(items) - 0.5)
-        if key == "scab_calibres":  # a body that turns over: tens of degrees
-            a.set_yscale("symlog", linthresh=1.0)
-        a.set_xlabel(label)
-        a.grid(alpha=0.3)
-    axes[0].set_ylabel("added turn at interface 1 (deg; symlog, linear within +-1)")
-    axes[1].set_ylabel("added turn at interface 1 (deg)")
-    fig.suptitle(f"Sensitivity of the added turn (debonded - bonded), {SHOT.speed:g} m/s at "
-                 f"{SHOT.obliquity:g} deg (uncalibrated settings)", fontsize=10)
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7), layout="constrained", sharex="col")
+    keys = ("rear zone (calibres)", "crater (shank radii)")
+    for col, key in enumerate(keys):
+        items = [(v, e) for (k, v), e in numbers.items() if k == key]
+        for row, what in enumerate(("added", "peak")):
+            a = axes[row, col]
+            for level, style in ((0, "o-"), (1, "s--")):
+                xs, ys = [], []
+                for v, e in items:
+                    y = e[what][level]
+                    if what == "peak":
+                        y = None if y is None else y[1] / 1e3
+                    if y is not None:
+                        xs.append(v)
+                        ys.append(y)
+                a.plot(xs, ys, style, mfc="none" if level else None,
+                       label="default" if level == 0 else "refined")
+            default = 2.12 if col == 0 else 4.5
+            a.axvline(default, color="0.6", lw=0.8, ls=":")
+            a.grid(alpha=0.3)
+            a.legend(fontsize=7)
+            if what == "added":
+                a.set_ylabel("(i) added turn at interface 1 (deg)")
+                if any(abs(e["added"][0] or 0.0) > 2.0 for _, e in items):
+                    a.set_yscale("symlog", linthresh=1.0)
+                    a.set_ylabel("(i) added turn at interface 1 (deg; symlog, linear "
+                                 "within +-1)")
+            else:
+                a.set_ylabel("(ii) axial peak at interface 1 (thousands of g; none: no point)")
+                a.set_xlabel(key + "; dotted: default")
+    fig.suptitle(f"The answers against the uncalibrated zone sizes, {SHOT.speed:g} m/s at "
+                 f"{SHOT.obliquity:g} deg, debonded", fontsize=10)
     written.append(save_figure(fig, folder / "interface_sensitivity.png", dpi=120,
                                bbox_inches="tight"))
-    return [str(p) for p in written], numbers
+    return [str(p) for p in written]
 
 
 def crossing_figure(results, folder):
-    """The added turn (layered - concrete, from the approach depth on, at the default ramp and
-    extrapolated to ramp -> 0) against the speed at which the nose tip crosses the first
+    """The added turn (layered - concrete, from the approach depth on, at the default and the
+    refined discretisation) against the speed at which the nose tip crosses the first
     interface, one line per obliquity (10-45 deg): does a slower crossing turn more?"""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    added, limits = _added(results, CONTACT_RAMP), extrapolated_added(results)
+    added, fine = _added(results, "default"), _added(results, "refined")
     speed = {(o, v): lay["crossing_speed_m_s"] for o, v, lay, _ in _pairs(results)}
     fig, ax = plt.subplots(figsize=(6.5, 4.2), layout="constrained")
     for k, o in enumerate(sorted({o for o, _ in added if 0.0 < o <= 45.0})):
-        rows = sorted((speed[(q, v)], x, limits[(q, v)][0]) for (q, v), x in added.items()
-                      if q == o and speed[(q, v)] is not None)
+        rows = sorted((speed[(q, v)], x, fine[(q, v)]) for (q, v), x in added.items()
+                      if q == o and speed[(q, v)] is not None and (q, v) in fine)
         if rows:
-            s_, x, lim = zip(*rows, strict=True)
-            ax.plot(s_, x, "o-", color=f"C{k}", label=f"{o:g} deg, ramp {CONTACT_RAMP:g} m/s")
-            ax.plot(s_, lim, "s--", color=f"C{k}", mfc="none", label=f"{o:g} deg, ramp -> 0")
+            s_, x, refined = zip(*rows, strict=True)
+            ax.plot(s_, x, "o-", color=f"C{k}", label=f"{o:g} deg, default")
+            ax.plot(s_, refined, "s--", color=f"C{k}", mfc="none", label=f"{o:g} deg, refined")
     ax.set_yscale("symlog", linthresh=1.0)
     ax.set_xlabel("speed at the first interface (m/s)")
     ax.set_ylabel("added turn, layered - concrete (deg; symlog, linear within +-1)")
@@ -599,13 +699,16 @@ def main(argv=None):
         strike = Strike(v, obliquity=20.0)
         runs[f"runway {v:g} m/s"] = fly(target, projectile, strike)
         runs[f"concrete only {v:g} m/s"] = fly(target.single(0), projectile, strike)
+    numbers = (zone_sensitivity(target, projectile) if args.interfaces == "debonded"
+               and not args.quick else None)
     write_text_atomic(folder / "study.csv", table_csv(results, faster))
-    write_text_atomic(folder / "report.md", report_md(results, answers, interfaces, faster))
+    write_text_atomic(folder / "report.md", report_md(results, answers, interfaces, faster,
+                                                      numbers))
     figures(results, folder, interfaces, runs)
     if args.interfaces == "debonded":
         crossing_figure(results, folder)
-        _, numbers = interface_figures(folder, target, projectile)
-        print(json.dumps({"sensitivity_added_turn_deg": numbers}, indent=1))
+        if numbers:
+            interface_figures(folder, target, projectile, numbers)
     print(json.dumps({k: v for k, v in answers.items() if k != "added_change_deg"}, indent=1))
     return 0
 
