@@ -121,6 +121,27 @@ class Result:
                 return sol.sol(t)
         raise ValueError(f"t = {t} s is outside the trajectory")
 
+    def check_answered(self, name):
+        """A run that reached the 1 s time limit still moving is no answer (a numerical
+        failure naming the run ``name``): either the body has turned tail-first and slides
+        through the target, which resists only surfaces moving into it and has no tail face to
+        plough (a large attack, or one against the obliquity, gets there), or it is too heavy
+        for the target to stop within the time limit."""
+        end = self.end
+        if end["state"] != "time limit":
+            return
+        y = self.solutions[-1].y[:, -1]
+        where = (f"to the {end['time_s']:g} s time limit ({end['speed_m_s']:.3g} m/s, nose "
+                 f"tip {end['nose_tip_m'][2]:.3g} m deep)")
+        if float(np.dot(self.model.axis(y), y[7:10])) < 0.0:
+            why = ("the body turned tail-first and slid " + where + "; the model loads only "
+                   "surfaces moving into the target (no tail face): use a smaller --attack or "
+                   "one toward the obliquity")
+        else:
+            why = (f"the body was still moving nose-first {where}: a body this heavy for the "
+                   "target is beyond the model's time")
+        raise CavexNumericalError(f"the {name} trajectory did not end: {why}")
+
 
 class Segment:
     """One phase of the compiled integrator: accepted times ``t`` (N), states ``y`` and

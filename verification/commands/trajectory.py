@@ -139,7 +139,7 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
         options["table"] = read_table(table)
     with _steps("runway", progress) as step:
         runs = {"runway": fly(target, projectile, strike, resistance, progress=step, **options)}
-    check_answered("runway", runs["runway"])
+    runs["runway"].check_answered("runway")
     if compare_homogeneous and len(target.layers) > 1:
         single = target.single(0)
         resistance_single = get(resistance).first_layer or resistance
@@ -148,7 +148,7 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
         with _steps("first layer only", progress) as step:
             runs["first layer only"] = fly(single, projectile, strike, resistance_single,
                                            progress=step, **options)
-        check_answered("first layer only", runs["first layer only"])
+        runs["first layer only"].check_answered("first layer only")
     settings = {"speed_m_s": strike.speed, "obliquity_deg": strike.obliquity,
                 "attack_deg": strike.attack, "attack_plane_deg": strike.attack_plane,
                 "spin_rad_s": strike.spin, "resistance": resistance, "boundary": boundary,
@@ -170,27 +170,6 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
     if get(resistance).takes_law:
         settings["law"] = law_echo(target, law_A, law_B)
     return {"runs": runs, "settings": settings, "target": target}
-
-
-def check_answered(name, result):
-    """A run that reached the 1 s time limit still moving is no answer (numerical failure):
-    either the body has turned tail-first and slides through the target, which resists only
-    surfaces moving into it and has no tail face to plough (a large attack, or one against the
-    obliquity, gets there), or it is too heavy for the target to stop within the time limit."""
-    end = result.end
-    if end["state"] != "time limit":
-        return
-    y = result.solutions[-1].y[:, -1]
-    where = (f"to the {end['time_s']:g} s time limit ({end['speed_m_s']:.3g} m/s, nose tip "
-             f"{end['nose_tip_m'][2]:.3g} m deep)")
-    if float(np.dot(result.model.axis(y), y[7:10])) < 0.0:
-        why = ("the body turned tail-first and slid " + where + "; the model loads only "
-               "surfaces moving into the target (no tail face): use a smaller --attack or one "
-               "toward the obliquity")
-    else:
-        why = (f"the body was still moving nose-first {where}: a body this heavy for the target "
-               "is beyond the model's time")
-    raise CavexNumericalError(f"the {name} trajectory did not end: {why}")
 
 
 @contextmanager
