@@ -82,11 +82,12 @@ def run(args, target, projectile):
                               "give one per model")
     out = check_output_dir(DEFAULT_OUT if args.out is None else args.out, "out")
     check_execution(workers, scheduler)
-    size = estimate(shot_file.shots, calibrations, out / "tables", workers, models)
+    size = estimate(shot_file.shots, calibrations, None, workers, models)
     print(f"cavex: validate {size}", file=sys.stderr, flush=True)
     began = time.monotonic()
-    result = job(shot_file, calibrations, tables_dir=out / "tables", workers=workers,
-                 scheduler=scheduler, progress=args.progress, models=models)
+    # the tables go into --out/tables/ with the other files, in the staged write
+    result = job(shot_file, calibrations, workers=workers, scheduler=scheduler,
+                 progress=args.progress, models=models)
     seconds = time.monotonic() - began
     result["command"] = command_line(shots_path, calibration_paths, out, args.models)
     written = write_staged(out, lambda stage: write_outputs(result, stage, draw=args.figures))
@@ -146,7 +147,8 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
         add_statistics(result)
     result["shots_file"] = {"path": shot_file.path, "comments": list(shot_file.comments),
                             "n": len(shot_file.shots)}
-    result["tables"] = {"built": tables.built, "reused": tables.reused}
+    # ``cache``: the run's tables, written by :func:`write_outputs` into ``tables/``
+    result["tables"] = {"built": tables.built, "reused": tables.reused, "cache": tables}
     return result
 
 
@@ -159,8 +161,8 @@ def summary(result):
 # --- files ------------------------------------------------------------------------------------
 
 def write_outputs(result, out, draw=True):
-    """Write the JSON, CSV, report and (if ``draw``) the figures into ``out``; return the
-    paths."""
+    """Write the JSON, CSV, report, (if ``draw``) the figures and the FE tables the run used
+    (``tables/``) into ``out``; return the paths."""
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, content in (("validation.json", json.dumps(summary(result), indent=2) + "\n"),
@@ -172,6 +174,9 @@ def write_outputs(result, out, draw=True):
         from cavex.verification.report.validation_figures import write_figures
 
         written += write_figures(result, out)
+    cache = result.get("tables", {}).get("cache")
+    if cache is not None:
+        written += cache.write_used(out / "tables")
     return [str(p) for p in written]
 
 
