@@ -7,7 +7,7 @@ import time
 from pathlib import Path
 
 from cavex.verification.commands.options import add_resistance_options
-from cavex.verification.commands.shared_options import add_parallel_options
+from cavex.verification.commands.shared_options import add_parallel_options, scheduler_of
 
 HELP = "fit material parameters to measured penetration depths (docs/validation.md)"
 
@@ -39,7 +39,7 @@ def run(args, target, projectile):
     params = check_parameters(args.params)
     out = check_output_file(args.out, "out")
     result = job(shots, resistance=settings["resistance"], boundary=settings["boundary"],
-                 params=params, workers=args.workers, scheduler=args.scheduler,
+                 params=params, workers=args.workers, scheduler=scheduler_of(args),
                  progress=args.progress, out=out)
     calibration = result["calibration"]
     result["command"] = command_line(args.shots, args.out, calibration.model, params, args.ids)

@@ -22,7 +22,11 @@ import time
 
 from cavex.analytic.models import labels
 from cavex.errors import CavexInputError
-from cavex.verification.commands.shared_options import add_figures_option, add_parallel_options
+from cavex.verification.commands.shared_options import (
+    add_figures_option,
+    add_parallel_options,
+    scheduler_of,
+)
 from cavex.verification.fedata.runner import check_execution
 from cavex.verification.output.files import write_text_atomic
 from cavex.verification.output.paths import check_output_dir, write_staged
@@ -71,7 +75,7 @@ def run(args, target, projectile):
     from cavex.verification.validation.calibration import read_calibration
 
     shots_path, calibration_paths = args.shots, args.calibration
-    workers, scheduler = args.workers, args.scheduler
+    workers, scheduler = args.workers, scheduler_of(args)
     models = check_models(args.models)
     shot_file = read_shots(shots_path)
     calibrations = [read_calibration(p) for p in calibration_paths or ()]
