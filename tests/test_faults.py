@@ -323,3 +323,70 @@ def test_tls_settings_become_a_distributed_security(tmp_path):
     assert security.tls_client_cert == str(tmp_path / "cert.pem")
     assert security.tls_client_key == str(tmp_path / "key.pem")
     assert scheduler_with_tls("tcp://127.0.0.1:8786") == "tcp://127.0.0.1:8786"
+
+
+# --- a full or read-only --out ---------------------------------------------------------------
+
+def small_tmpfs(path, options):
+    """A tmpfs mounted at ``path`` (root only, else the test is skipped); unmount after."""
+    import shutil
+    import subprocess
+
+    if os.geteuid() != 0 or shutil.which("mount") is None:
+        pytest.skip("needs root to mount a small tmpfs")
+    path.mkdir()
+    done = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(path)],
+                          capture_output=True)
+    if done.returncode != 0:
+        pytest.skip(f"tmpfs not available: {done.stderr.decode().strip()}")
+    return path
+
+
+def unmount(path):
+    import subprocess
+
+    subprocess.run(["umount", str(path)], check=True)
+
+
+def fill(path):
+    handle = os.open(path, os.O_WRONLY | os.O_CREAT, 0o644)
+    try:
+        while True:
+            os.write(handle, b"\0" * 4096)
+    except OSError:
+        pass
+    finally:
+        os.close(handle)
+
+
+@pytest.mark.parametrize("command", [
+    ["validate", "--shots", str(SHOTS), "--models", "paper", "--no-figures"],
+    ["trajectory", "--no-figures"],
+    ["penetrate", "--no-figures"],
+])
+def test_a_full_out_is_named_and_left_as_it_was(tmp_path, capsys, command):
+    disk = small_tmpfs(tmp_path / "disk", "size=64k")
+    try:
+        out = disk / "out"
+        out.mkdir()
+        (out / "keep.txt").write_text("kept\n")
+        fill(disk / "filler")
+        code = main([*command, "--out", str(out)])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert code == 2 and "'out'" in err[-1] and "No space left" in err[-1], err
+        assert "Traceback" not in "".join(err)
+        assert sorted(p.name for p in out.iterdir()) == ["keep.txt"]
+    finally:
+        unmount(disk)
+
+
+def test_a_read_only_out_is_refused_before_any_work(tmp_path, capsys):
+    disk = small_tmpfs(tmp_path / "disk", "ro,size=64k")
+    try:
+        code = main(["validate", "--shots", str(SHOTS), "--models", "paper", "--no-figures",
+                     "--out", str(disk / "out")])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert code == 2 and len(err) == 1 and "'out'" in err[0]
+        assert not list(disk.iterdir())
+    finally:
+        unmount(disk)

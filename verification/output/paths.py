@@ -7,6 +7,7 @@ computation and losing it. Nothing is created by the check: the folder is made w
 writes.
 """
 
+import errno
 import os
 import shutil
 import signal
@@ -65,6 +66,9 @@ def _check_writable(folder, option, text):
                               f"{text!r}: {exc.strerror or exc})") from None
 
 
+#: what an ``OSError`` while writing the stage says about the output folder: full, over
+#: quota, read-only, not permitted
+FOLDER_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM)
 STAGE_PREFIX = ".cavex-partial-"  # then host, process id and a random part
 STALE_SECONDS = 86400.0  # a stage of no known process (an older cavex, another host) after
 
@@ -147,7 +151,14 @@ def staged_output(folder, option="out"):
 
     sys.unraisablehook = quiet
     try:
-        yield stage
+        try:
+            yield stage
+        except OSError as exc:
+            if exc.errno not in FOLDER_ERRORS:
+                raise
+            raise CavexInputError(f"parameter '{option}' must be a folder the outputs can be "
+                                  f"written to (got '{folder}': {exc.strerror or exc}; "
+                                  "nothing was written)") from None
         held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
         try:
             if received:  # interrupted, but the exception was swallowed on its way
