@@ -62,8 +62,9 @@ def has_control_characters(text):
 def require_name(text, parameter):
     """Raise :class:`CavexInputError` unless ``text`` is a string without control
     characters (:func:`has_control_characters`)."""
-    require(isinstance(text, str) and not has_control_characters(text), parameter,
-            "a string without control characters", text)
+    require(isinstance(text, str), parameter, "a string", text)
+    require(not has_control_characters(text), parameter, "a string without control characters",
+            text)
 
 
 def is_finite_number(value):

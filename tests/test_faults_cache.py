@@ -285,3 +285,5 @@ def test_two_concurrent_runs_build_a_table_once(tmp_path):
     assert stdout.count("FE tables built 0, reused 1") == 1, outputs
     assert len(list((tmp_path / "cache").glob("table_*.nc"))) == 1
     assert built[0]["shots"] == built[1]["shots"]
+    waited = sum("cavex: waiting for another run" in err for _, err in outputs)
+    print(f"runs that waited for the other's claim: {waited}")

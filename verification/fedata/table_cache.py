@@ -131,18 +131,24 @@ def remove_stale_temporaries(directory):
 
 
 def folder_problem(directory):
-    """None if ``directory`` can hold the cache (it is, or can be made, a folder in which a
-    file can be created and removed), else the reason in words."""
+    """None if ``directory`` can hold the cache, else the reason in words: it is a folder in
+    which a file can be created and removed, or its nearest existing parent is (nothing is
+    created: the folder is made by the first store)."""
     from cavex.verification.output.files import exclusive_temporary
 
+    existing = Path(directory)
+    while not existing.exists() and not existing.is_symlink() and existing.parent != existing:
+        existing = existing.parent
+    if not existing.is_dir():
+        return f"'{existing}' is not a folder"
     try:
-        Path(directory).mkdir(parents=True, exist_ok=True)
-        handle, name = exclusive_temporary(Path(directory) / "table_check")
+        handle, name = exclusive_temporary(existing / "table_check")
         os.close(handle)
         os.remove(name)
     except OSError as exc:
         return exc.strerror or str(exc)
-    remove_stale_temporaries(directory)
+    if existing == Path(directory):
+        remove_stale_temporaries(directory)
     return None
 
 
@@ -166,6 +172,7 @@ def claimed(path):
 
     lock = os.fspath(path) + ".lock"
     try:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)  # the first claim makes the folder
         handle = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o666)
     except OSError:
         yield
