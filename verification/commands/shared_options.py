@@ -18,10 +18,12 @@ def add_parallel_options(parser):
                         "this machine and this machine's on its workers: connect only to "
                         "one you trust (docs/verification.md)")
     parser.add_argument("--scheduler-tls-ca", metavar="FILE", help="TLS: the certificate "
-                        "authority the tls:// scheduler's certificate is checked against")
+                        "authority the tls:// scheduler's certificate is checked against "
+                        "(default: none, no TLS)")
     parser.add_argument("--scheduler-tls-cert", metavar="FILE", help="TLS: this client's "
-                        "certificate (with --scheduler-tls-key)")
-    parser.add_argument("--scheduler-tls-key", metavar="FILE", help="TLS: this client's key")
+                        "certificate (with --scheduler-tls-key; default: none)")
+    parser.add_argument("--scheduler-tls-key", metavar="FILE", help="TLS: this client's key "
+                        "(default: none)")
     parser.add_argument("--workers", type=int, help="local worker processes (default: CPUs)")
     parser.add_argument("--progress", action=argparse.BooleanOptionalAction,
                         help="progress bar on stderr (default: when stderr is a terminal)")
