@@ -390,3 +390,39 @@ def test_a_read_only_out_is_refused_before_any_work(tmp_path, capsys):
         assert not list(disk.iterdir())
     finally:
         unmount(disk)
+
+
+def test_a_tls_scheduler_is_reached_with_the_tls_options(tmp_path, capsys):
+    """A local TLS cluster (certificates made by openssl, encryption required): ``cavex
+    table`` reaches it with ``--scheduler-tls-*`` and writes its table."""
+    import shutil
+    import subprocess
+
+    if shutil.which("openssl") is None:
+        pytest.skip("needs openssl to make the certificates")
+    distributed = pytest.importorskip("distributed")
+
+    def openssl(*words):
+        subprocess.run(["openssl", *words], cwd=tmp_path, check=True, capture_output=True)
+
+    openssl("req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", "ca.key", "-out",
+            "ca.pem", "-days", "1", "-subj", "/CN=cavex-test-ca")
+    openssl("req", "-newkey", "rsa:2048", "-nodes", "-keyout", "key.pem", "-out", "leaf.csr",
+            "-subj", "/CN=127.0.0.1")
+    (tmp_path / "ext.cnf").write_text("subjectAltName=IP:127.0.0.1,DNS:localhost\n")
+    openssl("x509", "-req", "-in", "leaf.csr", "-CA", "ca.pem", "-CAkey", "ca.key",
+            "-CAcreateserial", "-out", "cert.pem", "-days", "1", "-extfile", "ext.cnf")
+    ca, cert, key = (str(tmp_path / n) for n in ("ca.pem", "cert.pem", "key.pem"))
+    security = distributed.Security(
+        tls_ca_file=ca, tls_scheduler_cert=cert, tls_scheduler_key=key, tls_worker_cert=cert,
+        tls_worker_key=key, tls_client_cert=cert, tls_client_key=key, require_encryption=True)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  protocol="tls://", security=security,
+                                  dashboard_address=None) as cluster:
+        assert cluster.scheduler_address.startswith("tls://")
+        code = main(["table", "--velocities", "0", "100", "--depths", "0", "0.1", "-o",
+                     str(tmp_path / "t.nc"), "--scheduler", cluster.scheduler_address,
+                     "--scheduler-tls-ca", ca, "--scheduler-tls-cert", cert,
+                     "--scheduler-tls-key", key])
+    out = capsys.readouterr().out
+    assert code == 0 and (tmp_path / "t.nc").is_file() and "failed  0" in out
