@@ -380,6 +380,19 @@ def test_a_full_out_is_named_and_left_as_it_was(tmp_path, capsys, command):
         unmount(disk)
 
 
+def test_calibrate_onto_a_full_disk_names_out(tmp_path, capsys):
+    disk = small_tmpfs(tmp_path / "disk", "size=64k")
+    try:
+        fill(disk / "filler")
+        code = main(["calibrate", "--shots", str(SHOTS), "--out", str(disk / "cal.toml"),
+                     "--params", "lam", "--ids", "F94-39", "F94-40", "--workers", "1"])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert code == 2 and len(err) == 1 and "'out'" in err[0] and "No space" in err[0]
+        assert sorted(p.name for p in disk.iterdir()) == ["filler"]
+    finally:
+        unmount(disk)
+
+
 def test_a_read_only_out_is_refused_before_any_work(tmp_path, capsys):
     disk = small_tmpfs(tmp_path / "disk", "ro,size=64k")
     try:

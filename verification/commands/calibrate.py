@@ -87,14 +87,16 @@ def write_outputs(job, out):
     """Write the calibration file ``out``, recording the job's ``shots_path``, ``reference``
     shot and ``command``; return the paths written."""
     from cavex.verification.output.files import write_text_atomic
+    from cavex.verification.output.paths import output_refusals
     from cavex.verification.validation.calibration import calibration_text
 
     out = Path(out)
     text = calibration_text(job["calibration"], job["shots_path"], job["reference"],
                             job["command"])
-    if out.parent != Path(""):
-        out.parent.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(out, text)
+    with output_refusals("out", out):  # a full disk: one line naming --out, no file
+        if out.parent != Path(""):
+            out.parent.mkdir(parents=True, exist_ok=True)
+        write_text_atomic(out, text)
     return [str(out)]
 
 

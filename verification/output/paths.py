@@ -151,14 +151,8 @@ def staged_output(folder, option="out"):
 
     sys.unraisablehook = quiet
     try:
-        try:
+        with output_refusals(option, folder):
             yield stage
-        except OSError as exc:
-            if exc.errno not in FOLDER_ERRORS:
-                raise
-            raise CavexInputError(f"parameter '{option}' must be a folder the outputs can be "
-                                  f"written to (got '{folder}': {exc.strerror or exc}; "
-                                  "nothing was written)") from None
         held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
         try:
             if received:  # interrupted, but the exception was swallowed on its way
@@ -177,6 +171,21 @@ def staged_output(folder, option="out"):
                 folder.rmdir()  # only if empty: nothing was moved in
             except OSError:
                 pass
+
+
+@contextmanager
+def output_refusals(option, where):
+    """Turn an ``OSError`` that says the output location cannot take the files (full, over
+    quota, read-only, not permitted: :data:`FOLDER_ERRORS`) into one line naming ``option``
+    and ``where`` (:class:`CavexInputError`, exit 2); other errors pass."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.errno not in FOLDER_ERRORS:
+            raise
+        raise CavexInputError(f"parameter '{option}' must be a location the outputs can be "
+                              f"written to (got '{where}': {exc.strerror or exc}; nothing "
+                              "was written)") from None
 
 
 def planned_moves(stage, folder, option="out"):
