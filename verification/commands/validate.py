@@ -86,12 +86,17 @@ def run(args, target, projectile):
                               "give one per model")
     out = check_output_dir(DEFAULT_OUT if args.out is None else args.out, "out")
     check_execution(workers, scheduler)
-    size = estimate(shot_file.shots, calibrations, None, workers, models)
+    from cavex.verification.fedata.runner import show_progress
+
+    # one cache for the estimate and the run: the entries the estimate checked are not read
+    # again; the tables go into --out/tables/ with the other files, in the staged write
+    tables = TableCache(workers=workers, scheduler=scheduler,
+                        progress=show_progress(args.progress))
+    size = estimate(shot_file.shots, calibrations, tables, workers, models)
     print(f"cavex: validate {size}", file=sys.stderr, flush=True)
     began = time.monotonic()
-    # the tables go into --out/tables/ with the other files, in the staged write
     result = job(shot_file, calibrations, workers=workers, scheduler=scheduler,
-                 progress=args.progress, models=models)
+                 progress=args.progress, models=models, tables=tables)
     seconds = time.monotonic() - began
     result["command"] = command_line(shots_path, calibration_paths, out, args.models)
     written = write_staged(out, lambda stage: write_outputs(result, stage, draw=args.figures))
@@ -119,23 +124,26 @@ def columns_of(calibrations, models=None):
     return columns
 
 
-def estimate(shots, calibrations, tables_dir, workers, models=None):
-    """The run's size and time (:func:`cavex.verification.validation.predict.run_estimate`)."""
+def estimate(shots, calibrations, tables, workers, models=None):
+    """The run's size and time (:func:`cavex.verification.validation.predict.run_estimate`);
+    ``tables``: a :class:`TableCache` (None: a new one)."""
     from cavex.verification.validation.predict import run_estimate
 
     workers = workers or os.cpu_count() or 1
-    return run_estimate(shots, columns_of(calibrations, models), TableCache(tables_dir),
-                        workers)
+    return run_estimate(shots, columns_of(calibrations, models),
+                        TableCache() if tables is None else tables, workers)
 
 
 def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=None,
-        progress=None, models=None):
+        progress=None, models=None, tables=None):
     """:func:`cavex.verification.validation.predict.validate` plus the compressibility column and
-    the shots file's description."""
+    the shots file's description; ``tables``: the :class:`TableCache` to use (default a new
+    one copying its tables into ``tables_dir``)."""
     from cavex.verification.fedata.runner import show_progress
 
-    tables = TableCache(tables_dir, workers=workers, scheduler=scheduler,
-                        progress=show_progress(progress))
+    if tables is None:
+        tables = TableCache(tables_dir, workers=workers, scheduler=scheduler,
+                            progress=show_progress(progress))
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
                       progress=progress, models=models)
     if any(c.model == "derived-dynamic" for c in calibrations):

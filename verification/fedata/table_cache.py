@@ -30,6 +30,7 @@ a killed writer's (:func:`cavex.verification.output.files.stale_temporary`) is r
 writer's is counted.
 """
 
+import functools
 import hashlib
 import json
 import os
@@ -291,6 +292,7 @@ def store(table, path):
     return load_table(path)
 
 
+@functools.lru_cache(maxsize=1)
 def _cavex_version():
     from cavex.verification.fedata.table import _version
 

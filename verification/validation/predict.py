@@ -151,6 +151,7 @@ class TableCache:
         self.numerics, self.workers, self.scheduler = numerics, workers, scheduler
         self.progress = progress
         self._tables = {}
+        self._checked = {}  # entries read and trusted by :meth:`plan`
         self._velocities = None
         self.built = 0
         self.reused = 0
@@ -171,9 +172,11 @@ class TableCache:
                 wanted.setdefault(self.key(target, projectile, self._velocities),
                                   (target, projectile))
         keys = set(wanted) - set(self._tables)
-        cached = set() if self.cache is None else {
-            k for k in keys if read_entry(self._entry(k), *wanted[k], self._velocities,
-                                          self.numerics)[0] is not None}
+        for k in keys - set(self._checked) if self.cache is not None else ():
+            table = read_entry(self._entry(k), *wanted[k], self._velocities, self.numerics)[0]
+            if table is not None:  # checked now, used by :meth:`table` without a second read
+                self._checked[k] = table
+        cached = keys & set(self._checked)
         return len(keys - cached), len(cached)
 
     def key(self, target, projectile, velocities):
@@ -199,7 +202,10 @@ class TableCache:
         key = self.key(target, projectile, velocities)
         if key in self._tables:
             return self._tables[key]
-        if self.cache is None:
+        if key in self._checked:
+            table = self._checked.pop(key)
+            self.reused += 1
+        elif self.cache is None:
             table = self._build(shot, target, projectile, velocities, key)
         else:
             with claimed(self._entry(key)):
