@@ -287,3 +287,20 @@ def test_two_concurrent_runs_build_a_table_once(tmp_path):
     assert built[0]["shots"] == built[1]["shots"]
     waited = sum("cavex: waiting for another run" in err for _, err in outputs)
     print(f"runs that waited for the other's claim: {waited}")
+
+
+def test_without_a_usable_cache_the_tables_are_written_from_memory(tmp_path, capsys, built,
+                                                                   fake_builds):
+    """The run's copies in ``--out/tables/`` come from memory when there is no cache, never
+    from another cache folder (the default one)."""
+    shot = built[0]
+    blocker = tmp_path / "blocker"
+    blocker.write_text("x")
+    cache = TableCache(cache=blocker / "tables")
+    cache.velocities_for([shot])
+    cache.table(shot)
+    written = cache.write_used(tmp_path / "out" / "tables")
+    capsys.readouterr()
+    assert [p.name for p in written] == [built[2].name]
+    copy = read_netcdf3(written[0])
+    assert np.array_equal(copy["sigma_r"], read_netcdf3(built[2])["sigma_r"])

@@ -260,10 +260,12 @@ class TableCache:
         from cavex.verification.output.files import copy_atomic
 
         path = Path(self.directory if folder is None else folder) / f"table_{key}.nc"
-        try:
-            return copy_atomic(self._entry(key), path)
-        except FileNotFoundError:
-            return write_table(self._tables[key], path, reproducible=False)
+        if self.cache is not None:
+            try:
+                return copy_atomic(self._entry(key), path)
+            except FileNotFoundError:
+                pass
+        return write_table(self._tables[key], path)
 
     def write_used(self, folder):
         """Write every table this run used into ``folder`` (``table_<key>.nc``, as the cache
