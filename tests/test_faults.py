@@ -296,6 +296,7 @@ def test_the_command_lines_scheduler_overrides_the_file_without_opt_in(tmp_path,
       "--scheduler-tls-cert", "{ca}"], "scheduler-tls-cert"),  # a certificate without key
     (["--scheduler", "tls://127.0.0.1:1", "--scheduler-tls-cert", "{ca}",
       "--scheduler-tls-key", "{ca}"], "scheduler-tls-ca"),  # no CA
+    (["--scheduler", "tls://127.0.0.1:1"], "--scheduler-tls-ca"),  # tls:// without settings
 ])
 def test_bad_tls_settings_are_refused(tmp_path, capsys, extra, parameter):
     ca = tmp_path / "ca.pem"

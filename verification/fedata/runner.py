@@ -334,6 +334,10 @@ def scheduler_with_tls(address, ca=None, cert=None, key=None):
     them the address as it is. The files must be readable, the address ``tls://``, the
     certificate and key given together."""
     if ca is None and cert is None and key is None:
+        if isinstance(address, str) and address.startswith("tls://") and not _dask_tls():
+            raise CavexInputError(f"parameter 'scheduler' must be given with "
+                                  f"--scheduler-tls-ca FILE for a tls:// address (got "
+                                  f"{address!r}; or set Dask's distributed.comm.tls)")
         return address
     require(address is not None, "scheduler-tls-ca", "given with --scheduler tls://HOST:PORT",
             ca or cert or key)
@@ -349,6 +353,13 @@ def scheduler_with_tls(address, ca=None, cert=None, key=None):
             require(os.path.isfile(path) and os.access(path, os.R_OK), option,
                     "a readable file", path)
     return SchedulerAddress(address, ca, cert, key)
+
+
+def _dask_tls():
+    """Whether Dask's configuration names a TLS certificate authority for clients."""
+    import dask
+
+    return bool(dask.config.get("distributed.comm.tls.ca-file", None))
 
 
 def _check_address(address):
