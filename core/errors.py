@@ -53,6 +53,20 @@ def require_choice(value, choices, parameter):
         require(False, parameter, " or ".join(map(repr, choices)), value)
 
 
+def has_control_characters(text):
+    """Whether ``text`` holds a control character (U+0000-U+001F, U+007F-U+009F, NUL too):
+    none belongs in an id or a name that is written into files and printed."""
+    return any(ord(ch) < 0x20 or 0x7F <= ord(ch) <= 0x9F for ch in text)
+
+
+def require_name(text, parameter):
+    """Raise :class:`CavexInputError` unless ``text`` is a string without control
+    characters (:func:`has_control_characters`)."""
+    require(isinstance(text, str), parameter, "a string", text)
+    require(not has_control_characters(text), parameter, "a string without control characters",
+            text)
+
+
 def is_finite_number(value):
     """True for a finite int or float (booleans are not numbers here)."""
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)

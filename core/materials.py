@@ -5,7 +5,7 @@ from dataclasses import dataclass, field, fields
 from functools import cached_property
 from itertools import accumulate
 
-from cavex.errors import is_finite_number, require
+from cavex.errors import is_finite_number, require, require_name
 
 #: Largest velocity accepted (m/s), striking or expansion: far beyond it (hypervelocity impact)
 #: a rigid projectile and an elastic-plastic cavity expansion no longer describe the target.
@@ -71,7 +71,7 @@ class Material:
                                            metadata={"unit": "Pa", "fe_only": True})
 
     def __post_init__(self):
-        require(isinstance(self.name, str), "name", "a string", self.name)
+        require_name(self.name, "name")
         _positive("E", self.E)
         _positive("rho", self.rho)
         require(is_finite_number(self.nu) and -1.0 < self.nu < 0.5, "nu", "in (-1, 0.5)", self.nu)

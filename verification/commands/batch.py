@@ -6,7 +6,7 @@ import os
 import sys
 import time
 
-from cavex.verification.commands.shared_options import add_parallel_options
+from cavex.verification.commands.shared_options import add_parallel_options, scheduler_of
 
 HELP = "run a sweep of FE cases (TOML) into one Dataset"
 
@@ -19,22 +19,34 @@ def add_arguments(parser):
     add_parallel_options(parser)
     parser.add_argument("--allow-large", action="store_true",
                         help="run a sweep of more than 20000 FE cases")
+    parser.add_argument("--allow-file-scheduler", action="store_true",
+                        help="connect to the sweep file's [sweep] scheduler (without it the key "
+                        "is refused: a scheduler runs code on this machine; --scheduler always "
+                        "counts)")
 
 
 def run(args, target, projectile):
     """Run the sweep (:func:`job`); returns its result."""
-    return job(args.sweep, args.out, scheduler=args.scheduler, workers=args.workers,
-               progress=args.progress, allow_large=args.allow_large)
+    return job(args.sweep, args.out, scheduler=scheduler_of(args), workers=args.workers,
+               progress=args.progress, allow_large=args.allow_large,
+               allow_file_scheduler=args.allow_file_scheduler)
 
 
-def job(path, out_dir=None, *, scheduler=None, workers=None, progress=None, allow_large=False):
+def job(path, out_dir=None, *, scheduler=None, workers=None, progress=None, allow_large=False,
+        allow_file_scheduler=False):
     """Check, then run the sweep ``path`` into ``out_dir`` (default
     ``results/batch/<sweep name>``): ``{"dataset", "out_dir", "loaded", "seconds"}``.
 
     The size and an estimate of the run time go to stderr first; more than
     :data:`cavex.verification.fedata.cases.LARGE_RUN` cases need ``allow_large``.
     """
-    from cavex.verification.fedata.batch import STORE_DIR, parse_sweep, run_sweep, sweep_cases
+    from cavex.verification.fedata.batch import (
+        STORE_DIR,
+        file_scheduler,
+        parse_sweep,
+        run_sweep,
+        sweep_cases,
+    )
     from cavex.verification.fedata.cases import check_run_size
     from cavex.verification.fedata.runner import check_execution, check_store, read_store
     from cavex.verification.output.paths import check_output_dir
@@ -44,7 +56,8 @@ def job(path, out_dir=None, *, scheduler=None, workers=None, progress=None, allo
                                                                           sweep.name)
     cases = sweep_cases(sweep)
     check_output_dir(out_dir, "out")
-    scheduler = scheduler if scheduler is not None else sweep.scheduler
+    scheduler = scheduler if scheduler is not None else file_scheduler(sweep,
+                                                                        allow_file_scheduler)
     workers = workers if workers is not None else sweep.workers
     check_execution(workers, scheduler)
     estimate = check_run_size(len(cases), workers or os.cpu_count() or 1, allow_large)
@@ -53,7 +66,8 @@ def job(path, out_dir=None, *, scheduler=None, workers=None, progress=None, allo
     ids = {case["id"] for case in cases}
     loaded = len(ids & set(read_store(os.path.join(out_dir, STORE_DIR))))
     start = time.perf_counter()
-    dataset = run_sweep(path, out_dir, scheduler=scheduler, workers=workers, progress=progress)
+    dataset = run_sweep(path, out_dir, scheduler=scheduler, workers=workers, progress=progress,
+                        allow_file_scheduler=allow_file_scheduler)
     return {"dataset": dataset, "out_dir": out_dir, "loaded": loaded,
             "seconds": time.perf_counter() - start}
 

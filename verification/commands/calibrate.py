@@ -7,7 +7,7 @@ import time
 from pathlib import Path
 
 from cavex.verification.commands.options import add_resistance_options
-from cavex.verification.commands.shared_options import add_parallel_options
+from cavex.verification.commands.shared_options import add_parallel_options, scheduler_of
 
 HELP = "fit material parameters to measured penetration depths (docs/validation.md)"
 
@@ -39,7 +39,7 @@ def run(args, target, projectile):
     params = check_parameters(args.params)
     out = check_output_file(args.out, "out")
     result = job(shots, resistance=settings["resistance"], boundary=settings["boundary"],
-                 params=params, workers=args.workers, scheduler=args.scheduler,
+                 params=params, workers=args.workers, scheduler=scheduler_of(args),
                  progress=args.progress, out=out)
     calibration = result["calibration"]
     result["command"] = command_line(args.shots, args.out, calibration.model, params, args.ids)
@@ -87,14 +87,16 @@ def write_outputs(job, out):
     """Write the calibration file ``out``, recording the job's ``shots_path``, ``reference``
     shot and ``command``; return the paths written."""
     from cavex.verification.output.files import write_text_atomic
+    from cavex.verification.output.paths import output_refusals
     from cavex.verification.validation.calibration import calibration_text
 
     out = Path(out)
     text = calibration_text(job["calibration"], job["shots_path"], job["reference"],
                             job["command"])
-    if out.parent != Path(""):
-        out.parent.mkdir(parents=True, exist_ok=True)
-    write_text_atomic(out, text)
+    with output_refusals("out", out):  # a full disk: one line naming --out, no file
+        if out.parent != Path(""):
+            out.parent.mkdir(parents=True, exist_ok=True)
+        write_text_atomic(out, text)
     return [str(out)]
 
 

@@ -12,7 +12,11 @@ import time
 
 import numpy as np
 
-from cavex.verification.commands.shared_options import add_config_option, add_parallel_options
+from cavex.verification.commands.shared_options import (
+    add_config_option,
+    add_parallel_options,
+    scheduler_of,
+)
 
 HELP = "FE-tabulated sigma_r(V, L) for the target"
 STORE_SUFFIX = ".cases"  # the resumable case store: <out>.cases/ until the table is written
@@ -40,7 +44,7 @@ def run(args, target, projectile):
 
     refuse_debonded(target, "table")
     result = job(target, projectile, args.velocities, args.depths, args.out, nu=args.nu,
-                 workers=args.workers, scheduler=args.scheduler, progress=args.progress)
+                 workers=args.workers, scheduler=scheduler_of(args), progress=args.progress)
     result["outputs"] = write_outputs(result, result["output"])
     return result
 

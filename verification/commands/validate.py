@@ -22,7 +22,11 @@ import time
 
 from cavex.analytic.models import labels
 from cavex.errors import CavexInputError
-from cavex.verification.commands.shared_options import add_figures_option, add_parallel_options
+from cavex.verification.commands.shared_options import (
+    add_figures_option,
+    add_parallel_options,
+    scheduler_of,
+)
 from cavex.verification.fedata.runner import check_execution
 from cavex.verification.output.files import write_text_atomic
 from cavex.verification.output.paths import check_output_dir, write_staged
@@ -71,7 +75,7 @@ def run(args, target, projectile):
     from cavex.verification.validation.calibration import read_calibration
 
     shots_path, calibration_paths = args.shots, args.calibration
-    workers, scheduler = args.workers, args.scheduler
+    workers, scheduler = args.workers, scheduler_of(args)
     models = check_models(args.models)
     shot_file = read_shots(shots_path)
     calibrations = [read_calibration(p) for p in calibration_paths or ()]
@@ -82,11 +86,17 @@ def run(args, target, projectile):
                               "give one per model")
     out = check_output_dir(DEFAULT_OUT if args.out is None else args.out, "out")
     check_execution(workers, scheduler)
-    size = estimate(shot_file.shots, calibrations, out / "tables", workers, models)
+    from cavex.verification.fedata.runner import show_progress
+
+    # one cache for the estimate and the run: the entries the estimate checked are not read
+    # again; the tables go into --out/tables/ with the other files, in the staged write
+    tables = TableCache(workers=workers, scheduler=scheduler,
+                        progress=show_progress(args.progress))
+    size = estimate(shot_file.shots, calibrations, tables, workers, models)
     print(f"cavex: validate {size}", file=sys.stderr, flush=True)
     began = time.monotonic()
-    result = job(shot_file, calibrations, tables_dir=out / "tables", workers=workers,
-                 scheduler=scheduler, progress=args.progress, models=models)
+    result = job(shot_file, calibrations, workers=workers, scheduler=scheduler,
+                 progress=args.progress, models=models, tables=tables)
     seconds = time.monotonic() - began
     result["command"] = command_line(shots_path, calibration_paths, out, args.models)
     written = write_staged(out, lambda stage: write_outputs(result, stage, draw=args.figures))
@@ -114,23 +124,26 @@ def columns_of(calibrations, models=None):
     return columns
 
 
-def estimate(shots, calibrations, tables_dir, workers, models=None):
-    """The run's size and time (:func:`cavex.verification.validation.predict.run_estimate`)."""
+def estimate(shots, calibrations, tables, workers, models=None):
+    """The run's size and time (:func:`cavex.verification.validation.predict.run_estimate`);
+    ``tables``: a :class:`TableCache` (None: a new one)."""
     from cavex.verification.validation.predict import run_estimate
 
     workers = workers or os.cpu_count() or 1
-    return run_estimate(shots, columns_of(calibrations, models), TableCache(tables_dir),
-                        workers)
+    return run_estimate(shots, columns_of(calibrations, models),
+                        TableCache() if tables is None else tables, workers)
 
 
 def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=None,
-        progress=None, models=None):
+        progress=None, models=None, tables=None):
     """:func:`cavex.verification.validation.predict.validate` plus the compressibility column and
-    the shots file's description."""
+    the shots file's description; ``tables``: the :class:`TableCache` to use (default a new
+    one copying its tables into ``tables_dir``)."""
     from cavex.verification.fedata.runner import show_progress
 
-    tables = TableCache(tables_dir, workers=workers, scheduler=scheduler,
-                        progress=show_progress(progress))
+    if tables is None:
+        tables = TableCache(tables_dir, workers=workers, scheduler=scheduler,
+                            progress=show_progress(progress))
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
                       progress=progress, models=models)
     if any(c.model == "derived-dynamic" for c in calibrations):
@@ -146,7 +159,8 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
         add_statistics(result)
     result["shots_file"] = {"path": shot_file.path, "comments": list(shot_file.comments),
                             "n": len(shot_file.shots)}
-    result["tables"] = {"built": tables.built, "reused": tables.reused}
+    # ``cache``: the run's tables, written by :func:`write_outputs` into ``tables/``
+    result["tables"] = {"built": tables.built, "reused": tables.reused, "cache": tables}
     return result
 
 
@@ -159,8 +173,8 @@ def summary(result):
 # --- files ------------------------------------------------------------------------------------
 
 def write_outputs(result, out, draw=True):
-    """Write the JSON, CSV, report and (if ``draw``) the figures into ``out``; return the
-    paths."""
+    """Write the JSON, CSV, report, (if ``draw``) the figures and the FE tables the run used
+    (``tables/``) into ``out``; return the paths."""
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, content in (("validation.json", json.dumps(summary(result), indent=2) + "\n"),
@@ -172,6 +186,9 @@ def write_outputs(result, out, draw=True):
         from cavex.verification.report.validation_figures import write_figures
 
         written += write_figures(result, out)
+    cache = result.get("tables", {}).get("cache")
+    if cache is not None:
+        written += cache.write_used(out / "tables")
     return [str(p) for p in written]
 
 

@@ -7,7 +7,11 @@ previous report as it was, or (if that was removed) no report, never a partial o
 
 from pathlib import Path
 
-from cavex.verification.commands.shared_options import add_config_option, add_parallel_options
+from cavex.verification.commands.shared_options import (
+    add_config_option,
+    add_parallel_options,
+    scheduler_of,
+)
 
 HELP = "analytic against FE report for the target"
 DEFAULT_OUT = "results/verification"
@@ -28,7 +32,7 @@ def run(args, target, projectile):
 
     refuse_debonded(target, "verify")
     return job(target, projectile, config_path=args.config, quick=args.quick,
-               out_dir=args.out, scheduler=args.scheduler, workers=args.workers,
+               out_dir=args.out, scheduler=scheduler_of(args), workers=args.workers,
                progress=args.progress)
 
 

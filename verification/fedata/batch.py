@@ -121,6 +121,7 @@ def _sweep(data, base_dir, default_name):
     numerics, numerics_axes = _numerics_section(data.get("numerics", {}))
     layers, material_axes = _materials_section(data.get("materials", []), layers,
                                                "nu" in data["grid"])
+    refuse_debonded_layers(layers)
     axes += material_axes + numerics_axes
     names = [axis.name for axis in axes]
     duplicated = sorted({n for n in names if names.count(n) > 1})
@@ -128,6 +129,17 @@ def _sweep(data, base_dir, default_name):
         raise CavexInputError(f"two swept keys share the dimension name '{duplicated[0]}'")
     return Sweep(meta["name"], meta["scheduler"], meta["workers"], layers, projectile, axes,
                  nu, numerics)
+
+
+def refuse_debonded_layers(layers):
+    """Refuse a debonded interface (``bottom = "debonded"``), as ``stress``, ``fem``,
+    ``table`` and ``verify`` do (:func:`cavex.verification.commands.options.refuse_debonded`):
+    the FE cases solve the bonded spherical problem only."""
+    for j, layer in enumerate(layers):
+        if layer.get("bottom") == "debonded":
+            raise CavexInputError("is \"debonded\", which `cavex batch` does not model (the "
+                                  "spherical problem is one bonded continuum): remove the key",
+                                  f"target.layers[{j}].bottom")
 
 
 def _check_table(table, where, allowed, required=()):
@@ -364,8 +376,19 @@ def _id_text(value):
 
 # --- running and loading ------------------------------------------------------------------------
 
+def file_scheduler(sweep, allowed):
+    """The sweep file's ``scheduler`` if ``allowed`` (``--allow-file-scheduler``), None if it
+    has none; else refused: a Dask scheduler runs code on the machine that connects to it, so a
+    sweep file from someone else must not choose one (docs/verification.md)."""
+    if sweep.scheduler is None or allowed:
+        return sweep.scheduler
+    raise CavexInputError(f"is used only with --allow-file-scheduler (got "
+                          f"{sweep.scheduler!r}; a scheduler can run code on this machine): "
+                          "give --scheduler, or remove the key", "sweep.scheduler")
+
+
 def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None,
-              chunk_size=None):
+              chunk_size=None, allow_file_scheduler=False):
     """Validate, run (resuming from ``out_dir``) and return the sweep as one Dataset.
 
     Parameters
@@ -376,6 +399,8 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
         Output folder: ``sweep.json``, ``cases/<id>.json`` and ``results.nc``.
     scheduler : str or dask.distributed.Client, optional
         Overrides ``sweep.scheduler``; see :func:`cavex.verification.fedata.runner.run_cases`.
+        The file's ``sweep.scheduler`` is used only with ``allow_file_scheduler``
+        (:func:`file_scheduler`).
     workers : int, optional
         Overrides ``sweep.workers`` (local processes).
     progress : bool, optional
@@ -393,7 +418,8 @@ def run_sweep(path_or_dict, out_dir, scheduler=None, workers=None, progress=None
     sweep = parse_sweep(path_or_dict)
     cases = sweep_cases(sweep)
     out_dir = os.fspath(check_output_dir(out_dir, "out"))
-    scheduler = scheduler if scheduler is not None else sweep.scheduler
+    scheduler = scheduler if scheduler is not None else file_scheduler(sweep,
+                                                                        allow_file_scheduler)
     workers = workers if workers is not None else sweep.workers
     check_execution(workers, scheduler)
     check_store(os.path.join(out_dir, STORE_DIR), cases)  # before sweep.json is rewritten

@@ -309,6 +309,59 @@ def _check_workers(workers):
     return workers
 
 
+class SchedulerAddress(str):
+    """A Dask scheduler address (``tls://host:port``) with the TLS files to reach it: the
+    certificate authority ``ca`` (the scheduler's certificate is checked against it) and this
+    client's certificate ``cert`` and key ``key``. A ``str`` everywhere an address goes; the
+    connection (:func:`_connect`) uses :meth:`security`."""
+
+    def __new__(cls, address, ca, cert=None, key=None):
+        made = super().__new__(cls, address)
+        made.ca, made.cert, made.key = ca, cert, key
+        return made
+
+    def security(self):
+        """The :class:`distributed.Security` of this address: encryption required."""
+        from distributed import Security
+
+        return Security(tls_ca_file=self.ca, tls_client_cert=self.cert,
+                        tls_client_key=self.key, require_encryption=True)
+
+
+def scheduler_with_tls(address, ca=None, cert=None, key=None):
+    """``address`` (None: no scheduler) with the TLS files of ``--scheduler-tls-ca``,
+    ``--scheduler-tls-cert`` and ``--scheduler-tls-key`` (:class:`SchedulerAddress`); without
+    them the address as it is. The files must be readable, the address ``tls://``, the
+    certificate and key given together."""
+    if ca is None and cert is None and key is None:
+        if isinstance(address, str) and address.startswith("tls://") and not _dask_tls():
+            raise CavexInputError(f"parameter 'scheduler' must be given with "
+                                  f"--scheduler-tls-ca FILE for a tls:// address (got "
+                                  f"{address!r}; or set Dask's distributed.comm.tls)")
+        return address
+    require(address is not None, "scheduler-tls-ca", "given with --scheduler tls://HOST:PORT",
+            ca or cert or key)
+    require(ca is not None, "scheduler-tls-ca", "a CA file (with --scheduler-tls-cert/key)",
+            ca)
+    require((cert is None) == (key is None), "scheduler-tls-cert",
+            "given with --scheduler-tls-key (both or neither)", cert)
+    require(str(address).startswith("tls://"), "scheduler",
+            "a tls:// address with --scheduler-tls-*", address)
+    for option, path in (("scheduler-tls-ca", ca), ("scheduler-tls-cert", cert),
+                         ("scheduler-tls-key", key)):
+        if path is not None:
+            require(os.path.isfile(path) and os.access(path, os.R_OK), option,
+                    "a readable file", path)
+    return SchedulerAddress(address, ca, cert, key)
+
+
+def _dask_tls():
+    """Whether Dask's configuration names a TLS certificate authority for clients."""
+    import dask
+
+    return bool(dask.config.get("distributed.comm.tls.ca-file", None))
+
+
 def _check_address(address):
     match = _ADDRESS.match(address)
     require(match is not None and 0 < int(match["port"]) < 65536, "scheduler",
@@ -457,7 +510,9 @@ def _stream_dask(client, as_completed, function, todo, finished, while_running=N
 def _connect(client_class, address):
     """A client for ``address``; an unreachable or malformed address is an input error."""
     try:  # not the default client: a failed connection must not leave dask (and xarray) using it
-        return client_class(address, set_as_default=False, timeout=SCHEDULER_TIMEOUT)
+        security = address.security() if isinstance(address, SchedulerAddress) else None
+        return client_class(str(address), set_as_default=False, timeout=SCHEDULER_TIMEOUT,
+                            security=security)
     except (OSError, ValueError, TypeError) as exc:
         raise CavexInputError(f"parameter 'scheduler' must be a reachable Dask scheduler "
                               f"address (got {address!r}: {one_line_reason(exc)})") from None

@@ -1,30 +1,90 @@
 """Files every command writes: atomically (a temporary file, then ``os.replace``), so that a
-killed run never leaves a partial file: text, CSV columns of numbers, matplotlib figures, copies."""
+killed run never leaves a partial file: text, CSV columns of numbers, matplotlib figures, copies.
+
+Every temporary file is created exclusively in the destination folder
+(:func:`exclusive_temporary`: ``tempfile.mkstemp``, ``O_CREAT | O_EXCL | O_NOFOLLOW`` under a
+random name), so a symlink planted at a temporary name is never written through; the final
+``os.replace`` replaces a symlink planted at the final name (the link, not its target).
+"""
 
 import csv
 import gc
 import io
 import os
 import sys
+import tempfile
 from contextlib import contextmanager
+
+#: the process's umask (read once): a temporary file gets the mode ``open()`` would give
+_UMASK = os.umask(0)
+os.umask(_UMASK)
+#: every temporary file's name ends so (the FE-table cache counts and removes stale ones)
+TMP_SUFFIX = ".tmp"
+
+
+def temporary_prefix(path):
+    """``.<name>.<pid>.``: the hidden prefix of ``path``'s temporary files (the process id
+    tells a stale one, :func:`stale_temporary`)."""
+    return f".{os.path.basename(os.fspath(path))}.{os.getpid()}."
+
+
+def exclusive_temporary(path, suffix=TMP_SUFFIX):
+    """A new file beside ``path``, created exclusively (``tempfile.mkstemp``: ``O_CREAT |
+    O_EXCL | O_NOFOLLOW``, random name :func:`temporary_prefix` ``...suffix``) with the mode
+    ``open()`` would give; returns ``(descriptor, path)``."""
+    folder = os.path.dirname(os.fspath(path)) or "."
+    handle, tmp = tempfile.mkstemp(dir=folder, prefix=temporary_prefix(path), suffix=suffix)
+    try:
+        os.fchmod(handle, 0o666 & ~_UMASK)
+    except OSError:
+        pass
+    return handle, tmp
+
+
+def stale_temporary(name):
+    """Whether the temporary file named ``name`` (:func:`temporary_prefix`, then mkstemp's
+    8 random characters) belongs to no running process of this host (a killed writer's); a
+    name without a process id (an older cavex's) is stale."""
+    import re
+
+    found = re.findall(r"\.(\d+)\.[a-z0-9_]{8}(?=\.|$)", name)
+    if not found:
+        return True
+    pid = int(found[-1])
+    if pid == os.getpid():
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except OverflowError:  # no such process id
+        return True
+    except PermissionError:  # another user's process
+        return False
+    return False
 
 
 def write_text_atomic(path, text, durable=True):
     """Write ``text`` so that no reader (or a run resumed after ``kill -9``) sees a partial file.
 
-    The text goes to ``<path>.tmp``, is flushed (and, ``durable``, fsynced: on disk before it
-    replaces ``path``, so that an operating-system crash or a power cut leaves the old file or
-    the new one), then ``os.replace``-d onto ``path``. A killed process loses nothing it wrote
+    The text goes to a new temporary file beside ``path`` (:func:`exclusive_temporary`), is
+    flushed (and, ``durable``, fsynced: on disk before it replaces ``path``, so that an
+    operating-system crash or a power cut leaves the old file or the new one), then
+    ``os.replace``-d onto ``path``. A killed process loses nothing it wrote
     either way (the data is in the operating system's cache); ``durable=False`` is for files
     whose reader checks them and can recompute them (the case store: an fsync costs 1-4 ms here,
     ~0.2 s of a 100-case ``cavex table``)."""
-    tmp = os.fspath(path) + ".tmp"
-    with open(tmp, "w", encoding="utf-8", newline="") as handle:
-        handle.write(text)
-        handle.flush()
-        if durable:
-            os.fsync(handle.fileno())
-    os.replace(tmp, path)
+    handle, tmp = exclusive_temporary(path)
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8", newline="") as stream:
+            stream.write(text)
+            stream.flush()
+            if durable:
+                os.fsync(stream.fileno())
+        os.replace(tmp, path)
+    finally:
+        if os.path.lexists(tmp):
+            os.remove(tmp)
 
 
 def write_columns_csv(path, columns, quanta=None):
@@ -45,15 +105,17 @@ def write_columns_csv(path, columns, quanta=None):
 
 @contextmanager
 def replaced_atomically(path, suffix=".tmp"):
-    """Yield a temporary path beside ``path`` (``<path>.<pid><suffix>``) for the caller to
-    write; on success it is ``os.replace``-d onto ``path``, on an exception removed: a killed
-    or failed run never leaves a partial file."""
-    tmp = os.fspath(path) + f".{os.getpid()}{suffix}"
+    """Yield the path of a new, empty temporary file beside ``path``, created exclusively
+    (:func:`exclusive_temporary`), for the caller to write; on success it is
+    ``os.replace``-d onto ``path``, on an exception removed: a killed or failed run never
+    leaves a partial file."""
+    handle, tmp = exclusive_temporary(path, suffix)
+    os.close(handle)
     try:
         yield tmp
         os.replace(tmp, path)
     finally:
-        if os.path.exists(tmp):
+        if os.path.lexists(tmp):
             os.remove(tmp)
 
 
@@ -97,16 +159,10 @@ def collector_paused():
 
 
 def copy_atomic(source, path):
-    """Copy the file ``source`` to ``path`` (a temporary file of this process, then
-    ``os.replace``); returns ``path``."""
+    """Copy the file ``source`` to ``path`` (:func:`replaced_atomically`); returns ``path``."""
     import shutil
 
     os.makedirs(os.path.dirname(os.fspath(path)) or ".", exist_ok=True)
-    tmp = os.fspath(path) + f".{os.getpid()}.tmp"
-    try:
+    with replaced_atomically(path) as tmp:
         shutil.copyfile(source, tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
     return path

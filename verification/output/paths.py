@@ -7,6 +7,7 @@ computation and losing it. Nothing is created by the check: the folder is made w
 writes.
 """
 
+import errno
 import os
 import shutil
 import signal
@@ -65,6 +66,9 @@ def _check_writable(folder, option, text):
                               f"{text!r}: {exc.strerror or exc})") from None
 
 
+#: what an ``OSError`` while writing the stage says about the output folder: full, over
+#: quota, read-only, not permitted
+FOLDER_ERRORS = (errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM)
 STAGE_PREFIX = ".cavex-partial-"  # then host, process id and a random part
 STALE_SECONDS = 86400.0  # a stage of no known process (an older cavex, another host) after
 
@@ -102,7 +106,7 @@ def _alive(pid):
 
 
 @contextmanager
-def staged_output(folder):
+def staged_output(folder, option="out"):
     """Write a command's files into a hidden folder inside ``folder`` (the ``with`` target);
     when the block ends normally, move them into ``folder`` (``os.replace``, with SIGINT and
     SIGTERM held back for the moves), so that ``folder`` gets either every new file or none.
@@ -113,6 +117,11 @@ def staged_output(folder):
     middle of writing leaves no partial set of outputs. ``kill -9`` runs no clean-up: its stage
     (named by host and process id) is removed by the next staged write into ``folder``
     (:func:`remove_stale_stages`).
+
+    A clash (a staged file whose name is a folder in ``folder``, a staged folder whose name
+    is a file or a symlink) is found before anything is moved (:func:`planned_moves`): the
+    run is refused (:class:`CavexInputError` naming ``option``) and ``folder`` is left as it
+    was. Staged folders (``validate``'s ``tables/``) are merged into existing ones.
     """
     folder = Path(folder)
     created = not folder.exists()
@@ -142,13 +151,14 @@ def staged_output(folder):
 
     sys.unraisablehook = quiet
     try:
-        yield stage
+        with output_refusals(option, folder):
+            yield stage
         held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
         try:
             if received:  # interrupted, but the exception was swallowed on its way
                 raise KeyboardInterrupt(f"signal {received[0]}")
-            for path in sorted(stage.iterdir()):
-                os.replace(path, folder / path.name)
+            for source, destination in planned_moves(stage, folder, option):
+                os.replace(source, destination)
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, held)
     finally:
@@ -161,6 +171,47 @@ def staged_output(folder):
                 folder.rmdir()  # only if empty: nothing was moved in
             except OSError:
                 pass
+
+
+@contextmanager
+def output_refusals(option, where):
+    """Turn an ``OSError`` that says the output location cannot take the files (full, over
+    quota, read-only, not permitted: :data:`FOLDER_ERRORS`) into one line naming ``option``
+    and ``where`` (:class:`CavexInputError`, exit 2); other errors pass."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.errno not in FOLDER_ERRORS:
+            raise
+        raise CavexInputError(f"parameter '{option}' must be a location the outputs can be "
+                              f"written to (got '{where}': {exc.strerror or exc}; nothing "
+                              "was written)") from None
+
+
+def planned_moves(stage, folder, option="out"):
+    """The ``(source, destination)`` renames that put every entry of ``stage`` into
+    ``folder``: a file or a folder new to ``folder`` is moved whole, a staged folder whose
+    name is a folder of ``folder`` is merged into it (its entries planned the same way).
+    Every destination is checked before anything is moved: a file onto a folder, or a folder
+    onto a file or a symlink (never followed), is refused with :class:`CavexInputError`.
+    A symlink at a file's name is replaced (the link, not what it points to)."""
+    moves = []
+    for source in sorted(Path(stage).iterdir()):
+        destination = Path(folder) / source.name
+        real_folder = destination.is_dir() and not destination.is_symlink()
+        if source.is_dir() and real_folder:
+            moves += planned_moves(source, destination, option)
+            continue
+        if source.is_dir() and os.path.lexists(destination):
+            raise CavexInputError(f"parameter '{option}' must be a folder where '{source.name}'"
+                                  f" can be written as a folder (got '{destination}': a file "
+                                  "or a symlink; nothing was written)")
+        if real_folder:
+            raise CavexInputError(f"parameter '{option}' must be a folder where '{source.name}'"
+                                  f" can be written (got '{destination}': a folder; nothing "
+                                  "was written)")
+        moves.append((source, destination))
+    return moves
 
 
 def write_staged(folder, write):

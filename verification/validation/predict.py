@@ -134,14 +134,24 @@ class TableCache:
 
     def __init__(self, directory=None, numerics=None, workers=None, scheduler=None,
                  progress=False, cache=None):
-        from cavex.verification.fedata.table_cache import cache_dir, max_bytes
+        from cavex.verification.fedata.table_cache import (
+            cache_dir,
+            folder_problem,
+            max_bytes,
+            warn,
+        )
 
         max_bytes()  # a bad size limit is refused before any work
         self.directory = None if directory is None else Path(directory)
         self.cache = cache_dir() if cache is None else Path(cache)
+        problem = folder_problem(self.cache)  # before any FE work
+        if problem is not None:
+            warn(self.cache, problem)
+            self.cache = None
         self.numerics, self.workers, self.scheduler = numerics, workers, scheduler
         self.progress = progress
         self._tables = {}
+        self._checked = {}  # entries read and trusted by :meth:`plan`
         self._velocities = None
         self.built = 0
         self.reused = 0
@@ -153,10 +163,20 @@ class TableCache:
     def plan(self, shots, mappings):
         """``(to build, on disk)``: the distinct FE tables ``shots`` need under ``mappings``
         (call :meth:`velocities_for` first); on disk: in the cache (checked when read)."""
-        keys = {self.key(shot_target(shot, m), shot_projectile(shot), self._velocities)
-                for m in mappings for shot in shots}
-        keys -= set(self._tables)
-        cached = {k for k in keys if self._entry(k).exists()}
+        from cavex.verification.fedata.table_cache import read_entry
+
+        wanted = {}
+        for m in mappings:
+            for shot in shots:
+                target, projectile = shot_target(shot, m), shot_projectile(shot)
+                wanted.setdefault(self.key(target, projectile, self._velocities),
+                                  (target, projectile))
+        keys = set(wanted) - set(self._tables)
+        for k in keys - set(self._checked) if self.cache is not None else ():
+            table = read_entry(self._entry(k), *wanted[k], self._velocities, self.numerics)[0]
+            if table is not None:  # checked now, used by :meth:`table` without a second read
+                self._checked[k] = table
+        cached = keys & set(self._checked)
         return len(keys - cached), len(cached)
 
     def key(self, target, projectile, velocities):
@@ -172,19 +192,32 @@ class TableCache:
 
     def table(self, shot, mapping=None):
         """The FE table of ``shot``'s target (velocities: :meth:`velocities_for`, else the
-        shot's own): from memory, else the cache, else built and cached."""
-        from cavex.verification.fedata.table_cache import load_entry
+        shot's own): from memory, else the cache (claimed, so that concurrent runs build it
+        once: :func:`cavex.verification.fedata.table_cache.claimed`), else built and cached;
+        an untrusted entry is rebuilt with one line on stderr."""
+        from cavex.verification.fedata.table_cache import claimed, read_entry
 
         target, projectile = shot_target(shot, mapping), shot_projectile(shot)
         velocities = self._velocities or table_velocities([shot])
         key = self.key(target, projectile, velocities)
         if key in self._tables:
             return self._tables[key]
-        table = load_entry(self._entry(key), target, projectile, velocities, self.numerics)
-        if table is None:
+        if key in self._checked:
+            table = self._checked.pop(key)
+            self.reused += 1
+        elif self.cache is None:
             table = self._build(shot, target, projectile, velocities, key)
         else:
-            self.reused += 1
+            with claimed(self._entry(key)):
+                table, reason = read_entry(self._entry(key), target, projectile, velocities,
+                                           self.numerics)
+                if reason is not None:
+                    print(f"cavex: FE-table cache entry '{self._entry(key)}' is rebuilt: "
+                          f"{reason.splitlines()[0][:200]}", file=sys.stderr, flush=True)
+                if table is None:
+                    table = self._build(shot, target, projectile, velocities, key)
+                else:
+                    self.reused += 1
         failed = int(table["failed"].sum()) + int(table["failed_first_layer"].sum())
         if failed:
             raise CavexNumericalError(f"{failed} FE cell(s) failed building the table for "
@@ -195,9 +228,11 @@ class TableCache:
         return table
 
     def _build(self, shot, target, projectile, velocities, key):
-        """Build the table, store it in the cache and return it as stored."""
-        from cavex.verification.fedata.table import build_table
-        from cavex.verification.fedata.table_cache import store
+        """Build the table, store it in the cache (unless it holds failed cells, or there
+        is no usable cache) and return it as stored; a store that fails (a full disk) leaves
+        the cache unused for the rest of the run after one warning line."""
+        from cavex.verification.fedata.table import build_table, reproducible_table
+        from cavex.verification.fedata.table_cache import store, warn
 
         if self.progress:
             print(f"cavex: FE table for f_c = {shot.fc / 1e6:.4g} MPa, rho = {shot.rho:g} "
@@ -206,13 +241,41 @@ class TableCache:
                             numerics=self.numerics, workers=self.workers,
                             scheduler=self.scheduler, progress=False)
         self.built += 1
-        return store(table, self._entry(key))
+        failed = int(np.sum(table["failed"])) + int(np.sum(table["failed_first_layer"]))
+        if self.cache is not None and not failed:
+            try:
+                return store(table, self._entry(key))
+            except OSError as exc:
+                warn(self.cache, exc.strerror or str(exc))
+                self.cache = None
+        from cavex.netcdf3 import PlainDataset
 
-    def _copy(self, key):
-        """Copy the cache entry ``key`` into :attr:`directory` (atomically)."""
+        return reproducible_table(PlainDataset.from_dataset(table)).dataset()
+
+    def _copy(self, key, folder=None):
+        """Copy the cache entry ``key`` into ``folder`` (default :attr:`directory`),
+        atomically; an entry gone from the cache (pruned by another run, or the cache
+        unusable) is written from memory. Returns the path written."""
+        from cavex.verification.fedata.table import write_table
         from cavex.verification.output.files import copy_atomic
 
-        copy_atomic(self._entry(key), self.directory / f"table_{key}.nc")
+        path = Path(self.directory if folder is None else folder) / f"table_{key}.nc"
+        if self.cache is not None:
+            try:
+                return copy_atomic(self._entry(key), path)
+            except FileNotFoundError:
+                pass
+        return write_table(self._tables[key], path)
+
+    def write_used(self, folder):
+        """Write every table this run used into ``folder`` (``table_<key>.nc``, as the cache
+        stores it); returns the paths. A command calls it inside its staged write
+        (:func:`cavex.verification.output.paths.write_staged`): the tables arrive in the
+        results folder with the report, or not at all."""
+        if not self._tables:
+            return []
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        return [Path(self._copy(key, folder)) for key in sorted(self._tables)]
 
 
 # --- many shots -------------------------------------------------------------------------------

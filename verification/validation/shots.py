@@ -21,7 +21,7 @@ import math
 from dataclasses import dataclass, field
 
 from cavex.analytic.models.shots import shot_projectile, shot_target  # noqa: F401 (re-exported)
-from cavex.errors import CavexInputError
+from cavex.errors import CavexInputError, require_name
 from cavex.input_files import in_file, read_text
 from cavex.materials import MASS_RANGE, MAX_CRH, MAX_VELOCITY, RADIUS_RANGE
 
@@ -185,6 +185,7 @@ def _parse_row(number, cells, header):
     if not shot_id:
         raise CavexInputError("must be a non-empty shot name (got '')", f"line {number}, "
                               "column id")
+    require_name(shot_id, f"line {number}, column id")
     where = f"line {number} (shot {shot_id!r})"
     values = {}
     for column, (attribute, lower, upper, accepted) in NUMBER_COLUMNS.items():
