@@ -99,7 +99,10 @@ class Model:
         return tuple(f"{self.name}-{b}" for b in self.boundaries) or (self.name,)
 
     def boundary(self, boundary=None):
-        """The convention the model runs with: ``boundary``, or its default."""
+        """The convention the model runs with: ``boundary``, or its default; None for a model
+        with no convention (whatever is asked)."""
+        if not self.has_boundary():
+            return None
         return self.default_boundary if boundary is None else boundary
 
     def has_boundary(self):
