@@ -128,3 +128,151 @@ def test_table_command_writes_the_figure_beside_the_table(paper_table, tmp_path)
     assert plain == [str(tmp_path / "u.nc")] and not (tmp_path / "u_S.png").exists()
     args = build_parser("table").parse_args(["table", "--no-figures"])
     assert args.figures is False
+
+
+# --- 2. debonded runs say so; 3. a user's target is not "runway" -----------------------------
+
+def penetrate_job(target, projectile):
+    from cavex.verification.commands.penetrate import penetration_job
+
+    return penetration_job(target, projectile)
+
+
+def draw_penetration(job):
+    """The two panels of ``cavex penetrate``'s figures, drawn as the command draws them
+    (figure size, then tight layout)."""
+    from cavex.verification.report.penetration_figures import draw_deceleration, draw_velocity
+
+    panels = []
+    for draw in (draw_velocity, draw_deceleration):
+        fig = agg_figure(figsize=(6.4, 4.8))
+        ax = fig.add_subplot()
+        draw(ax, job)
+        fig.tight_layout()
+        fig.canvas.draw()
+        panels.append(ax)
+    return panels
+
+
+def test_penetrate_debonded_says_so_in_text_titles_and_legends():
+    from cavex.verification.commands.penetrate import text
+
+    target, projectile = load_config()
+    job = penetrate_job(target.with_interfaces("debonded"), projectile)
+    assert text(job).splitlines()[0].endswith(", debonded interfaces")
+    assert job["target_label"] == "runway (the paper's Table 1, debonded interfaces)"
+    for ax in draw_penetration(job):
+        assert "debonded interfaces" in ax.get_title()
+        assert legend_texts(ax)[0] == "runway (layered, debonded interfaces)"
+    bonded = penetrate_job(target, projectile)
+    assert "debonded" not in text(bonded).splitlines()[0]
+    assert all("debonded" not in ax.get_title() for ax in draw_penetration(bonded))
+
+
+def test_penetrate_user_target_names_every_layer_and_is_no_runway(user_config):
+    from cavex.verification.commands.penetrate import text
+
+    target, projectile = load_config(user_config)
+    job = penetrate_job(target, projectile)
+    assert job["target_label"] == "layered target" and "runway" not in text(job)
+    velocity, deceleration = draw_penetration(job)
+    for ax in (velocity, deceleration):
+        assert legend_texts(ax) == ["layered target", "asphalt alone"]
+    names = [t for t in deceleration.texts if t.get_text() in USER_NAMES]
+    assert sorted(t.get_text() for t in names) == sorted(USER_NAMES)  # none dropped
+    renderer = deceleration.figure.canvas.get_renderer()
+    frame = deceleration.get_window_extent(renderer)
+    boxes = [t.get_window_extent(renderer) for t in names]
+    title = deceleration.title.get_window_extent(renderer)
+    for box in boxes:  # inside the axes' width, below the title, none over another
+        assert frame.x0 - 0.5 <= box.x0 and box.x1 <= frame.x1 + 0.5
+        assert box.y1 <= title.y0 + 0.5
+    assert not any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])
+
+
+def test_penetrate_paper_target_keeps_its_words():
+    """The paper's target is still the runway (its committed figures and text unchanged)."""
+    target, projectile = load_config()
+    job = penetrate_job(target, projectile)
+    assert job["target_label"] == "runway (the paper's Table 1)"
+    velocity, deceleration = draw_penetration(job)
+    assert legend_texts(velocity) == ["runway (layered)", "concrete alone"]
+    assert {t.get_text() for t in deceleration.texts} == {"concrete", "macadam", "soil"}
+
+
+@pytest.fixture(scope="module")
+def trajectory_jobs(user_config):
+    """A debonded paper target and a user's target, 30 deg at 500 m/s (the derived model)."""
+    from cavex.analytic.penetration.strike import Strike
+    from cavex.verification.commands.trajectory import trajectory_job
+
+    target, projectile = load_config()
+    user, user_projectile = load_config(user_config)
+    strike = Strike(500.0, 30.0, 0.0, 0.0, 0.0)
+    return {"debonded": trajectory_job(target.with_interfaces("debonded"), projectile, strike),
+            "user": trajectory_job(user, user_projectile, strike, compare_homogeneous=True)}
+
+
+@pytest.fixture
+def kept_trajectory_figures(monkeypatch):
+    """The trajectory figures kept (by file name) instead of written."""
+    from cavex.verification.report import trajectory_figures
+
+    kept = {}
+
+    def keep(fig, path, **savefig):
+        fig.canvas.draw()
+        kept[path.name] = fig
+        return path
+
+    monkeypatch.setattr(trajectory_figures, "save_figure", keep)
+    return kept
+
+
+def titles(fig):
+    """The figure's title and its axes' titles, in one string."""
+    words = [fig._suptitle.get_text() if fig._suptitle else ""]
+    return " | ".join(words + [ax.get_title() for ax in fig.axes])
+
+
+def test_trajectory_debonded_says_so_in_text_and_every_figure(trajectory_jobs, tmp_path,
+                                                               kept_trajectory_figures):
+    from cavex.verification.commands.trajectory import text
+    from cavex.verification.report.trajectory_figures import figures
+
+    job = trajectory_jobs["debonded"]
+    assert text({**job, "outputs": []}).splitlines()[0].endswith("; debonded interfaces")
+    figures(job, tmp_path)
+    assert sorted(kept_trajectory_figures) == ["overload.png", "path_3d.png", "path_side.png",
+                                               "pitch_time.png"]
+    for name, fig in kept_trajectory_figures.items():
+        assert "debonded interfaces" in titles(fig), name
+
+
+def test_trajectory_user_target_is_a_layered_target_with_its_names(trajectory_jobs, tmp_path,
+                                                                    kept_trajectory_figures):
+    from cavex.verification.commands.trajectory import summary, text
+    from cavex.verification.report.trajectory_figures import figures
+
+    job = trajectory_jobs["user"]
+    words = text({**job, "outputs": []})
+    assert "layered target:" in words and "runway" not in words
+    assert "runway" in summary(job)["runs"]  # the JSON keys and file names stay
+    figures(job, tmp_path)
+    for name, fig in kept_trajectory_figures.items():
+        labels = [t.get_text() for legend in [*fig.legends, *(a.get_legend() for a in fig.axes)]
+                  if legend for t in legend.get_texts()]
+        assert not any("runway" in label for label in labels), name
+        assert "debonded" not in titles(fig), name
+    side = kept_trajectory_figures["path_side.png"]
+    assert any(label.startswith("layered target: ") for label in
+               (t.get_text() for t in side.legends[0].get_texts()))
+    renderer = side.canvas.get_renderer()
+    names = {t.get_text().replace("\n", " "): t for t in side.axes[0].texts}
+    assert set(USER_NAMES) <= set(names)
+    for name in USER_NAMES:  # inside the figure: not cropped at its right edge
+        assert names[name].get_window_extent(renderer).x1 <= side.bbox.x1, name
+    assert "\n" in names["crushed stone base"].get_text()  # wrapped to fit
+    legend_3d = [t.get_text() for t in kept_trajectory_figures["path_3d.png"].legends[0]
+                 .get_texts()]
+    assert set(USER_NAMES) <= set(legend_3d)

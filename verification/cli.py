@@ -24,13 +24,14 @@ COMMANDS = ("penetrate", "stress", "fem", "table", "verify", "batch", "calibrate
 
 class _Help(argparse.ArgumentDefaultsHelpFormatter):
     """Every option's help shows its default (or that it is required), unless the help already
-    says it; a flag (off unless given) shows none."""
+    says it; a flag (off unless given) shows none, nor does a command in ``cavex --help``'s
+    list (an entry of the optional COMMAND: bare ``cavex`` prints the help)."""
 
     def _get_help_string(self, action):
         text = action.help or ""
         if "default" in text or "required" in text:
             return text
-        if action.required or not action.option_strings:
+        if action.required:  # a required option or positional; not a command of the list
             return text + " (required)"
         if action.default is None or action.default is False or action.nargs == 0:
             return text

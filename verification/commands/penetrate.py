@@ -96,12 +96,21 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
             "boundary": boundary, "epsilon": epsilon,
             "table": None if table is None else str(table), "crater": crater,
             "runs": runs, "table2": table2_comparison(runs["runway"]) if paper else None,
-            "target_label": "runway (the paper's Table 1)" if paper else "layered target",
+            "target_label": target_label(paper, target.debonded),
             "notes": crater_notes(target, projectile, crater),
             "debonded": bool(target.debonded),
             "interface_depths": target.interface_depths,
             "title": model.describe(boundary, epsilon, table, settings.get("law")),
             "layer_names": target.layer_names()}
+
+
+def target_label(paper, debonded):
+    """The target in words: "runway (the paper's Table 1)" for the paper's (its layers and
+    projectile, whatever the interfaces), else "layered target"; ", debonded interfaces"
+    added where any is."""
+    if paper:
+        return "runway (the paper's Table 1" + (", debonded interfaces)" if debonded else ")")
+    return "layered target" + (" (debonded interfaces)" if debonded else "")
 
 
 def table_error(target, projectile, table, crater, runway):
@@ -148,7 +157,7 @@ def text(job):
     s = summary(job)
     debonded = [i for i in s["interfaces"] if i["bottom"] == "debonded"]
     lines = [f"model {s['model']}{get(s['resistance']).settings_text(s)}, crater from "
-             f"{s['crater']}"]
+             f"{s['crater']}" + (", debonded interfaces" if debonded else "")]
     if debonded:
         lines.append("debonded interfaces at " + ", ".join(
             f"{i['depth_m']:g} m (rear zone {i['rear_zone_m']:.4g} m)" for i in debonded))
