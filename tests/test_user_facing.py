@@ -9,9 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from cavex import __version__
 from cavex.config import load_config
 from cavex.netcdf3 import PlainDataset
-from cavex.verification.cli import build_parser
+from cavex.verification.cli import build_parser, main
 from cavex.verification.output.files import agg_figure
 
 RUNWAY_TOML = Path(__file__).parents[1] / "core" / "data" / "runway.toml"
@@ -276,3 +277,72 @@ def test_trajectory_user_target_is_a_layered_target_with_its_names(trajectory_jo
     legend_3d = [t.get_text() for t in kept_trajectory_figures["path_3d.png"].legends[0]
                  .get_texts()]
     assert set(USER_NAMES) <= set(legend_3d)
+
+
+# --- 4. help ------------------------------------------------------------------------------------
+
+def help_text(*command):
+    parser = build_parser(command[0] if command else None)
+    return (parser._subparsers._group_actions[0].choices[command[0]] if command
+            else parser).format_help()
+
+
+def test_command_list_tags_no_command_required():
+    text = help_text()
+    assert "(required)" not in text
+    for name in ("penetrate", "calibrate", "trajectory", "config"):
+        assert name in text
+
+
+def test_calibrate_help_offers_no_table_option_it_refuses():
+    text = " ".join(help_text("calibrate").split())
+    assert "--table" not in text and "an FE table (built by the command)" in text
+    assert "--table" in help_text("penetrate")  # where it is an option, it is named
+
+
+def test_law_help_and_errors_describe_the_same_two_laws(capsys):
+    from cavex.verification.commands.options import GLOBAL_LAW, LAYER_LAW
+
+    flat = " ".join(help_text("penetrate").split())
+    assert f"A of the global plain law {GLOBAL_LAW}" in flat
+    assert f"B of the global plain law {GLOBAL_LAW}" in flat
+    assert f"each layer's own plain law {LAYER_LAW}" in flat
+    assert main(["penetrate", "--law-A", "1e8", "--no-figures"]) == 2
+    error = capsys.readouterr().err
+    assert GLOBAL_LAW in error and LAYER_LAW in error
+    assert main(["penetrate", "--resistance", "law", "--no-figures"]) == 2
+    error = capsys.readouterr().err
+    assert "layers[0].law_A" in error and LAYER_LAW in error and GLOBAL_LAW in error
+
+
+def test_trajectory_velocity_help_gives_the_number():
+    flat = " ".join(help_text("trajectory").split())
+    V0 = load_config()[1].V0
+    assert V0 == 1000.0
+    assert ("--velocity VELOCITY striking speed (m/s; default: the projectile's V0, 1000 m/s "
+            "for the paper's Table 1)") in flat
+
+
+# --- 5. the version in every JSON output --------------------------------------------------------
+
+def test_every_json_print_opens_with_the_version(capsys, tmp_path):
+    """``--json`` goes through one function for every command (cli.main); two commands run."""
+    for argv in (["stress", "--depth", "0.3", "--velocity", "500", "--json"],
+                 ["penetrate", "--json", "--no-figures", "--out", str(tmp_path / "p")]):
+        assert main(argv) == 0, argv
+        document = json.loads(capsys.readouterr().out)
+        assert next(iter(document)) == "cavex_version" and document["cavex_version"] == (
+            __version__), argv
+
+
+def test_json_files_open_with_the_version(trajectory_jobs, tmp_path):
+    from cavex.verification.commands.trajectory import write_outputs
+
+    write_outputs(trajectory_jobs["user"], tmp_path, draw=False)
+    document = json.loads((tmp_path / "summary.json").read_text())
+    assert list(document) == ["cavex_version", "settings", "runs"]
+    assert document["cavex_version"] == __version__
+    root = Path(__file__).parents[1] / "results" / "validation"
+    for path in (root / "validation.json", root / "compilation_dev" / "validation.json"):
+        committed = json.loads(path.read_text())
+        assert next(iter(committed)) == "cavex_version", path  # regenerated with the key

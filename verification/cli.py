@@ -1,12 +1,11 @@
 """The ``cavex`` command line: the parser (each command's module adds its own options), the
 configuration, dispatch to the command's module (:mod:`cavex.verification.commands`, one per
 command: ``run(args, target, projectile)`` returns the result, printed as ``summary`` JSON with
-``--json``, else as ``text``) and exit codes."""
+``--json``, opened by ``cavex_version``, else as ``text``) and exit codes."""
 
 import argparse
 import gc
 import importlib
-import json
 import os
 import re
 import signal
@@ -15,6 +14,7 @@ import sys
 from cavex import __version__
 from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
+from cavex.verification.output.json_document import json_text
 
 #: The commands, in the order ``cavex --help`` lists them; each is the module
 #: ``cavex.verification.commands.<name>``.
@@ -166,7 +166,7 @@ def main(argv=None):
         _announce_on_terminal(args.command)
         command = command_module(args.command)
         result = command.run(args, target, projectile)
-        text = (json.dumps(command.summary(result), indent=2) if getattr(args, "json", False)
+        text = (json_text(command.summary(result)) if getattr(args, "json", False)
                 else command.text(result))
     except CavexInputError as exc:
         print(f"cavex: error: {exc}", file=sys.stderr)

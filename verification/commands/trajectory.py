@@ -32,6 +32,7 @@ from cavex.verification.commands.options import (
 from cavex.verification.commands.shared_options import add_config_option, add_figures_option
 from cavex.verification.fedata.runner import show_progress
 from cavex.verification.output.files import write_columns_csv, write_text_atomic
+from cavex.verification.output.json_document import json_text
 from cavex.verification.output.paths import check_output_dir, write_staged
 from cavex.verification.report.trajectory_figures import figures, run_label, shot_title
 
@@ -265,7 +266,7 @@ def write_outputs(job, out, draw=True):
                for name, result in job["runs"].items()]
     path = folder / "summary.json"
     document = summary(job)
-    text = json.dumps({"settings": document["settings"], "runs": document["runs"]}, indent=2)
+    text = json_text({"settings": document["settings"], "runs": document["runs"]})
     write_text_atomic(path, text + "\n")
     written.append(str(path))
     if draw:
