@@ -346,3 +346,11 @@ def test_json_files_open_with_the_version(trajectory_jobs, tmp_path):
     for path in (root / "validation.json", root / "compilation_dev" / "validation.json"):
         committed = json.loads(path.read_text())
         assert next(iter(committed)) == "cavex_version", path  # regenerated with the key
+
+
+def test_citation_names_this_version():
+    """CITATION.cff (validated against CFF 1.2.0 with cffconvert 2.0.0 when written) carries
+    the package's version."""
+    text = (Path(__file__).parents[1] / "CITATION.cff").read_text()
+    assert "cff-version: 1.2.0" in text
+    assert f"\nversion: {__version__}\n" in text
