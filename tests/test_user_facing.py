@@ -354,3 +354,17 @@ def test_citation_names_this_version():
     text = (Path(__file__).parents[1] / "CITATION.cff").read_text()
     assert "cff-version: 1.2.0" in text
     assert f"\nversion: {__version__}\n" in text
+
+
+def test_phase_table_columns_hold_a_long_layer_name(user_config, tmp_path):
+    from cavex.verification.commands.penetrate import text
+
+    long_name = "crushed and compacted stone base course"
+    path = tmp_path / "long.toml"
+    path.write_text(user_config.read_text().replace('"crushed stone base"', f'"{long_name}"'))
+    lines = text(penetrate_job(*load_config(path))).splitlines()
+    header = next(i for i, line in enumerate(lines) if line.startswith(" # label"))
+    rows = [line for line in lines[header + 1:] if line[:2].strip().isdigit()]
+    assert any(long_name in row for row in rows)
+    column = lines[header].index("L (m)") + len("L (m)")  # the depth column's right edge
+    assert all(row[column - 6:column].strip().replace(".", "").isdigit() for row in rows)

@@ -163,10 +163,11 @@ def text(job):
             f"{i['depth_m']:g} m (rear zone {i['rear_zone_m']:.4g} m)" for i in debonded))
     lines += [f"note: {note}" for note in s["notes"]]
     stage = (lambda p: f" {p['stage']:<9}") if debonded else (lambda p: "")
+    width = max([24, *(len(p["label"]) for p in s["phases"])])  # a long layer name fits
     lines += ["", f"phases ({s['target_label']}):",
-              f"{'#':>2}{' stage    ' if debonded else ''} {'label':<24} {'L (m)':>8} "
+              f"{'#':>2}{' stage    ' if debonded else ''} {'label':<{width}} {'L (m)':>8} "
               f"{'V (m/s)':>9} {'t (ms)':>8}  ends because"]
-    lines += [f"{p['phase']:>2}{stage(p)} {p['label']:<24} {p['end_depth_m']:8.4f} "
+    lines += [f"{p['phase']:>2}{stage(p)} {p['label']:<{width}} {p['end_depth_m']:8.4f} "
               f"{p['end_velocity_m_s']:9.2f} {p['end_time_s'] * 1e3:8.3f}  {p['end_reason']}"
               for p in s["phases"]]
     if "interpolation_error_estimate_m" in s:
