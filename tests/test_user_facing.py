@@ -103,8 +103,9 @@ def test_table_figure_degenerate_grids(velocities, depths, wall, names, switches
     bar = draw_table(ax, synthetic(velocities, depths, wall, names))
     assert len(ax.get_lines()) == len(depths)
     assert ax.get_xlim() == (velocities[0], velocities[-1])
-    assert ax.get_title().startswith(f"Tabulated S(V, L): {len(velocities)} velocities x "
-                                     f"{len(depths)} depths")
+    depth_words = "1 depth" if len(depths) == 1 else f"{len(depths)} depths"
+    assert ax.get_title() == (f"Tabulated S(V, L): {len(velocities)} velocities x "
+                              f"{depth_words}, {len(names)} layer" + "s" * (len(names) > 1))
     assert len(bar.ax.get_lines()) == switches
     low, high = sorted(bar.ax.get_ylim())
     assert low <= min(depths) < high and low < max(depths) <= high
@@ -112,6 +113,8 @@ def test_table_figure_degenerate_grids(velocities, depths, wall, names, switches
     layers = [t for t in legend_texts(ax) if t.startswith("wall in")]
     assert len(layers) == len(set(wall))  # one entry a wall layer
     assert not any("wall in :" in t for t in layers)  # a nameless layer is "layer k"
+    if len(depths) == 1:
+        assert layers == [f"wall in {names[0]}: L {depths[0]:g} m"]
     marker = ax.get_lines()[0].get_marker()
     assert marker == ("o" if len(velocities) < 4 else "None")
 

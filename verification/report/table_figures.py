@@ -67,6 +67,16 @@ def switch_depths(table):
     return [first for _, first, _ in wall_segments(table)[1:]]
 
 
+def counted(n, word, plural=None):
+    """``n word`` or ``n words`` (``plural``: the plural where it is not word + s)."""
+    return f"{n} {word if n == 1 else plural or word + 's'}"
+
+
+def depth_range(first, last):
+    """``first-last`` (m, 3 digits), or one depth."""
+    return f"{first:.3g}" if f"{first:.3g}" == f"{last:.3g}" else f"{first:.3g}-{last:.3g}"
+
+
 def draw_table(ax, table, cmap="viridis"):
     """On ``ax``: ``S`` against V (m/s), one line per depth coloured by depth (colour bar
     beside ``ax``, depth downward, the switch depths as red lines across it) and styled by
@@ -93,8 +103,8 @@ def draw_table(ax, table, cmap="viridis"):
     ax.set_xlim(float(velocity.min()), float(velocity.max()))
     ax.set_xlabel("cavity expansion velocity V (m/s)")
     ax.set_ylabel(r"S = $\sigma_r$ / $\tau$ of the wall layer")
-    ax.set_title(f"Tabulated S(V, L): {velocity.size} velocities x {depth.size} depths, "
-                 f"{len(names)} layer{'s' if len(names) != 1 else ''}", fontsize=10)
+    ax.set_title(f"Tabulated S(V, L): {counted(velocity.size, 'velocity', 'velocities')} x "
+                 f"{counted(depth.size, 'depth')}, {counted(len(names), 'layer')}", fontsize=10)
     bar = ax.figure.colorbar(ScalarMappable(norm, colours), ax=ax)
     bar.set_label("nose-tip depth L (m)")
     bar.ax.invert_yaxis()  # depth downward
@@ -102,7 +112,7 @@ def draw_table(ax, table, cmap="viridis"):
     for L in switches:
         bar.ax.axhline(L, color=SWITCH_COLOUR, lw=2.0)
     handles = [Line2D([], [], color="0.2", ls=LAYER_STYLES[k % len(LAYER_STYLES)],
-                      label=f"wall in {names[k]}: L {first:.3g}-{last:.3g} m")
+                      label=f"wall in {names[k]}: L {depth_range(first, last)} m")
                for k, first, last in wall_segments(table)]
     if switches:
         handles.append(Line2D([], [], color=SWITCH_COLOUR, lw=2.0, label="wall layer switches "
