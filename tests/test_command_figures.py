@@ -296,28 +296,35 @@ def test_the_collector_pause_restores_the_collector():
 
 
 def test_penetrate_layer_names_fit_without_overlap():
-    """The deceleration figure's layer names: a layer narrower than its name keeps it when its
-    neighbours leave room (the runway's macadam on a 5 m axis); names that would overlap or
-    stick out of the axes are left out; the placed ones never overlap."""
+    """The deceleration figure's layer names: every layer is named (issue 33: none dropped);
+    a layer narrower than its name keeps it on the first row when its neighbours leave room
+    (the runway's macadam on a 5 m axis), else its name goes up a row; a name that would stick
+    out of the axes is moved in to the edge; a layer below the view is named "below: name";
+    names never overlap."""
     from cavex.verification.output.files import agg_figure
     from cavex.verification.report.penetration_figures import layer_names
 
     def placed(bounds, names, xlim):
+        """``{name: row}`` of the placed names (row 0: just above the axes)."""
         fig = agg_figure(figsize=(6.4, 4.8))
         ax = fig.add_subplot()
         ax.set_xlim(*xlim)
-        layer_names(ax, names, [xlim[0], *bounds, xlim[1]])
+        rows = layer_names(ax, names, [xlim[0], *bounds, xlim[1]])
         renderer = fig.canvas.get_renderer()
-        boxes = sorted(((t.get_window_extent(renderer), t.get_text()) for t in ax.texts),
-                       key=lambda b: b[0].x0)
-        for (a, _), (b, _) in zip(boxes, boxes[1:], strict=False):
-            assert a.x1 <= b.x0  # never overlapping
+        boxes = [(t.get_window_extent(renderer), t.get_text()) for t in ax.texts]
+        for i, (a, _) in enumerate(boxes):
+            assert not any(a.overlaps(b) for b, _ in boxes[i + 1:])  # never overlapping
         frame = ax.get_window_extent(renderer)
-        assert all(frame.x0 <= box.x0 and box.x1 <= frame.x1 for box, _ in boxes)
-        return [name for _, name in boxes]
+        assert all(frame.x0 - 0.5 <= box.x0 and box.x1 <= frame.x1 + 0.5 for box, _ in boxes)
+        bottoms = sorted({round(box.y0, 3) for box, _ in boxes})
+        assert len(bottoms) == rows
+        return {name: bottoms.index(round(box.y0, 3)) for box, name in boxes}
 
     names = ["concrete", "macadam", "soil"]
-    assert placed([0.65, 1.1], names, (-0.26, 5.52)) == names  # macadam 7.8 % of the axis
+    # macadam 7.8 % of the axis: one row
+    assert placed([0.65, 1.1], names, (-0.26, 5.52)) == {n: 0 for n in names}
     crowded = placed([0.65, 0.7], names, (0.0, 5.5))  # a 5 cm layer between two names
-    assert "macadam" not in crowded and {"concrete", "soil"} <= set(crowded)
-    assert placed([0.65, 1.1], names, (0.0, 0.5)) == ["concrete"]  # only the layer in view
+    assert crowded == {"concrete": 0, "macadam": 1, "soil": 0}
+    # only concrete in view: the layers below named at the right edge
+    assert placed([0.65, 1.1], names, (0.0, 0.5)) == {"concrete": 0, "below: macadam": 0,
+                                                      "below: soil": 1}

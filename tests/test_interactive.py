@@ -122,11 +122,13 @@ def test_the_paper_model_loads_no_compiled_kernel():
 def test_table_writes_without_xarray(tmp_path):
     """``cavex table`` writes its netCDF without xarray (cavex.netcdf3),
     so neither xarray nor dask nor pandas is loaded by it (their import and xarray's probes
-    for dask cost ~1 s of CPU: benchmarks/table.py); the file reads back through xarray."""
+    for dask cost ~1 s of CPU: benchmarks/table.py); the file reads back through xarray. Its
+    figure (t_S.png) loads matplotlib."""
     out = tmp_path / "t.nc"
     code, _, loaded = _loaded_after(["table", "--velocities", "0", "500", "--depths", "0.1",
                                      "0.2", "--workers", "1", "-o", str(out)])
-    assert (code, loaded) == (0, "['numba', 'scipy', 'skfem']")
+    assert (code, loaded) == (0, "['matplotlib', 'numba', 'scipy', 'skfem']")
+    assert (tmp_path / "t_S.png").stat().st_size > 0
     import xarray as xr
 
     with xr.open_dataset(out, engine="scipy") as table:

@@ -1,12 +1,11 @@
 """The ``cavex`` command line: the parser (each command's module adds its own options), the
 configuration, dispatch to the command's module (:mod:`cavex.verification.commands`, one per
 command: ``run(args, target, projectile)`` returns the result, printed as ``summary`` JSON with
-``--json``, else as ``text``) and exit codes."""
+``--json``, opened by ``cavex_version``, else as ``text``) and exit codes."""
 
 import argparse
 import gc
 import importlib
-import json
 import os
 import re
 import signal
@@ -15,6 +14,7 @@ import sys
 from cavex import __version__
 from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError
+from cavex.verification.output.json_document import json_text
 
 #: The commands, in the order ``cavex --help`` lists them; each is the module
 #: ``cavex.verification.commands.<name>``.
@@ -24,13 +24,14 @@ COMMANDS = ("penetrate", "stress", "fem", "table", "verify", "batch", "calibrate
 
 class _Help(argparse.ArgumentDefaultsHelpFormatter):
     """Every option's help shows its default (or that it is required), unless the help already
-    says it; a flag (off unless given) shows none."""
+    says it; a flag (off unless given) shows none, nor does a command in ``cavex --help``'s
+    list (an entry of the optional COMMAND: bare ``cavex`` prints the help)."""
 
     def _get_help_string(self, action):
         text = action.help or ""
         if "default" in text or "required" in text:
             return text
-        if action.required or not action.option_strings:
+        if action.required:  # a required option or positional; not a command of the list
             return text + " (required)"
         if action.default is None or action.default is False or action.nargs == 0:
             return text
@@ -165,7 +166,7 @@ def main(argv=None):
         _announce_on_terminal(args.command)
         command = command_module(args.command)
         result = command.run(args, target, projectile)
-        text = (json.dumps(command.summary(result), indent=2) if getattr(args, "json", False)
+        text = (json_text(command.summary(result)) if getattr(args, "json", False)
                 else command.text(result))
     except CavexInputError as exc:
         print(f"cavex: error: {exc}", file=sys.stderr)

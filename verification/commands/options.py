@@ -27,6 +27,11 @@ FLOWN = {"flies": True}  # penetrate: every model with a 1-D resistance
 FLOWN_3D = {"flies_3d": True}  # trajectory: every model with a 3-D stress law
 CLOSED_FORMS = {"closed_form": True}  # stress: the closed forms of the wall stress
 FITTED = {"fits_mapping": True}  # calibrate: the models of the (f_c, rho) mapping
+#: The two plain laws of ``--resistance law``, in the words of the help and of the errors: the
+#: options' global law and each layer's own (its keys), which share the letters A and B
+GLOBAL_LAW = "sigma_n = A + B V_n^2 (A in Pa, B in kg/m^3)"
+LAYER_LAW = "S = law_A + law_B rho V^2 / tau (law_A, law_B dimensionless)"
+TABLE_BUILT = " (built by the command)"  # a table model where the command has no --table
 NEW_OPTIONS = "--resistance derived|paper|table (with --boundary dynamic|quasi-static)"
 #: old values of --resistance and --model that are no label, with what replaced them
 OLD_VALUES = {"closed-form": "--resistance derived or --resistance paper",
@@ -39,7 +44,8 @@ def add_resistance_options(command, offered=FITTED, table=True, epsilon=True):
     and the refused ``--model``; ``offered``: the capabilities of the models offered."""
     offered = names(**offered)
     models = [get(name) for name in offered]
-    phrases = [m.help + (" (--epsilon)" if m.takes_epsilon and epsilon else "") for m in models]
+    phrases = [(m.help if table or not m.takes_table else m.help.replace(" (--table)", TABLE_BUILT))
+               + (" (--epsilon)" if m.takes_epsilon and epsilon else "") for m in models]
     command.add_argument("--resistance", default="derived", metavar="{" + ",".join(offered) + "}",
                          help="the resistance: " + ", ".join(phrases))
     command.add_argument("--boundary", choices=BOUNDARIES,
@@ -60,11 +66,11 @@ def add_resistance_options(command, offered=FITTED, table=True, epsilon=True):
 def add_law_options(command):
     """``--law-A PA --law-B KG_PER_M3``: the global plain law of ``--resistance law`` (added by
     :func:`add_resistance_options` where "law" is offered: ``penetrate``, ``trajectory``)."""
-    command.add_argument("--law-A", dest="law_A", type=float, help="A of sigma_n = A + B "
-                         "V_n^2 everywhere (Pa; with --resistance law; default: none, each "
-                         "layer's law_A, law_B keys)")
-    command.add_argument("--law-B", dest="law_B", type=float, help="B (kg/m^3; with "
-                         "--law-A; default: none)")
+    command.add_argument("--law-A", dest="law_A", type=float, help="A of the global plain law "
+                         f"{GLOBAL_LAW} (with --resistance law and --law-B; default: none, "
+                         f"each layer's own plain law {LAYER_LAW} from its keys)")
+    command.add_argument("--law-B", dest="law_B", type=float, help="B of the global plain law "
+                         f"{GLOBAL_LAW} (with --law-A; default: none)")
 
 
 def law_settings(args, target):
@@ -76,15 +82,16 @@ def law_settings(args, target):
     law = [args.law_A is not None, args.law_B is not None]
     takes_law = get(args.resistance).takes_law
     if any(law) and not (all(law) and takes_law):
-        raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' go with "
-                              "'--resistance law' (both, or neither: each layer's law_A, "
-                              "law_B keys)")
+        raise CavexInputError("options '--law-A PA --law-B KG_PER_M3' (the global plain law "
+                              f"{GLOBAL_LAW}) go with '--resistance law' (both, or neither: "
+                              f"each layer's own plain law {LAYER_LAW} from its keys)")
     if takes_law and not any(law):
         missing = next((i for i, plain in enumerate(target.plain_laws) if plain is None), None)
         if missing is not None:
             raise CavexInputError("must be given on every layer for '--resistance law' without "
-                                  "'--law-A PA --law-B KG_PER_M3' (the layer's plain law "
-                                  "S = A + B rho V^2 / tau; docs/config.md)",
+                                  "'--law-A PA --law-B KG_PER_M3' (the layer's own plain law "
+                                  f"{LAYER_LAW}; the options give instead the global plain "
+                                  f"law {GLOBAL_LAW}; docs/config.md)",
                                   f"layers[{missing}].law_A")
     if takes_law and args.boundary is not None:
         refuse_boundary(args.resistance)

@@ -96,12 +96,21 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
             "boundary": boundary, "epsilon": epsilon,
             "table": None if table is None else str(table), "crater": crater,
             "runs": runs, "table2": table2_comparison(runs["runway"]) if paper else None,
-            "target_label": "runway (the paper's Table 1)" if paper else "layered target",
+            "target_label": target_label(paper, target.debonded),
             "notes": crater_notes(target, projectile, crater),
             "debonded": bool(target.debonded),
             "interface_depths": target.interface_depths,
             "title": model.describe(boundary, epsilon, table, settings.get("law")),
             "layer_names": target.layer_names()}
+
+
+def target_label(paper, debonded):
+    """The target in words: "runway (the paper's Table 1)" for the paper's (its layers and
+    projectile, whatever the interfaces), else "layered target"; ", debonded interfaces"
+    added where any is."""
+    if paper:
+        return "runway (the paper's Table 1" + (", debonded interfaces)" if debonded else ")")
+    return "layered target" + (" (debonded interfaces)" if debonded else "")
 
 
 def table_error(target, projectile, table, crater, runway):
@@ -148,16 +157,17 @@ def text(job):
     s = summary(job)
     debonded = [i for i in s["interfaces"] if i["bottom"] == "debonded"]
     lines = [f"model {s['model']}{get(s['resistance']).settings_text(s)}, crater from "
-             f"{s['crater']}"]
+             f"{s['crater']}" + (", debonded interfaces" if debonded else "")]
     if debonded:
         lines.append("debonded interfaces at " + ", ".join(
             f"{i['depth_m']:g} m (rear zone {i['rear_zone_m']:.4g} m)" for i in debonded))
     lines += [f"note: {note}" for note in s["notes"]]
     stage = (lambda p: f" {p['stage']:<9}") if debonded else (lambda p: "")
+    width = max([24, *(len(p["label"]) for p in s["phases"])])  # a long layer name fits
     lines += ["", f"phases ({s['target_label']}):",
-              f"{'#':>2}{' stage    ' if debonded else ''} {'label':<24} {'L (m)':>8} "
+              f"{'#':>2}{' stage    ' if debonded else ''} {'label':<{width}} {'L (m)':>8} "
               f"{'V (m/s)':>9} {'t (ms)':>8}  ends because"]
-    lines += [f"{p['phase']:>2}{stage(p)} {p['label']:<24} {p['end_depth_m']:8.4f} "
+    lines += [f"{p['phase']:>2}{stage(p)} {p['label']:<{width}} {p['end_depth_m']:8.4f} "
               f"{p['end_velocity_m_s']:9.2f} {p['end_time_s'] * 1e3:8.3f}  {p['end_reason']}"
               for p in s["phases"]]
     if "interpolation_error_estimate_m" in s:

@@ -14,6 +14,7 @@ import numpy as np
 
 from cavex.verification.commands.shared_options import (
     add_config_option,
+    add_figures_option,
     add_parallel_options,
     scheduler_of,
 )
@@ -34,6 +35,7 @@ def add_arguments(parser):
     parser.add_argument("--nu", type=float, help="Poisson's ratio for every layer (default: "
                         "file's)")
     parser.add_argument("--json", action="store_true", help="print JSON")
+    add_figures_option(parser, "the NetCDF table")
     add_parallel_options(parser)
 
 
@@ -45,7 +47,7 @@ def run(args, target, projectile):
     refuse_debonded(target, "table")
     result = job(target, projectile, args.velocities, args.depths, args.out, nu=args.nu,
                  workers=args.workers, scheduler=scheduler_of(args), progress=args.progress)
-    result["outputs"] = write_outputs(result, result["output"])
+    result["outputs"] = write_outputs(result, result["output"], draw=args.figures)
     return result
 
 
@@ -104,20 +106,26 @@ def grid_line(grid):
             + ", ".join(f"{d:.4g}" for d in added) + " m)")
 
 
-def write_outputs(job, out):
+def write_outputs(job, out, draw=True):
     """Write the table into the file ``out``, remove the case store (the table holds every cell
-    now); return the paths written."""
+    now) and, if ``draw``, the figure of S(V, L) beside it, ``<out stem>_S.png``
+    (:mod:`cavex.verification.report.table_figures`); return the paths written."""
     from cavex.verification.fedata.table import write_table
 
-    written = write_table(job["table"], out)
+    written = [write_table(job["table"], out)]
     shutil.rmtree(job["store"], ignore_errors=True)
-    return [str(written)]
+    if draw:
+        from cavex.verification.report.table_figures import figure, figure_path
+
+        written.append(figure(job["table"], figure_path(written[0])))
+    return [str(path) for path in written]
 
 
 def summary(job):
     """What ``cavex table --json`` prints: FE cases (the grid plus the first layer alone),
     the grid's axes, failed cells, the largest error estimate (None: none estimated), the wall
-    time and the file written."""
+    time, the table's file and the files written (the table and its figure; none before they
+    are)."""
     table = job["table"]
     estimates = table["error_estimate"]
     estimate = float(np.nanmax(estimates)) if np.any(np.isfinite(estimates)) else None
@@ -129,7 +137,7 @@ def summary(job):
             "depths_added_m": job["grid"]["added"],
             "failed": int(table["failed"].sum()) + int(table["failed_first_layer"].sum()),
             "max_error_estimate": estimate, "wall_time_s": float(job["seconds"]),
-            "output": str(job["output"])}
+            "output": str(job["output"]), "outputs": list(job.get("outputs", ()))}
 
 
 def text(job):
@@ -145,5 +153,5 @@ def text(job):
         f"failed  {s['failed']}",
         f"largest FE error estimate {estimate:.3%}",
         f"time    {s['wall_time_s']:.1f} s",
-        f"wrote   {s['output']}",
+        f"wrote   {', '.join(s['outputs'] or [s['output']])}",
     ])

@@ -19,6 +19,7 @@ import numpy as np
 from cavex.analytic.models import get
 from cavex.analytic.models.plain_law import law_echo
 from cavex.analytic.penetration.strike import Strike
+from cavex.config import load_config
 from cavex.errors import CavexInputError, CavexNumericalError, is_finite_number, require
 from cavex.verification.commands.options import (
     FLOWN_3D,
@@ -31,8 +32,9 @@ from cavex.verification.commands.options import (
 from cavex.verification.commands.shared_options import add_config_option, add_figures_option
 from cavex.verification.fedata.runner import show_progress
 from cavex.verification.output.files import write_columns_csv, write_text_atomic
+from cavex.verification.output.json_document import json_text
 from cavex.verification.output.paths import check_output_dir, write_staged
-from cavex.verification.report.trajectory_figures import figures, shot_title
+from cavex.verification.report.trajectory_figures import figures, run_label, shot_title
 
 HELP = ("oblique shot with attitude: the rigid projectile in 3-D through the layers "
         "(docs/oblique.md)")
@@ -57,7 +59,8 @@ MAX_STEPS = 100_000
 def add_arguments(parser):
     """The options of ``cavex trajectory``."""
     add_config_option(parser)
-    parser.add_argument("--velocity", type=float, help="striking speed (m/s; default V0)")
+    parser.add_argument("--velocity", type=float, help="striking speed (m/s; default: the "
+                        f"projectile's V0, {load_config()[1].V0:g} m/s for the paper's Table 1)")
     parser.add_argument("--obliquity", type=float, default=0.0,
                         help="angle of the velocity from the target normal (deg)")
     parser.add_argument("--attack", type=float, default=0.0,
@@ -169,7 +172,9 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
         settings["crater"] = crater
     if get(resistance).takes_law:
         settings["law"] = law_echo(target, law_A, law_B)
-    return {"runs": runs, "settings": settings, "target": target}
+    paper = target.with_interfaces("bonded") == load_config()[0]
+    return {"runs": runs, "settings": settings, "target": target,
+            "labels": {} if paper else {"runway": "layered target"}}
 
 
 @contextmanager
@@ -244,8 +249,7 @@ def write_outputs(job, out, draw=True):
                for name, result in job["runs"].items()]
     path = folder / "summary.json"
     document = summary(job)
-    text = json.dumps({k: document[k] for k in ("settings", "runs", "estimate") if k in document},
-                      indent=2)
+    text = json_text({k: document[k] for k in ("settings", "runs", "estimate") if k in document})
     write_text_atomic(path, text + "\n")
     written.append(str(path))
     if draw:
@@ -321,7 +325,7 @@ def text(job):
     lines = [shot_title(document)]
     for name, s in document["runs"].items():
         e = s["end"]
-        lines += ["", f"{name}:",
+        lines += ["", f"{run_label(job, name)}:",
                   f"{'phase':<10} {'ends at t (ms)':>14} {'tip z (m)':>10} {'pitch':>8} "
                   f"{'speed':>8}  because"]
         lines += [f"{p['label']:<10} {p['end_time_s'] * 1e3:14.4f} "

@@ -14,7 +14,6 @@ and no wall time is written, so a rerun gives the same files.
 
 import csv
 import io
-import json
 import os
 import shlex
 import sys
@@ -29,6 +28,7 @@ from cavex.verification.commands.shared_options import (
 )
 from cavex.verification.fedata.runner import check_execution
 from cavex.verification.output.files import write_text_atomic
+from cavex.verification.output.json_document import json_text
 from cavex.verification.output.paths import check_output_dir, write_staged
 from cavex.verification.report.validation_markdown import (
     number_or_na,
@@ -177,7 +177,7 @@ def write_outputs(result, out, draw=True):
     (``tables/``) into ``out``; return the paths."""
     out.mkdir(parents=True, exist_ok=True)
     written = []
-    for name, content in (("validation.json", json.dumps(summary(result), indent=2) + "\n"),
+    for name, content in (("validation.json", json_text(summary(result)) + "\n"),
                           ("predictions.csv", predictions_csv(result)),
                           ("report.md", report_markdown(result, figures=draw))):
         write_text_atomic(out / name, content)

@@ -26,12 +26,25 @@ def figures(job, out):
 
 
 def _labels(job):
-    """The legend's words for the runway and for its first layer alone."""
+    """The legend's words for the target (the paper's: "runway"; another: "layered target")
+    and for its first layer alone."""
     names = job.get("layer_names", [])
-    runway = "runway (layered)" if job.get("table") is None else "runway (layered, FE table)"
+    paper = job.get("target_label", "runway").startswith("runway")
+    whole, kind = ("runway", "layered, ") if paper else ("layered target", "")
     if job.get("debonded"):
-        runway = "runway (layered, debonded interfaces)"
-    return runway, f"{names[0] if names else 'first layer'} alone"
+        label = f"{whole} ({kind}debonded interfaces)"
+    elif job.get("table") is not None:
+        label = f"{whole} ({kind}FE table)"
+    else:
+        label = f"{whole} (layered)" if paper else whole
+    return label, f"{names[0] if names else 'first layer'} alone"
+
+
+def subtitle(job):
+    """The resistance in words (``job["title"]``), with ", debonded interfaces" where the
+    target has any, wrapped to 70 characters."""
+    words = job["title"] + (", debonded interfaces" if job.get("debonded") else "")
+    return textwrap.fill(words, 70)
 
 
 def draw_velocity(ax, job):
@@ -42,7 +55,7 @@ def draw_velocity(ax, job):
     ax.plot(runway.t * 1e3, runway.velocity, label=runway_label)
     ax.plot(single.t * 1e3, single.velocity, "--", label=single_label)
     ax.set(xlabel="time (ms)", ylabel="velocity (m/s)")
-    ax.set_title(f"Velocity against time\n{textwrap.fill(job['title'], 70)}", fontsize=10)
+    ax.set_title(f"Velocity against time\n{subtitle(job)}", fontsize=10)
     legend_below(ax)
 
 
@@ -59,33 +72,52 @@ def draw_deceleration(ax, job):
     for depth in job["interface_depths"]:
         ax.axvline(depth, color="grey", linewidth=0.8, linestyle=":")
     ax.set_xlim(left, right)
-    layer_names(ax, job.get("layer_names", []), bounds)
+    rows = layer_names(ax, job.get("layer_names", []), bounds)
     ax.set(xlabel="nose-tip depth (m)", ylabel=r"deceleration ($10^3$ g)")
-    ax.set_title(f"Deceleration against depth\n{textwrap.fill(job['title'], 70)}", fontsize=10,
-                 pad=14)
+    ax.set_title(f"Deceleration against depth\n{subtitle(job)}", fontsize=10,
+                 pad=14 + NAME_ROW_PT * (rows - 1))
     legend_below(ax)
 
 
+NAME_ROW_PT = 10  # the height of a row of layer names above the axes (points)
+
+
 def layer_names(ax, names, bounds):
-    """Each layer's name above the axes, centred on the part of its depth range ``bounds[k]``
-    to ``bounds[k + 1]`` in view; a name that would stick out of the axes or overlap a
-    name already placed is left out (its extent measured, not guessed: a layer narrower
-    than its name keeps it when its neighbours leave room)."""
+    """Every layer's name above the axes: a layer in view centred on the part of its depth
+    range ``bounds[k]`` to ``bounds[k + 1]`` in view, a layer below the view at the right
+    edge ("below: name"); a name that would stick out of the axes is moved in to its edge,
+    one that would overlap a name already placed goes up a row (extents measured, not
+    guessed). Returns the number of rows used (1 when every name fits in one)."""
+    from matplotlib.transforms import offset_copy
+
     left, right = ax.get_xlim()
     renderer = ax.figure.canvas.get_renderer()
     frame, placed = ax.get_window_extent(renderer), []
     for k, name in enumerate(names[:len(bounds) - 1]):
         lo, hi = max(bounds[k], left), min(bounds[k + 1], right)
-        if hi <= lo:
+        if hi <= lo and bounds[k] < right:  # above the view (none: the view starts at 0)
             continue
-        text = ax.text(0.5 * (lo + hi), 1.0, name, ha="center", va="bottom", fontsize=8,
-                       style="italic", transform=ax.get_xaxis_transform())
-        box = text.get_window_extent(renderer)
-        if (box.x0 < frame.x0 or box.x1 > frame.x1
-                or any(box.x0 < other.x1 and other.x0 < box.x1 for other in placed)):
-            text.remove()
-        else:
-            placed.append(box)
+        for row in range(len(names)):
+            where = offset_copy(ax.get_xaxis_transform(), fig=ax.figure, y=NAME_ROW_PT * row,
+                                units="points") if row else ax.get_xaxis_transform()
+            if hi > lo:
+                text = ax.text(0.5 * (lo + hi), 1.0, name, ha="center", va="bottom",
+                               fontsize=8, style="italic", transform=where)
+            else:
+                text = ax.text(right, 1.0, f"below: {name}", ha="right", va="bottom",
+                               fontsize=8, style="italic", transform=where)
+            box = text.get_window_extent(renderer)
+            if box.x0 < frame.x0 or box.x1 > frame.x1:  # moved in to the edge it crosses
+                text.set(x=left if box.x0 < frame.x0 else right,
+                         ha="left" if box.x0 < frame.x0 else "right")
+                box = text.get_window_extent(renderer)
+            if any(box.x0 < other.x1 and other.x0 < box.x1 and row == other_row
+                   for other, other_row in placed):
+                text.remove()
+                continue
+            placed.append((box, row))
+            break
+    return 1 + max((row for _, row in placed), default=0)
 
 
 def legend_below(ax):

@@ -61,8 +61,23 @@ def _layer_names(ax, target):
     for k, name in enumerate(target.layer_names()):
         low, high = max(tops[k], shallow, 0.0), min(tops[k + 1], deep)
         if high > low:
-            ax.text(1.01, 0.5 * (low + high), name, transform=ax.get_yaxis_transform(),
-                    va="center", fontsize=8, color="0.3")
+            fit_right(ax.text(1.01, 0.5 * (low + high), name,
+                              transform=ax.get_yaxis_transform(), va="center", fontsize=8,
+                              color="0.3"))
+
+
+def fit_right(text, narrowest=6):
+    """Wrap ``text`` (a name right of the axes) onto more lines until it ends inside the
+    figure (its extent measured), down to ``narrowest`` characters a line: a long layer
+    name is not cropped at the figure's edge."""
+    figure = text.figure
+    renderer = figure.canvas.get_renderer()
+    edge, words = figure.bbox.x1, text.get_text()
+    for width in range(len(words), narrowest - 1, -1):
+        if text.get_window_extent(renderer).x1 <= edge:
+            return text
+        text.set_text(textwrap.fill(words, width))
+    return text
 
 
 def outline_points(result, y):
@@ -116,10 +131,11 @@ def draw_side_view(ax, job, curves=None):
     target = job["target"]
     curves, ((x0, x1), (z0, z1)) = side_view_curves(job) if curves is None else curves
     for name, color, h, outlines in curves:
-        ax.plot(h["cg_x_m"], h["cg_z_m"], color=color, lw=1, label=f"{name}: centre of mass")
+        label = run_label(job, name)
+        ax.plot(h["cg_x_m"], h["cg_z_m"], color=color, lw=1, label=f"{label}: centre of mass")
         for k, (ox, oz) in enumerate(outlines):
             ax.plot(ox, oz, color=color, lw=0.8,
-                    label=f"{name}: outline at 9 equal time intervals" if k == 0 else None)
+                    label=f"{label}: outline at 9 equal time intervals" if k == 0 else None)
     for depth in target.interface_depths:
         if z0 < depth < z1:
             ax.axhline(depth, color="0.5", lw=0.8, ls="--")
@@ -155,9 +171,15 @@ def side_view(job, path):
     return save_figure(fig, path, dpi=120)
 
 
+def run_label(job, name):
+    """The words for the run ``name`` of ``job`` in legends and text: its ``labels`` entry
+    (a target other than the paper's: "layered target" for "runway"), else the name."""
+    return job.get("labels", {}).get(name, name)
+
+
 def shot_title(job):
     """One line of the shot's settings (``job`` or its summary: its ``settings``): speed,
-    obliquity, attack, resistance, the contact and the entry crater."""
+    obliquity, attack, resistance, the contact, the entry crater and debonded interfaces."""
     s = job["settings"]
     law = get(s["resistance"]).label(s["boundary"])
     return (f"V0 = {s['speed_m_s']:g} m/s, obliquity {s['obliquity_deg']:g} deg, attack "
@@ -165,7 +187,8 @@ def shot_title(job):
             + (f"contact ramp {s['contact_ramp_m_s']:g} m/s" if "contact_ramp_m_s" in s
                else f"held contact {s['contact_hold_m']:g} m")
             + (f"; entry crater to {s['entry_crater_m'][1]:.3g} m" if "entry_crater_m" in s
-               else ""))
+               else "")
+            + ("; debonded interfaces" if "debonded" in s.get("interfaces", ()) else ""))
 
 
 def _note(ax, text):
@@ -201,7 +224,7 @@ def draw_pitch(ax, job):
     moving = turning_runs(job)
     for k, name, result in moving:
         h = result.history
-        ax.plot(h["t_s"] * 1e3, h["pitch_deg"], color=f"C{k}", label=name)
+        ax.plot(h["t_s"] * 1e3, h["pitch_deg"], color=f"C{k}", label=run_label(job, name))
         for ph in result.phases[:-1]:
             ax.axvline(ph["end_time_s"] * 1e3, color=f"C{k}", lw=0.6, ls=":")
     if moving:
@@ -209,7 +232,7 @@ def draw_pitch(ax, job):
         ax.set_ylabel("pitch (deg, axis from +z toward +x)")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    still = [name for name, _ in runs if name not in {m[1] for m in moving}]
+    still = [run_label(job, name) for name, _ in runs if name not in {m[1] for m in moving}]
     if still:
         note = (f"pitch of {', '.join(still)} stays 0 (below {PITCH_ROUNDOFF_DEG:g} deg: "
                 "round-off; a shot in its plane of symmetry does not turn)")
@@ -255,8 +278,8 @@ def draw_overload_row(ax_time, ax_depth, job, key):
         if key == "lateral_g" and np.max(np.abs(h[key])) < LATERAL_ROUNDOFF * peak:
             continue
         shown += 1
-        ax_time.plot(h["t_s"] * 1e3, h[key] / 1e3, color=f"C{k}", label=name)
-        ax_depth.plot(h["tip_z_m"], h[key] / 1e3, color=f"C{k}", label=name)
+        ax_time.plot(h["t_s"] * 1e3, h[key] / 1e3, color=f"C{k}", label=run_label(job, name))
+        ax_depth.plot(h["tip_z_m"], h[key] / 1e3, color=f"C{k}", label=run_label(job, name))
     word = key.split("_")[0]
     if not shown:
         for a in (ax_time, ax_depth):
@@ -334,7 +357,7 @@ def view_3d(job, path):
 
 
 def draw_view_3d(ax, job):
-    """On the 3-D ``ax`` (``computed_zorder=False``): the runway's path in the layered block,
+    """On the 3-D ``ax`` (``computed_zorder=False``): the target's path in the layered block,
     drawn to scale (equal axes, ticks in m): the block is cut open along the plane of obliquity
     (its half ``y >= 0``, behind the path as seen), each layer a coloured band on the block's
     back walls and floor, the surface and the interfaces outlined, the centre of mass's path
