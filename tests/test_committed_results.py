@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import cavex.analytic.penetration.resistance as resistance_module
+import cavex.analytic.models as resistance_module
 from cavex.verification.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
