@@ -276,34 +276,38 @@ def test_zones_open_at_their_events(oblique_pair, debonded):
 
 
 def test_first_debonded_interface_adds_a_nose_up_turn(oblique_pair):
-    """Done-when (issue 20), measured: after the nose tip crosses the first interface the
-    debonded runway turns nose up (pitch away from +z grows) by 0.159 deg at ramp 0.01 m/s and
-    0.137 deg at 0.003 m/s; bonded: -0.002 and -0.001 deg. The added turn is positive and 70x
-    the bonded one; it converges first order in the ramp to +0.140 +- 0.003 deg (rtol 1e-4,
-    ramps 0.03 to 0.001 m/s), but between 0.01 and 0.003 m/s it differs by 14 % here (8 % at
-    rtol 1e-4), not the 3 % the issue asks (docs/oblique.md "Debonded interfaces")."""
+    """Done-when (issue 20), with the converged nose rule (16 points, issue 30): after the nose
+    tip crosses the first interface the debonded runway turns nose up by 0.095 deg more than
+    the bonded one at ramp 0.01 m/s and 0.100 deg at 0.003 m/s (measured; bonded: below 0.01
+    deg). The 8-point rule's +0.16 deg was a discretisation artefact: over nose points 16-64,
+    azimuths, shank rings, rtol and the contact the added turn spans +0.06 to +0.12 deg
+    (docs/oblique.md "Convergence"), so the bound here is that band's lower edge, and the two
+    ramps agree within 10 % (measured 5 %)."""
     added = {ramp: _turn_after(oblique_pair["debonded", ramp])
              - _turn_after(oblique_pair["bonded", ramp]) for ramp in (0.01, 0.003)}
     print("added turn (deg) at ramp 0.01, 0.003:", added)
-    assert added[0.01] > 0.1 and added[0.003] > 0.1
+    assert added[0.01] > 0.05 and added[0.003] > 0.05
     for ramp in (0.01, 0.003):
         assert abs(_turn_after(oblique_pair["bonded", ramp])) < 0.01
-    assert abs(added[0.003] / added[0.01] - 1.0) < 0.2  # measured 0.137 / 0.159: -14 %
+    assert abs(added[0.003] / added[0.01] - 1.0) < 0.1  # measured 0.0998 / 0.0948: +5 %
 
 
-def test_axial_overload_peaks_after_the_debonded_interface(oblique_pair, debonded):
-    """The nose enters the macadam's crater: the axial overload dips across the gap and peaks
-    again after the interface (measured: a dip to 9 700 g, a peak of 10 860 g at 0.673 m, by
-    the product's peak rule, oblique.overload_peaks); bonded, it only falls."""
+def test_no_axial_overload_peak_survives_after_the_debonded_interface(oblique_pair, debonded):
+    """The converged answer to the paper's (ii) (issue 30): with the 16-point nose rule no
+    peak of the axial overload is reported after the first interface, debonded or bonded, by
+    the product's peak rule (oblique.overload_peaks, ripples of one event merged). The 8-point
+    rule's peak there (10 860 g at 0.673 m) was an artefact; a bump of about 5 %, at the rule's
+    own threshold, shows at rtol 3e-4 and with the held contact but survives no refinement
+    (docs/oblique.md)."""
     from cavex.analytic.penetration.oblique import overload_peaks
 
     target, projectile = debonded
     H = target.interface_depths[0]
     window = (H, H + crater_depth(projectile) + 0.05)
-    for name, expect in (("debonded", 1), ("bonded", 0)):
+    for name in ("debonded", "bonded"):
         peaks = overload_peaks(oblique_pair[name, 0.01].history)
         after = [z for z, _ in peaks if window[0] < z <= window[1]]
-        assert len(after) == expect, (name, peaks)
+        assert after == [], (name, peaks)
 
 
 def test_debonded_shot_mirrors_to_the_last_bit(debonded):
@@ -356,7 +360,7 @@ def test_trajectory_json_peaks_and_pitch_change_per_phase(capsys, tmp_path):
     changes = [p["pitch_change_deg"] for p in run["phases"]]
     assert sum(changes) == pytest.approx(run["end"]["pitch_deg"] - 20.0, abs=1e-9)
     # the turn after the interface (the last phase, in the macadam) is nose up
-    assert run["phases"][-1]["label"] == "macadam" and changes[-1] > 0.1
+    assert run["phases"][-1]["label"] == "macadam" and changes[-1] > 0.05  # measured 0.093
     peaks = run["overload_peaks"]
     assert all(set(p) == {"tip_depth_m", "axial_g"} for p in peaks)
     assert any(0.65 < p["tip_depth_m"] < 0.65 + crater_depth_default() + 0.05 for p in peaks)

@@ -110,14 +110,13 @@ def _turn_after(result, interface=1):
 
 
 def test_added_turn_refinement_in_the_contact_ramp(default):
-    """Issue 20 item 4, measured (docs/oblique.md "Debonded interfaces"): the added turn at
-    the first debonded interface (600 m/s, 20 deg; debonded minus bonded, pitch at the stop
-    minus at the crossing) falls monotonically as the ramp is refined 0.03, 0.01, 0.003,
-    0.001 m/s (0.411, 0.367, 0.341, 0.328 deg), its steps shrink (0.044, 0.026, 0.013), so
-    it converges; the limit is about 0.31-0.32 deg. The 0.01-vs-0.003 gap is 7.7 % (the 3 %
-    asked is NOT met): the shank's last supported rings above the rear zone hold the nose's
-    moment as a short couple loaded near its capacity, where the ramp lets it creep at
-    ~V_r (docs). Bound on the gap: 10 %."""
+    """Issue 30, measured with the converged nose rule (16 points; docs/oblique.md
+    "Convergence"): the added turn at the first debonded interface (600 m/s, 20 deg; debonded
+    minus bonded, pitch at the stop minus at the crossing) at ramps 0.03, 0.01, 0.003, 0.001
+    m/s is 0.108, 0.095, 0.100, 0.102 deg: not monotone, but every ramp within 0.01 deg of
+    the finest (the issue's tolerance, max(0.01 deg, 3 %); measured at most 0.0067 deg), and
+    the two finest within 3 % (measured 1.8 %). At the 8-point rule it fell 0.411 to 0.328 deg
+    and the 0.01-vs-0.003 gap was 7.7 %: the ramp's creep was the coarse rule's."""
     target, projectile = default
     debonded = target.with_interfaces("debonded")
     added = {}
@@ -127,11 +126,8 @@ def test_added_turn_refinement_in_the_contact_ramp(default):
                        - _turn_after(fly(target, projectile, Strike(600.0, 20.0),
                                          contact_ramp=ramp)))
     print("added turn (deg) by ramp:", added)
-    values = list(added.values())
-    steps = np.diff(values)
-    assert np.all(steps < 0)  # monotone
-    assert abs(steps[2]) < abs(steps[1]) < abs(steps[0])  # converging
-    assert abs(added[0.003] / added[0.01] - 1.0) < 0.10
+    assert all(abs(value - added[0.001]) < 0.01 for value in added.values())
+    assert abs(added[0.001] / added[0.003] - 1.0) < 0.03
 
 
 @pytest.mark.parametrize("command", [["stress", "--velocity", "600", "--depth", "0.3"],
