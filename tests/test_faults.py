@@ -10,6 +10,7 @@ import os
 from pathlib import Path
 
 import pytest
+from tmpfs_helpers import small_tmpfs, unmount
 
 from cavex.errors import CavexInputError
 from cavex.verification.cli import main
@@ -327,27 +328,6 @@ def test_tls_settings_become_a_distributed_security(tmp_path):
 
 
 # --- a full or read-only --out ---------------------------------------------------------------
-
-def small_tmpfs(path, options):
-    """A tmpfs mounted at ``path`` (root only, else the test is skipped); unmount after."""
-    import shutil
-    import subprocess
-
-    if os.geteuid() != 0 or shutil.which("mount") is None:
-        pytest.skip("needs root to mount a small tmpfs")
-    path.mkdir()
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(path)],
-                          capture_output=True)
-    if done.returncode != 0:
-        pytest.skip(f"tmpfs not available: {done.stderr.decode().strip()}")
-    return path
-
-
-def unmount(path):
-    import subprocess
-
-    subprocess.run(["umount", str(path)], check=True)
-
 
 def fill(path):
     handle = os.open(path, os.O_WRONLY | os.O_CREAT, 0o644)

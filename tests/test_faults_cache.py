@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from tmpfs_helpers import small_tmpfs, unmount
 
 from cavex.netcdf3 import PlainDataset, read_netcdf3
 from cavex.verification.fedata import table as fe_table
@@ -185,24 +186,9 @@ def test_a_file_where_the_cache_folder_should_be(tmp_path, capsys, built, fake_b
     assert blocker.read_text() == "x"
 
 
-def mounted_tmpfs(path, options):
-    if os.geteuid() != 0 or shutil.which("mount") is None:
-        pytest.skip("needs root to mount a small tmpfs")
-    path.mkdir()
-    done = subprocess.run(["mount", "-t", "tmpfs", "-o", options, "tmpfs", str(path)],
-                          capture_output=True)
-    if done.returncode != 0:
-        pytest.skip(f"tmpfs not available: {done.stderr.decode().strip()}")
-    return path
-
-
-def unmount(path):
-    subprocess.run(["umount", str(path)], check=True)
-
-
 def test_a_read_only_cache_folder(tmp_path, capsys, built, fake_builds):
     shot = built[0]
-    folder = mounted_tmpfs(tmp_path / "ro", "ro,size=1m")
+    folder = small_tmpfs(tmp_path / "ro", "ro,size=1m")
     try:
         cache = TableCache(cache=folder)
         err = capsys.readouterr().err.strip().splitlines()
@@ -229,7 +215,7 @@ def fill(path):
 
 def test_a_full_cache_folder(tmp_path, capsys, built, fake_builds):
     shot = built[0]
-    folder = mounted_tmpfs(tmp_path / "full", "size=64k")
+    folder = small_tmpfs(tmp_path / "full", "size=64k")
     try:
         fill(folder / "filler")
         cache = TableCache(cache=folder)  # an empty file can still be made
