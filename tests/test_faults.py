@@ -10,7 +10,7 @@ import os
 from pathlib import Path
 
 import pytest
-from tmpfs_helpers import small_tmpfs, unmount
+from tmpfs_helpers import fill, small_tmpfs, unmount
 
 from cavex.errors import CavexInputError
 from cavex.verification.cli import main
@@ -328,17 +328,6 @@ def test_tls_settings_become_a_distributed_security(tmp_path):
 
 
 # --- a full or read-only --out ---------------------------------------------------------------
-
-def fill(path):
-    handle = os.open(path, os.O_WRONLY | os.O_CREAT, 0o644)
-    try:
-        while True:
-            os.write(handle, b"\0" * 4096)
-    except OSError:
-        pass
-    finally:
-        os.close(handle)
-
 
 @pytest.mark.parametrize("command", [
     ["validate", "--shots", str(SHOTS), "--models", "paper", "--no-figures"],

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tmpfs_helpers import small_tmpfs, unmount
+from tmpfs_helpers import fill, small_tmpfs, unmount
 
 from cavex.netcdf3 import PlainDataset, read_netcdf3
 from cavex.verification.fedata import table as fe_table
@@ -199,18 +199,6 @@ def test_a_read_only_cache_folder(tmp_path, capsys, built, fake_builds):
         assert len(fake_builds) == 1
     finally:
         unmount(folder)
-
-
-def fill(path):
-    """Write zeros to ``path`` until the disk is full."""
-    handle = os.open(path, os.O_WRONLY | os.O_CREAT, 0o644)
-    try:
-        while True:
-            os.write(handle, b"\0" * 4096)
-    except OSError:
-        pass
-    finally:
-        os.close(handle)
 
 
 def test_a_full_cache_folder(tmp_path, capsys, built, fake_builds):

@@ -23,3 +23,15 @@ def small_tmpfs(path, options):
 
 def unmount(path):
     subprocess.run(["umount", str(path)], check=True)
+
+
+def fill(path):
+    """Write zeros to ``path`` until the disk is full."""
+    handle = os.open(path, os.O_WRONLY | os.O_CREAT, 0o644)
+    try:
+        while True:
+            os.write(handle, b"\0" * 4096)
+    except OSError:
+        pass
+    finally:
+        os.close(handle)
