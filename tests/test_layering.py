@@ -181,3 +181,16 @@ def test_the_walk_finds_a_circle():
     """The checker itself: a -> b -> c -> a and d -> d are circles, e -> a is not."""
     graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"d"}, "e": {"a"}}
     assert sorted(import_circles(graph)) == [["a", "b", "c"], ["d"]]
+
+
+def test_every_package_folder_is_installed():
+    """Every folder of the package with an ``__init__.py`` is listed in pyproject.toml's
+    ``packages`` (a plain ``pip install .`` installs only those: an unlisted folder works in an
+    editable install and fails on a user's)."""
+    import tomllib
+
+    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+                 ["packages"])
+    folders = {name.removesuffix(".__init__") for name, _ in MODULES
+               if name.endswith(".__init__")}
+    assert folders - {"cavex"} <= listed and "cavex" in listed, folders - listed
