@@ -50,18 +50,21 @@ def stale_temporary(name):
     found = re.findall(r"\.(\d+)\.[a-z0-9_]{8}(?=\.|$)", name)
     if not found:
         return True
-    pid = int(found[-1])
+    return not process_alive(int(found[-1]))
+
+
+def process_alive(pid):
+    """Whether process ``pid`` exists on this host (this process, or another user's, counts
+    as alive; an id no process can have does not)."""
     if pid == os.getpid():
-        return False
+        return True
     try:
         os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    except OverflowError:  # no such process id
-        return True
-    except PermissionError:  # another user's process
+    except (ProcessLookupError, OverflowError):
         return False
-    return False
+    except PermissionError:  # another user's process
+        return True
+    return True
 
 
 def write_text_atomic(path, text, durable=True):

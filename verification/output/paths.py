@@ -19,6 +19,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from cavex.errors import CavexInputError, require
+from cavex.verification.output.files import process_alive
 
 
 def check_output_dir(path, option, shown=None):
@@ -84,25 +85,12 @@ def remove_stale_stages(folder):
         owner = stage.name[len(STAGE_PREFIX):].rsplit("-", 2)
         try:
             mine = len(owner) == 3 and owner[0] == host
-            dead = mine and not _alive(int(owner[1]))
+            dead = mine and not process_alive(int(owner[1]))
             old = time.time() - stage.stat().st_mtime > STALE_SECONDS
         except (ValueError, OSError):
             continue
         if stage.is_dir() and (dead or (old and not mine)):
             shutil.rmtree(stage, ignore_errors=True)
-
-
-def _alive(pid):
-    """Whether process ``pid`` exists on this host."""
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:  # another user's process
-        return True
-    return True
 
 
 @contextmanager
