@@ -92,12 +92,17 @@ def table_depth(shot, table, mapping=None):
     return flown_depth(get(FE_MODEL), shot, mapping, table=table)
 
 
+def model_of(label):
+    """The registry's model of a column's ``label`` (one of validate's models, checked)."""
+    return parse_label(label, "models", labels(predicts_shots=True))[0]
+
+
 def predict(shot, model, mapping=None, tables=None):
     """Predicted depth (m) of ``model`` (one of :data:`MODELS`) for ``shot``.
 
     ``tables`` (a :class:`TableCache`) gives the FE tables of the ``table`` model.
     """
-    chosen, boundary = parse_label(model, "models", labels(predicts_shots=True))
+    chosen, boundary = parse_label(model, "models", labels(predicts_shots=True))  # checked
     if chosen.takes_table:
         tables = tables or TableCache()
     return chosen.shot_depth(shot, boundary=boundary, mapping=mapping, tables=tables)
@@ -286,11 +291,10 @@ def run_estimate(shots, models, tables, workers):
     each model's ``prediction_seconds`` and ``concrete_table_seconds`` (the registry's)."""
     tables.velocities_for(shots)
     table_mappings = [mapping or Mapping() for model, mapping in models.values()
-                      if parse_label(model, "models")[0].takes_table]
+                      if model_of(model).takes_table]
     build, reused = tables.plan(shots, table_mappings) if table_mappings else (0, 0)
     cases = build * len(tables._velocities) * len(TABLE_DEPTHS)
-    chosen = [parse_label(model, "models", labels(predicts_shots=True))[0]
-              for model, _ in models.values()]
+    chosen = [model_of(model) for model, _ in models.values()]
     per_shot = sum(model.prediction_seconds for model in chosen)
     table_seconds = max((model.concrete_table_seconds for model in chosen), default=0.0)
     concretes = len({(s.fc, s.rho) for s in shots}) if table_seconds else 0
@@ -395,7 +399,7 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
     tables = tables or TableCache()
     tables.velocities_for(shots)
     concrete = [name for name, (model, _) in columns.items()
-                if parse_label(model, "models")[0].concrete_table_seconds]
+                if model_of(model).concrete_table_seconds]
     ids = [shot.id for shot in shots]
     depths, failures = predictions(
         shots, {k: v for k, v in columns.items() if k not in concrete}, tables, progress)
@@ -405,7 +409,7 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
                                                                          progress)
         for name in concrete:
             depths[name], failed = concrete_depths, concrete_failures
-            if parse_label(columns[name][0], "models")[0].parts:
+            if model_of(columns[name][0]).parts:
                 depths[name] = [_split_depth(shot, depth)
                                 for shot, depth in zip(shots, concrete_depths, strict=True)]
                 failed = {i: reason for i, reason in concrete_failures.items()
