@@ -17,11 +17,11 @@ from scipy.interpolate import PchipInterpolator
 
 from cavex.analytic.cavity import cavity_solution, cavity_stress
 from cavex.analytic.geometry import spherical_problem, switch_depths
+from cavex.analytic.models.comparison import compare_trajectories
 from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.analytic.penetration.tabulated import (
     TabulatedResistance,
-    compare_trajectories,
     load_table,
     pchip,
     trajectory_summary,

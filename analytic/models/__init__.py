@@ -17,7 +17,16 @@ from cavex.analytic.models import li_chen_2003 as _li_chen_2003  # noqa: F401
 from cavex.analytic.models import li_chen_concrete as _li_chen_concrete  # noqa: F401
 from cavex.analytic.models import forrestal_1994 as _forrestal_1994  # noqa: F401
 # isort: on
-from cavex.analytic.models.registry import Model, get, labels, models, names, parse_label  # noqa: F401
+from cavex.analytic.models.registry import (  # noqa: F401
+    Model,
+    get,
+    labels,
+    line_style,
+    models,
+    names,
+    parse_label,
+    the,
+)
 from cavex.errors import require
 
 #: the derived model's default boundary convention

@@ -17,6 +17,8 @@ class Derived(Model):
     default_boundary = "dynamic"
     debonded = True
     free_surface_option = True
+    compared_with_fe = True
+    line_styles = (("C0", "--"), ("C1", "-"))  # quasi-static, dynamic
 
     def describe(self, boundary=None, epsilon=None, table=None, law=None):
         return f"derived model, {self.boundary(boundary)} boundary"

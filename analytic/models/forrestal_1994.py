@@ -11,6 +11,8 @@ class Forrestal1994(Model):
                     "it is not an out-of-sample prediction")
     predicts_shots = True
     prediction_seconds = 0.0
+    empirical_reference = regime_figure = True
+    marker_size = 10  # drawn larger: the reference the others are read against
 
     def shot_depth(self, shot, **options):
         from cavex.analytic.empirical import shot_depth

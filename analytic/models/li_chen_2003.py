@@ -10,6 +10,7 @@ class LiChen2003(Model):
                     "2003, fitted by them to published shots)")
     predicts_shots = True
     prediction_seconds = 0.0
+    regime_figure = True
 
     def shot_depth(self, shot, **options):
         from cavex.analytic.empirical import li_chen_depth

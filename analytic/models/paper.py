@@ -12,6 +12,8 @@ class Paper(Model):
     flies = flies_3d = closed_form = predicts_shots = fits_mapping = True
     default_boundary = "quasi-static"  # its own, and no other
     takes_epsilon = True
+    compared_with_fe = True
+    line_styles = (("C2", ":"),)
 
     def describe(self, boundary=None, epsilon=None, table=None, law=None):
         return f"paper model (She 2020), epsilon: {epsilon}"

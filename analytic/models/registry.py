@@ -75,6 +75,25 @@ class Model:
     prediction_seconds, concrete_table_seconds : float
         Time of one shot's prediction, and of one concrete's cavity table where the model
         needs one (``validate``'s run estimate).
+    compared_with_fe : bool
+        Flown, each of its labels, beside the FE table on the report's target (the
+        analytic-against-FE report's trajectories, :mod:`.comparison`).
+    line_styles : tuple of (colour, linestyle)
+        Its curves' matplotlib colour and line style, one per label (:meth:`labels`' order);
+        empty: the default colour, a solid line.
+    line_width : float
+        Its curves' line width (points).
+    marker_size : float
+        Its points' marker size in ``validate``'s figures (points).
+    compressible_partner : str or None
+        The label of the incompressible closed form the model is the compressible
+        counterpart of: ``validate`` also runs the model with that label's calibrated mapping
+        (the compressibility column) and reports the depth ratio, same material.
+    empirical_reference : bool
+        The empirical formula ``validate``'s report compares the calibrated models with (one
+        model has it).
+    regime_figure : bool
+        Drawn in ``validate``'s regime figures (beside the recommended model).
     """
 
     name = None
@@ -91,6 +110,12 @@ class Model:
     parts = ()
     prediction_seconds = 2.5e-3  # a closed form, measured on the development shots
     concrete_table_seconds = 0.0
+    compared_with_fe = False
+    line_styles = ()
+    line_width = 1.3
+    marker_size = 7
+    compressible_partner = None
+    empirical_reference = regime_figure = False
 
     # --- labels and options -----------------------------------------------------------------
 
@@ -135,6 +160,16 @@ class Model:
         """What the text header adds after the label (e.g. the paper model's epsilon)."""
         return ""
 
+    def variants(self):
+        """``[(label, boundary)]``: each label with the boundary convention that gives it
+        (None where the model offers no choice)."""
+        return [(self.label(b), b) for b in self.boundaries or (None,)]
+
+    def line_style(self, label):
+        """``(colour, linestyle, linewidth)`` of the curve of ``label``, one of its labels."""
+        styles = dict(zip(self.labels(), self.line_styles, strict=False))
+        return (*styles.get(label, (None, "-")), self.line_width)
+
     # --- what it computes -------------------------------------------------------------------
 
     def resistance(self, target, projectile, **options):
@@ -178,6 +213,21 @@ def names(**capabilities):
 def labels(**capabilities):
     """Every label of :func:`models` ``(**capabilities)``, in order."""
     return tuple(label for m in models(**capabilities) for label in m.labels())
+
+
+def the(**capabilities):
+    """The one model with the given capabilities (e.g. ``recommended=True``)."""
+    found = models(**capabilities)
+    if len(found) != 1:
+        raise LookupError(f"{len(found)} models have {capabilities}, not one")
+    return found[0]
+
+
+def line_style(label):
+    """``(colour, linestyle, linewidth)`` of the curves of a model's ``label``
+    (:meth:`Model.line_style`)."""
+    model, _ = parse_label(label)
+    return model.line_style(label)
 
 
 def get(name, parameter="resistance", offered=None):

@@ -19,6 +19,11 @@ class Table(Model):
     first_layer = "derived"
     free_surface_option = True  # its 3-D law (derived: its own; table: the FE's)
     prediction_seconds = 3e-2  # a prediction with an FE table (docs/validation.md)
+    compared_with_fe = True  # the reference the closed forms are flown against
+    line_styles, line_width = (("k", "-"),), 2.2
+    # the FE with the derived-dynamic closed form's calibrated mapping: what compressibility
+    # and finite strain change, same material (validate's compressibility column)
+    compressible_partner = "derived-dynamic"
 
     def check(self, boundary=None):
         get(self.first_layer).check(boundary)  # the first layer's convention

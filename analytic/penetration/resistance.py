@@ -14,6 +14,7 @@ kept: the integrator asks for the label at points where it has asked for the for
 """
 
 import math
+from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -26,7 +27,32 @@ from cavex.errors import CavexNumericalError, require, require_choice
 from cavex.problem import BOUNDARIES
 
 RECENT = 32  # (depth, velocity) answers kept
-CLOSED_FORMS = ("derived", "paper")  # the two closed forms this module evaluates
+
+
+@dataclass(frozen=True)
+class ClosedForm:
+    """One closed form :class:`ClosedFormResistance` evaluates, and what it accepts.
+
+    ``printed``: the paper's printed coefficients (:class:`~cavex.analytic.paper_model.
+    PaperModel`), else the derived cavity solution (:func:`~cavex.analytic.cavity.nose_walk`);
+    ``boundaries``: the yield-at-boundary conventions it takes, its default first;
+    ``switch``: when a layer stops surrounding the cavity by default (``geometry``);
+    ``debonded``: it models a debonded interface (the derived form's traction-free sphere).
+    """
+
+    name: str
+    printed: bool
+    boundaries: tuple
+    switch: str
+    debonded: bool
+
+
+#: the two closed forms this module evaluates, by the name of the model that flies each
+CLOSED_FORMS = {form.name: form for form in (
+    ClosedForm("derived", printed=False, boundaries=("dynamic", "quasi-static"),
+               switch="cavity", debonded=True),
+    ClosedForm("paper", printed=True, boundaries=("quasi-static",), switch="nose-tip",
+               debonded=False))}
 
 
 @runtime_checkable
@@ -83,23 +109,23 @@ class ClosedFormResistance(Resistance):
 
     def __init__(self, target, projectile, model="derived", boundary=None,
                  switch=None, epsilon="quasi-static"):
-        require_choice(model, CLOSED_FORMS, "model")
-        paper = model == "paper"
+        require_choice(model, tuple(CLOSED_FORMS), "model")
+        form = CLOSED_FORMS[model]
         if boundary is not None:
             require_choice(boundary, BOUNDARIES, "boundary")
-        require(not paper or boundary in (None, "quasi-static"), "boundary",
-                "'quasi-static' for the paper model", boundary)
-        require(not paper or not target.debonded, "interfaces",
-                "'bonded' for the paper model (a debonded interface needs the derived closed "
-                "form's traction-free sphere)", "debonded")
-        boundary = boundary or ("quasi-static" if paper else "dynamic")
+        require(boundary is None or boundary in form.boundaries, "boundary",
+                f"'{form.boundaries[0]}' for the {form.name} model", boundary)
+        require(form.debonded or not target.debonded, "interfaces",
+                f"'bonded' for the {form.name} model (a debonded interface needs the derived "
+                "closed form's traction-free sphere)", "debonded")
+        boundary = boundary or form.boundaries[0]
         self.target, self.projectile = target, projectile
         self.model, self.boundary, self.epsilon = model, boundary, epsilon
-        self.switch = switch or ("nose-tip" if paper else "cavity")
+        self.switch = switch or form.switch
         spherical_problem(target, projectile, 0.0, self.switch)  # validates the switch
         self._single = None if target.layers[1:] == () else ClosedFormResistance(
             target.single(0), projectile, model, boundary, switch, epsilon)
-        self._paper = PaperModel(target, projectile, epsilon) if paper else None
+        self._paper = PaperModel(target, projectile, epsilon) if form.printed else None
         n = len(target.layers)
         # the layers the cavity in layer i sees: down to the first debonded interface below
         # (its radius is then a traction-free sphere), else all (docs/analytic.md)

@@ -32,7 +32,7 @@ from scipy.interpolate import PchipInterpolator
 from cavex.analytic.geometry import switch_depths, wall_layer
 from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.nose import nose_rule
-from cavex.analytic.penetration.resistance import ClosedFormResistance, Resistance
+from cavex.analytic.penetration.resistance import Resistance
 from cavex.config import fingerprint, fingerprint_data
 from cavex.errors import CavexInputError, require_choice
 from cavex.netcdf3 import read_netcdf3
@@ -261,42 +261,6 @@ def penetrate_with_table(target, projectile, table_path, crater="nose-base"):
     """Trajectory through ``target`` with the FE-tabulated resistance read from ``table_path``."""
     resistance = TabulatedResistance(read_table(table_path), target, projectile)
     return penetrate(target, projectile, resistance, crater=crater)
-
-
-def compare_trajectories(target, projectile, table, crater="nose-base"):
-    """Closed forms (derived quasi-static and dynamic, paper) against the FE table.
-
-    Parameters
-    ----------
-    target, projectile : Target, Projectile
-    table : xarray.Dataset or str or path
-        The FE table (a path is loaded).
-    crater : {"nose-base", "nose-tip"}
-
-    Returns
-    -------
-    dict
-        Keyed by model (``derived quasi-static``, ``derived dynamic``, ``paper``, ``FE table``):
-        ``phases`` (label, end depth, velocity, time, reason), ``final_depth_m``,
-        ``final_time_s`` and ``at_H1`` (velocity and time when the nose tip reaches ``H1``:
-        the residual velocity after the concrete; None if it stops before).
-    """
-    return {name: trajectory_summary(run, target)
-            for name, run in comparison_runs(target, projectile, table, crater).items()}
-
-
-def comparison_runs(target, projectile, table, crater="nose-base"):
-    """The trajectories :func:`compare_trajectories` summarises: ``{name: Trajectory}``."""
-    if not hasattr(table, "attrs"):
-        table = read_table(table)
-    models = {
-        "derived-quasi-static": ClosedFormResistance(target, projectile, "derived",
-                                                     "quasi-static"),
-        "derived-dynamic": ClosedFormResistance(target, projectile, "derived", "dynamic"),
-        "paper": ClosedFormResistance(target, projectile, "paper"),
-        "table": TabulatedResistance(table, target, projectile),
-    }
-    return {name: penetrate(target, projectile, r, crater=crater) for name, r in models.items()}
 
 
 def trajectory_summary(trajectory, target):

@@ -38,6 +38,7 @@ from cavex.verification.report.validation_markdown import (
 )
 from cavex.verification.validation.predict import (
     FE_MODEL,
+    FE_PARTNER,
     TableCache,
     add_statistics,
     predictions,
@@ -47,7 +48,7 @@ from cavex.verification.validation.shots import read_shots
 
 HELP = "predicted against measured penetration depths (docs/validation.md)"
 DEFAULT_OUT = "results/validation"
-COMPRESSIBILITY_COLUMN = f"{FE_MODEL}, derived-dynamic calibration"
+COMPRESSIBILITY_COLUMN = f"{FE_MODEL}, {FE_PARTNER} calibration"
 #: the run's bookkeeping in the result, not in ``validation.json`` (:func:`summary`): the FE
 #: tables built or reused, the wall time (s), the files written
 BOOKKEEPING = ("tables", "seconds", "outputs")
@@ -118,7 +119,7 @@ def columns_of(calibrations, models=None):
     from cavex.verification.validation.predict import validation_columns
 
     columns = validation_columns(calibrations, models=models)
-    dynamic = [c for c in calibrations if c.model == "derived-dynamic"]
+    dynamic = [c for c in calibrations if c.model == FE_PARTNER]
     if dynamic:
         columns[COMPRESSIBILITY_COLUMN] = (FE_MODEL, dynamic[0].mapping)
     return columns
@@ -146,7 +147,7 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
                             progress=show_progress(progress))
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
                       progress=progress, models=models)
-    if any(c.model == "derived-dynamic" for c in calibrations):
+    if any(c.model == FE_PARTNER for c in calibrations):
         columns = {COMPRESSIBILITY_COLUMN: columns_of(calibrations)[COMPRESSIBILITY_COLUMN]}
         depths, failures = predictions(shot_file.shots, columns, tables, progress)
         for row, depth in zip(result["shots"], depths[COMPRESSIBILITY_COLUMN], strict=True):

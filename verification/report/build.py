@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from cavex.analytic.models import the
 from cavex.errors import CavexInputError
 from cavex.fem.estimate import DEFAULT_ERROR_TARGET
 from cavex.verification.fedata.table import build_table, write_table
@@ -90,7 +91,8 @@ def grid_axes(quick, velocities=None, depths=None, target=None, projectile=None)
 def trajectories(target, projectile, table):
     """:func:`compare_trajectories` on the FE table and the trajectories themselves
     (``{name: Trajectory}``), or a one-line reason why not and ``{}``."""
-    from cavex.analytic.penetration.tabulated import comparison_runs, trajectory_summary
+    from cavex.analytic.models.comparison import comparison_runs
+    from cavex.analytic.penetration.tabulated import trajectory_summary
 
     try:
         runs = comparison_runs(target, projectile, table)
@@ -105,7 +107,7 @@ def table_interpolation_error(target, projectile, table, runs):
     other node in V and in L), None without a table shot."""
     from cavex.analytic.penetration.table_error import interpolation_error
 
-    run = runs.get("table")
+    run = runs.get(the(takes_table=True).name)
     if run is None:
         return None
     reference = {"final_depth_m": float(run.depth[-1]),

@@ -21,10 +21,12 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator  # noqa: E402
 
+from cavex.analytic.models import line_style  # noqa: E402
 from cavex.analytic.states import STATE_GROUPS, state_meaning  # noqa: E402
 from cavex.verification.output.files import save_figure  # noqa: E402
 from cavex.verification.output.number_format import ESTIMATE_DECIMALS  # noqa: E402
 from cavex.verification.report.analysis import (  # noqa: E402
+    MODEL_LABEL,
     MODELS,
     RESOLVED_FRACTION,
     TOLERANCES,
@@ -43,8 +45,6 @@ BREAK_FRACTION = 0.5
 # Okabe-Ito (colour-blind-safe) for the response states, grey instead of black
 STATE_COLOURS = ("#0072B2", "#E69F00", "#009E73", "#F0E442", "#56B4E9", "#D55E00", "#CC79A7",
                  "#999999")
-MODEL_STYLES = {"derived-quasi-static": ("C0", "--"), "derived-dynamic": ("C1", "-"),
-                "paper": ("C2", ":"), "table": ("k", "-")}
 
 
 def _pct(fraction):
@@ -364,7 +364,6 @@ def error_estimate_map(grid, target, out):
 def s_curves(grid, target, out, velocities):
     """``S`` against nose depth at a few velocities: FE points, closed forms as lines."""
     fig, ax = plt.subplots(figsize=(7, 5))
-    styles = {"dynamic": "-", "quasi_static": "--", "paper": ":"}
     for i, V in enumerate(velocities):
         row = grid.sel(velocity=V)
         colour = f"C{i}"
@@ -372,8 +371,8 @@ def s_curves(grid, target, out, velocities):
         ax.plot(row.depth.values[ok], row["S"].values[ok], "o", color=colour, ms=4,
                 label=f"FE, V = {V:g} m/s")
         for key, label, _ in MODELS:
-            ax.plot(row.depth.values, row[f"S_{key}"].values, styles[key], color=colour, lw=1,
-                    label=label if i == 0 else None)
+            ax.plot(row.depth.values, row[f"S_{key}"].values, line_style(MODEL_LABEL[key])[1],
+                    color=colour, lw=1, label=label if i == 0 else None)
     _depth_limit(ax, grid, target)
     _interfaces_v(ax, target)
     ax.set(xlabel="nose-tip depth L (m)", ylabel="S = sigma_r / tau of the wall layer",
@@ -408,8 +407,7 @@ def trajectory_plot(runs, target, out):
     ``{name: Trajectory}``), the stops marked."""
     fig, ax = plt.subplots(figsize=(7, 4.6))
     for name, run in runs.items():
-        colour, style = MODEL_STYLES.get(name, (None, "-"))
-        lw = 2.2 if name == "table" else 1.3
+        colour, style, lw = line_style(name)
         ax.plot(run.depth, run.velocity, style, color=colour, lw=lw,
                 label=f"{name} (stops at {run.depth[-1]:.2f} m)")
         ax.plot(run.depth[-1], 0.0, "o", color=colour, ms=5)

@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 
+from cavex.analytic.models import the
 from cavex.analytic.states import state_meaning
 from cavex.verification.report.analysis import (
     ERROR_PARTS,
@@ -214,11 +215,12 @@ def trajectory_section(trajectories):
     if isinstance(trajectories, str):
         return trajectories
     rows = []
-    fe = trajectories.get("table")
+    fe_label = the(takes_table=True).name  # the FE table, the others' reference
+    fe = trajectories.get(fe_label)
     for name, t in trajectories.items():
         h1 = t["at_H1"]
         v1 = "stops before" if h1 is None else f"{h1['velocity_m_s']:.2f}"
-        dv = ("n/a" if h1 is None or fe is None or fe["at_H1"] is None or name == "table"
+        dv = ("n/a" if h1 is None or fe is None or fe["at_H1"] is None or name == fe_label
               else f"{h1['velocity_m_s'] - fe['at_H1']['velocity_m_s']:+.2f}")
         rows.append([name, f"{t['phases'][0]['end_velocity_m_s']:.2f}", v1, dv,
                      "n/a" if h1 is None else f"{1e3 * h1['time_s']:.4f}",

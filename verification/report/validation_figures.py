@@ -13,9 +13,9 @@ import math
 
 import numpy as np
 
-from cavex.analytic.models import labels
+from cavex.analytic.models import labels, names, parse_label
 from cavex.verification.output.files import save_figure
-from cavex.verification.validation.predict import CONCRETE, EMPIRICAL, LI_CHEN
+from cavex.verification.validation.predict import FE_PARTNER
 from cavex.verification.validation.regimes import NON_RIGID, REGIME_TITLES, REGIMES
 
 BAND = 0.2  # +-20 % band on the predicted-against-measured figure
@@ -95,7 +95,7 @@ def regime_models(result):
     """The models of the regime figures: the concrete model, the empirical formulas and, drawn
     last (on top of the one it equals in a regime), the recommended one (those that ran, each
     once)."""
-    chosen = (CONCRETE, LI_CHEN, EMPIRICAL, result["recommended_model"])
+    chosen = (*names(regime_figure=True), result["recommended_model"])
     return [m for k, m in enumerate(chosen) if m in result["models"] and m not in chosen[k + 1:]]
 
 
@@ -239,7 +239,7 @@ def fitted_ids(result, model):
     for calibration in result["calibrations"]:
         if calibration["column"] == model or (
                 model == result.get("compressibility_column")
-                and calibration["model"] == "derived-dynamic"):
+                and calibration["model"] == FE_PARTNER):
             return set(calibration["shots"])
     return set()
 
@@ -255,7 +255,7 @@ def _draw_model(ax, result, model, measured, velocity):
     y = y * 1e3 if velocity is None else y / measured
     marker = "P" if model == result.get("compressibility_column") else marker
     style = {"marker": marker, "color": colour, "linestyle": "none",
-             "markersize": 10 if base == EMPIRICAL else 7}
+             "markersize": parse_label(base)[0].marker_size}
     if model in labels(predicts_shots=True):
         ax.plot(x, y, label=model, markerfacecolor=colour, **style)
         return

@@ -8,7 +8,7 @@ from the shots."""
 import numpy as np
 
 from cavex.analytic.models import get, models
-from cavex.verification.validation.predict import EMPIRICAL, FE_MODEL
+from cavex.verification.validation.predict import EMPIRICAL, FE_MODEL, FE_PARTNER
 from cavex.verification.validation.regimes import NON_RIGID, REGIME_TITLES
 
 
@@ -87,7 +87,7 @@ def compressibility(result, column):
 
     ``column`` is the FE column; its closed-form partner is ``derived-dynamic`` (uncalibrated
     mapping) or ``derived-dynamic calibrated`` (the compressibility column)."""
-    partner = "derived-dynamic" if column == FE_MODEL else "derived-dynamic calibrated"
+    partner = FE_PARTNER if column == FE_MODEL else f"{FE_PARTNER} calibrated"
     ratios = [row["predicted_m"][column] / row["predicted_m"][partner]
               for row in result["shots"]
               if row["predicted_m"].get(column) and row["predicted_m"].get(partner)]

@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cavex.analytic.models import get, labels, names, parse_label
+from cavex.analytic.models import get, labels, names, parse_label, the
 from cavex.analytic.penetration.nose import nose_rule
 from cavex.concrete import Mapping
 from cavex.errors import CavexInputError, CavexNumericalError, require_choice
@@ -51,8 +51,10 @@ from cavex.verification.validation.shots import shot_projectile, shot_target
 MODELS = labels(predicts_shots=True)
 CAVEX_MODELS = labels(fits_mapping=True)  # what a calibration can fit: the flown models
 FE_MODEL = names(takes_table=True)[0]  # the model that needs FE tables
-EMPIRICAL, CONCRETE, LI_CHEN, SPLIT = ("forrestal-1994", "concrete", "li-chen-2003",
-                                       "li-chen-concrete")  # the report's words about them
+#: the closed form the FE model is the compressible counterpart of: the compressibility
+#: column runs the FE with that label's calibrated mapping
+FE_PARTNER = get(FE_MODEL).compressible_partner
+EMPIRICAL = the(empirical_reference=True).name  # the report compares the calibrated with it
 #: The model ``cavex validate`` recommends (the registry's ``recommended`` model: Li and Chen
 #: (2003) at normal strength, the concrete model above; docs/validation.md)
 RECOMMENDED_MODEL = names(recommended=True)[0]
