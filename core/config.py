@@ -4,8 +4,10 @@ written back (the tables, their TOML text and its fingerprint)."""
 import hashlib
 import json
 import tomllib
+from dataclasses import replace
 from importlib import resources
 
+from cavex.concrete import Concrete
 from cavex.errors import CavexInputError, check_keys, prefixed, require
 from cavex.input_files import in_file, read_toml
 from cavex.materials import (
@@ -16,10 +18,14 @@ from cavex.materials import (
     material_parameters,
 )
 
-#: a layer's keys: the material's parameters (declared by :class:`cavex.materials.Material`)
-#: and the layer's own (its name, thickness, bottom face, plain law, tunnel wall)
+#: a layer's keys: the material's parameters (declared by :class:`cavex.materials.Material`),
+#: or a concrete that gives them (:func:`concrete_layer`), and the layer's own (its name,
+#: thickness, bottom face, plain law, tunnel wall)
 LAYER_KEYS = {"name", "thickness", *material_parameters(), "bottom", "scab_depth", "law_A",
-              "law_B", "tunnel_wall"}
+              "law_B", "tunnel_wall", "concrete"}
+#: the keys of a layer's ``concrete = {fc = <Pa>, rho = <kg/m^3>}``: a concrete from its
+#: strength and density (:class:`cavex.concrete.Concrete`), instead of the material's keys
+CONCRETE_KEYS = {"fc", "rho", "capped"}
 #: FE-only layer keys (docs/config.md), written back only when given: targets without them keep
 #: their tables and fingerprints
 OPTIONAL_LAYER_KEYS = fe_only_parameters()
@@ -67,7 +73,8 @@ def parse_target(layers):
         where = f"layers[{i}]."
         require(isinstance(table, dict), f"layers[{i}]", "a table", table)
         last = i == len(layers) - 1
-        required = {"E", "nu", "rho", "lam"} | (set() if last else {"thickness"})
+        material_keys = set() if "concrete" in table else {"E", "nu", "rho", "lam"}
+        required = material_keys | (set() if last else {"thickness"})
         check_keys(table, LAYER_KEYS, where, required=required)
         for key in ("thickness", *BOTTOM_KEYS) if last else ():
             if key in table:
@@ -77,7 +84,7 @@ def parse_target(layers):
             require(isinstance(table["bottom"], str), f"{where}bottom", "a string",
                     table["bottom"])
         numbers = {k: _number(table[k], where + k) for k in table
-                   if k not in ("name", "bottom")}
+                   if k not in ("name", "bottom", "concrete")}
         thickness = numbers.pop("thickness", None)
         scab = numbers.pop("scab_depth", None)
         law = numbers.pop("law_A", None), numbers.pop("law_B", None)
@@ -87,12 +94,38 @@ def parse_target(layers):
                                   "S = A + B rho V^2 / tau)", f"{where}{missing}")
         laws.append(None if law[0] is None else law)
         walls.append(numbers.pop("tunnel_wall", 1.0))
-        materials.append(prefixed(Material, where, name=table.get("name", ""), **numbers))
+        if "concrete" in table:
+            materials.append(concrete_layer(table["concrete"], where, table.get("name"),
+                                            numbers))
+        else:
+            materials.append(prefixed(Material, where, name=table.get("name", ""), **numbers))
         if thickness is not None:
             thicknesses.append(thickness)
             bottoms.append(table.get("bottom", "bonded"))
             scabs.append(scab)
     return prefixed(Target, "", materials, thicknesses, bottoms, scabs, laws, walls)
+
+
+def concrete_layer(table, where="", name=None, material=()):
+    """The material of a layer's ``concrete = {fc, rho}`` table (``where``: the layer's key
+    path, e.g. ``"layers[0]."``): :meth:`cavex.concrete.Concrete.layer`, a concrete of strength
+    ``fc`` (Pa) and density ``rho`` (kg/m^3) with ``E``, ``nu``, ``lam`` and ``tau`` from the
+    published correlations (:mod:`cavex.concrete`); with ``capped = true``
+    :meth:`~cavex.concrete.Concrete.fe_layer` (the cap ``tau_max = 7 f_c`` and the tension
+    cut-off that the FE carries). Named ``name`` (default ``"concrete"``). The layer's own
+    material keys (``material``) are refused: the concrete is its material."""
+    if material:
+        raise CavexInputError("must be absent with concrete (the layer's material is the "
+                              "concrete's)", f"{where}{next(iter(material))}")
+    key = f"{where}concrete"
+    require(isinstance(table, dict), key, "a table {fc = <Pa>, rho = <kg/m^3>}", table)
+    check_keys(table, CONCRETE_KEYS, f"{key}.", required={"fc", "rho"})
+    capped = table.get("capped", False)
+    require(isinstance(capped, bool), f"{key}.capped", "true or false", capped)
+    concrete = prefixed(Concrete, f"{key}.", fc=_number(table["fc"], f"{key}.fc"),
+                        rho=_number(table["rho"], f"{key}.rho"))
+    layer = prefixed(concrete.fe_layer if capped else concrete.layer, f"{key}.")
+    return layer if name is None else prefixed(replace, where, layer, name=name)
 
 
 def parse_projectile(table):
