@@ -22,8 +22,9 @@ Shear limit: the published flattening meridians (:data:`MERIDIANS`)
   strength ratio 1e20): the RHT failure surface's compressive meridian as set by Leppänen
   (2004, Chalmers Publ. 04:4, Table C.2, "calculated with a model proposed by Attard and
   Setunge (1996)"; his Fig. 4.6 draws it over Bažant et al.'s (1996) data of a 46 MPa
-  concrete up to ``p/f_c`` = 10). RHT's shift ``p* - p*_spall`` is left out (below 3 % of
-  ``p/f_c`` above 1).
+  concrete up to ``p/f_c`` = 10). RHT's shift of ``p/f_c`` by its spall pressure (of the
+  order of ``f_t/f_c``, 0.1 or less) is left out: at ``p/f_c >= 1`` it changes ``q`` by under
+  ``N x 0.1`` = 7 %.
 
 Each meridian is used with one of two ``f_c`` scalings (:func:`shear_limit`):
 
