@@ -134,6 +134,19 @@ def shear_limit(p, fc, meridian="rht", scaling="fc"):
     return f * _capped(m.B * (p / f) ** m.N, m.S_max)
 
 
+def cavity_power_law(fc, meridian="rht", scaling="fc"):
+    """The meridian in the cavity model's units (stresses over ``f_c``,
+    :class:`cavex.concrete.Constants`): ``(power_B, power_N, cap)`` with
+    ``D/f_c = min(power_B (p/f_c)^power_N, cap)``; not normalised by ``f_c``,
+    ``power_B = B (f_ref/f_c)^(1 - N)`` and ``cap = S_max f_ref/f_c``."""
+    require_choice(meridian, tuple(MERIDIANS), "meridian")
+    require_choice(scaling, SCALINGS, "scaling")
+    _check_strength(fc)
+    m = MERIDIANS[meridian]
+    ratio = 1.0 if scaling == "fc" else m.f_ref / fc
+    return m.B * ratio ** (1.0 - m.N), m.N, m.S_max * ratio
+
+
 def _capped(value, cap):
     """``min(value, cap)`` for a number or an array (``inf``: no cap)."""
     return value if not math.isfinite(cap) else np.minimum(value, cap)

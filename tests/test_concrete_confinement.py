@@ -54,6 +54,15 @@ def test_scaled_meridian_grows_as_fc_to_one_minus_n():
                                   cc.shear_limit(p, 50e6, "rht", "none"))
 
 
+@pytest.mark.parametrize("meridian, scaling", OPTIONS)
+@pytest.mark.parametrize("fc", [20e6, 237e6])
+def test_cavity_power_law_is_the_meridian_over_fc(meridian, scaling, fc):
+    B, N, cap = cc.cavity_power_law(fc, meridian, scaling)
+    p = np.array([1e7, 1e8, 1e9, 2e9])
+    np.testing.assert_allclose(fc * np.minimum(B * (p / fc) ** N, cap),
+                               cc.shear_limit(p, fc, meridian, scaling), rtol=1e-12)
+
+
 def test_hjc_meridian_is_capped_at_smax_fc():
     fc = 48e6
     assert cc.shear_limit(2e9, fc, "hjc") == pytest.approx(7.0 * fc, rel=1e-12)
