@@ -174,3 +174,19 @@ def test_committed_report_is_what_the_study_writes():
 
     committed = (ROOT / "results" / "concrete" / "confinement.md").read_text(encoding="utf-8")
     assert committed == report_md()
+
+
+def test_the_option_is_chosen_on_the_other_groups_among_those_that_predict_them_all():
+    """The selection rule of the shot study on a made-up table: a group left out gets the
+    option best on the others among the options with a depth for every other shot."""
+    from cavex.verification.studies.confinement_selection import cross_validated_choice
+
+    measured = [1.0, 1.0, 1.0, 1.0]
+    depths = {"a": [1.1, 1.1, 2.0, 2.0],           # good on groups x, poor on y
+              "b": [1.5, 1.5, 1.05, 1.05],         # good on y
+              "c": [1.0, 1.0, 1.0, math.nan]}      # perfect, but misses a shot of y
+    out = cross_validated_choice(depths, measured, {"x": [0, 1], "y": [2, 3]})
+    assert out["x"][0] == "b"  # c misses a shot of y, the group it is chosen on
+    assert out["x"][2] == pytest.approx(math.log(1.5))
+    assert out["y"][0] == "c"  # on x, c is admissible and best
+    assert out["y"][2] == math.inf  # and it gives no depth for one shot of y
