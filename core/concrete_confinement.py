@@ -56,8 +56,9 @@ then locked with the modulus ``K_lock``; ``mu = rho/rho_0 - 1``)
   48 MPa concrete;
 - ``mu_crush = p_crush/K``, ``K = E/(3 (1 - 2 nu))`` with ACI 318's ``E`` and ``nu = 0.2``
   (:mod:`cavex.concrete`): continuous at the crush point;
-- ``mu_lock = phi/(1 - phi)``: the locked state is the pore-free solid (HJC's
-  ``mu_lock = rho_grain/rho_0 - 1``), ``phi`` the porosity. ``phi = a (f_c/MPa)^b`` with
+- ``mu_lock = phi/(1 - phi)``: at the lock the pores are closed, ``rho = rho_grain``,
+  ``phi`` the porosity (the solid's own compression at ``p_lock``, ``p_lock/K_lock`` = 0.009,
+  is left out). ``phi = a (f_c/MPa)^b`` with
   ``a`` = :data:`POROSITY_A`, ``b`` = :data:`POROSITY_B`, the least-squares line in logs
   through the porosities ``v_c`` that Imran and Pantazopoulou (2001, J. Eng. Mech. 127(3),
   Table 1) list for six concretes of Ansari and Li (1998) and Xie et al. (1995), 47-119 MPa
