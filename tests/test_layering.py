@@ -25,7 +25,8 @@ ROOT = Path(__file__).resolve().parents[1]
 FOLDERS = {"core": "cavex", "analytic": "cavex.analytic", "fem": "cavex.fem",
            "verification": "cavex.verification"}
 CORE = ("cavex.__init__", "cavex.errors", "cavex.input_files", "cavex.materials", "cavex.config",
-        "cavex.problem", "cavex.lazy", "cavex.netcdf3", "cavex.concrete")
+        "cavex.problem", "cavex.lazy", "cavex.netcdf3", "cavex.concrete",
+        "cavex.concrete_confinement")
 #: analytic's floors below the model registry: the closed forms, then the penetration feature
 CLOSED_FORMS = ("cavex.analytic.cavity", "cavex.analytic.geometry", "cavex.analytic.paper_model",
                 "cavex.analytic.concrete_cavity", "cavex.analytic.empirical",
