@@ -48,8 +48,6 @@ hemispherical. The nose tip recedes by ``l(psi_0) - l(psi)``, ``l = r sqrt(4 psi
 import math
 from dataclasses import dataclass
 
-from scipy.optimize import brentq
-
 from cavex.errors import require
 from cavex.materials import DEFAULT_DENSITY
 
@@ -169,6 +167,8 @@ class ErodingNose:
         if volume <= self.blunt_volume:
             psi = HEMISPHERE
         else:
+            from scipy.optimize import brentq
+
             psi = brentq(lambda p: nose_volume(self.r, p) - volume, HEMISPHERE, self.psi0,
                          xtol=1e-14, rtol=1e-14)
         self._last = (mass, psi)

@@ -145,8 +145,8 @@ def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, 
         become state, the force is the current nose's; the crater's loss is applied at its
         end. None, or a law that is off for this striking velocity (``erosion.active``
         False): the rigid projectile, the same numbers bit for bit. With erosion the depths
-        are the original nose tip's (the eroded tip: ``Trajectory.erosion["tip_depth_m"]``),
-        and only one-layer bonded targets are accepted.
+        (and so the layers' geometry and the interface stops) are the original nose tip's;
+        the eroded tip's final depth is ``Trajectory.erosion["tip_depth_m"]``.
 
     Returns
     -------
@@ -169,43 +169,30 @@ def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, 
 
 
 def _eroding_penetrate(target, projectile, resistance, crater, rtol, atol, erosion):
-    """:func:`penetrate` with an eroding nose: the rigid crater stage (its loss
-    :meth:`~cavex.analytic.penetration.erosion.ErodingNose.crater_loss` applied at its end),
-    then tunnel phases of the state ``(L, V, m)`` until rest; a phase ends where the
-    resistance's label changes, as the rigid one's does."""
-    from cavex.errors import require
-
-    require(len(target.layers) == 1 and not getattr(resistance, "force_jumps", ()), "erosion",
-            "a one-layer target and a resistance without force jumps (layered and plain-law "
-            "runs are rigid only)", None)
+    """:func:`penetrate` with an eroding nose: the rigid crater stage, its loss
+    (:meth:`~cavex.analytic.penetration.erosion.ErodingNose.crater_loss`) applied at its end,
+    then the tunnel phases of the state ``(L, V, m)`` (:func:`_tunnel`)."""
     columns = [[] for _ in range(5)]
-    masses, phases = [], []
+    phases, masses = [], []
     t0, depth0, v0 = 0.0, 0.0, projectile.V0
     mass = projectile.m - erosion.lost
     if crater is not None:
         depth0 = crater_depth(projectile, crater)
-        samples, t0, v0 = crater_stage(projectile, resistance.crater_force, depth0)
+        samples, t0, v0 = crater_stage(replace(projectile, m=mass), resistance.crater_force,
+                                       depth0)
         _append(columns, *samples, 0)
-        masses.append(np.full(len(samples[0]), mass))
         depth0 = samples[1][-1]
-        mass -= erosion.crater_loss(projectile, 0.5 * projectile.m * (projectile.V0 ** 2
-                                                                      - v0 ** 2))
+        masses.append(np.full(len(samples[0]), mass))
+        mass -= erosion.crater_loss(projectile, 0.5 * mass * (projectile.V0 ** 2 - v0 ** 2))
         masses[-1][-1] = mass
         phases.append(Phase("crater", depth0, v0, t0,
                             "crater depth reached" if v0 > 0.0 else STOPPED, "crater",
                             end_mass=mass))
-    start = (t0, depth0, v0, mass)
-    while start[2] > 0.0:
-        label = resistance.label(start[1], start[2])
-        phase, sol = integrate(resistance, start[3], start[:3], label=label, rtol=rtol,
-                               atol=atol, erosion=erosion)
-        _append_solution(columns, sol, phase, resistance, None, len(phases), erosion)
-        masses.append(sol.sol(columns[0][-1])[2])
-        phases.append(phase)
-        start = (phase.end_time, phase.end_depth, phase.end_velocity, phase.end_mass)
-    trajectory = _trajectory(columns, phases)
-    return replace(trajectory, mass=np.concatenate(masses),
-                   erosion=erosion.summary(start[3], float(trajectory.depth[-1])))
+    trajectory = _tunnel(target, projectile, resistance, (t0, depth0, v0), columns, phases,
+                         crater=crater, rtol=rtol, atol=atol, erosion=erosion, mass=mass,
+                         masses=masses)
+    end_mass = float(trajectory.mass[-1])
+    return replace(trajectory, erosion=erosion.summary(end_mass, float(trajectory.depth[-1])))
 
 
 def phase_stops(target, projectile):
@@ -225,9 +212,11 @@ def phase_stops(target, projectile):
     return stops
 
 
-def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol, atol):
+def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol, atol,
+            erosion=None, mass=None, masses=None):
     """Phases from ``start = (t0, L0, V0)`` to rest, each ended by :func:`integrate` (and a
-    crater stage below each debonded interface, :func:`phase_stops`)."""
+    crater stage below each debonded interface, :func:`phase_stops`). With ``erosion`` the
+    mass is state too: ``mass`` at the start, ``masses`` the list its samples go to."""
     label = resistance.label(start[1], start[2])
     stops = phase_stops(target, projectile)
     jumps = [(depth, FORCE_JUMP, None) for depth in getattr(resistance, "force_jumps", ())]
@@ -237,9 +226,17 @@ def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol
                                for s, d in zip(stops, stops[1:], strict=False)) else "tunnel"
     while start[2] > 0.0:
         stop_depth, stop_reason = (ahead[0][0], ahead[0][1]) if ahead else (None, None)
-        phase, sol = integrate(resistance, projectile.m, start, stop_depth=stop_depth,
-                               stop_reason=stop_reason, label=label, rtol=rtol, atol=atol)
-        _append_solution(columns, sol, phase, resistance, projectile.m, len(phases))
+        if erosion is None:
+            phase, sol = integrate(resistance, projectile.m, start, stop_depth=stop_depth,
+                                   stop_reason=stop_reason, label=label, rtol=rtol, atol=atol)
+            _append_solution(columns, sol, phase, resistance, projectile.m, len(phases))
+        else:
+            phase, sol = integrate(resistance, mass, start, stop_depth=stop_depth,
+                                   stop_reason=stop_reason, label=label, rtol=rtol, atol=atol,
+                                   erosion=erosion)
+            _append_solution(columns, sol, phase, resistance, None, len(phases), erosion)
+            masses.append(np.append(sol.sol(columns[0][-1][:-1])[2], phase.end_mass))
+            mass = phase.end_mass
         start = (phase.end_time, phase.end_depth, phase.end_velocity)
         if phase.end_reason == FORCE_JUMP:  # a step ends where the force jumps; the phase
             ahead.pop(0)                    # goes on past it unless the label changes there
@@ -252,6 +249,15 @@ def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol
         phases.append(replace(phase, stage=stage))
         if phase.end_reason == stop_reason:
             stage = ahead.pop(0)[2]
+            if stage == "crater" and erosion is not None:
+                start, mass = _eroding_interface_crater(target, projectile, resistance, start,
+                                                        columns, phases, crater, erosion,
+                                                        mass, masses)
+                stage = "tunnel"
+                ahead = [stop for stop in ahead if stop[0] > start[1]]
+                if start[2] > 0.0:
+                    label = resistance.label(start[1], start[2])
+                continue
             if stage == "crater":
                 start = _interface_crater(target, projectile, resistance, start, columns,
                                           phases, crater)
@@ -262,7 +268,24 @@ def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol
                 continue
         if start[2] > 0.0:
             label = _next_label(resistance, sol, phase.end_time, label)
+    if erosion is not None:
+        return replace(_trajectory(columns, phases), mass=np.concatenate(masses))
     return _trajectory(columns, phases)
+
+
+def _eroding_interface_crater(target, projectile, resistance, start, columns, phases, crater,
+                              erosion, mass, masses):
+    """:func:`_interface_crater` of the eroding projectile (its current mass, its nose as it
+    struck; the crater's loss at its end); returns the state at its end and the mass."""
+    flown = replace(projectile, m=mass)
+    n = len(columns[0])
+    end = _interface_crater(target, flown, resistance, start, columns, phases, crater)
+    if len(columns[0]) == n:  # no crater stage
+        return end, mass
+    mass = float(mass - erosion.crater_loss(projectile, 0.5 * mass * (start[2] ** 2 - end[2] ** 2)))
+    masses.append(np.full(len(columns[0][-1]), mass))
+    phases[-1] = replace(phases[-1], end_mass=mass)
+    return end, mass
 
 
 def _interface_crater(target, projectile, resistance, start, columns, phases, crater):
@@ -401,7 +424,7 @@ def _depth_event(depth):
 def _next_label(resistance, sol, t_end, label):
     """Label just past a phase end (the event root may sit on either side of the jump)."""
     for nudge in (0.0, 1e-13, 1e-11, 1e-9):
-        depth, v = sol.sol(t_end * (1.0 + nudge))
+        depth, v = sol.sol(t_end * (1.0 + nudge))[:2]
         new = resistance.label(depth, max(v, 0.0))
         if new != label:
             return new
