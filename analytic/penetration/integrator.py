@@ -72,9 +72,10 @@ class Trajectory:
     erosion: dict | None = None  # :meth:`~cavex.analytic.penetration.erosion.ErodingNose.summary`
 
     def as_columns(self):
-        """Columns for CSV output, in SI units."""
-        return {"t_s": self.t, "depth_m": self.depth, "velocity_m_s": self.velocity,
-                "deceleration_m_s2": self.deceleration, "phase": self.phase}
+        """Columns for CSV output, in SI units (``mass_kg`` with erosion only)."""
+        columns = {"t_s": self.t, "depth_m": self.depth, "velocity_m_s": self.velocity,
+                   "deceleration_m_s2": self.deceleration, "phase": self.phase}
+        return columns if self.mass is None else {**columns, "mass_kg": self.mass}
 
 
 def crater_exit(projectile, force, depth, speed=None):
