@@ -127,22 +127,29 @@ def table_depth(shot, resistance, erosion=None):
     Where it is on for the shot, the crater's loss
     (:meth:`~cavex.analytic.penetration.erosion.ErodingNose.crater_loss`) is taken at the
     crater's end and the tunnel flies the eroding nose; the depth is then the eroded nose
-    tip's."""
+    tip's (:func:`table_flight`)."""
+    return table_flight(shot, resistance, erosion)[0]
+
+
+def table_flight(shot, resistance, erosion=None):
+    """``(depth, eroded)``: :func:`table_depth` and the flight's erosion summary
+    (:meth:`~cavex.analytic.penetration.erosion.ErodingNose.summary`; None where the
+    projectile flew rigid: no law, a law off at ``V0``, or a crater that stops it)."""
     crater = crater_calibres(shot.crh) * shot.diameter
     projectile = Projectile.tangent_ogive(shot.mass, shot.diameter, shot.crh, shot.V0)
     energy = shot.mass * shot.V0 ** 2
     static = resistance.force(0.0, 0.0)
     if energy <= crater * static:
-        return math.sqrt(energy * crater / static)
+        return math.sqrt(energy * crater / static), None
     v1, _ = crater_exit(projectile, resistance.crater_force, crater)
     tunnel = Projectile(r=projectile.r, l=projectile.l, m=projectile.m, V0=v1, R=projectile.R)
     nose = eroding_nose(erosion, shot, projectile)
     if nose is None:
         return crater + float(penetrate(_target(shot), tunnel, resistance, crater=None)
-                              .depth[-1])
+                              .depth[-1]), None
     nose.lost = nose.crater_loss(projectile, 0.5 * shot.mass * (shot.V0 ** 2 - v1 ** 2))
-    flight = penetrate(_target(shot), tunnel, resistance, crater=None, erosion=nose)
-    return crater + flight.erosion["tip_depth_m"]
+    eroded = penetrate(_target(shot), tunnel, resistance, crater=None, erosion=nose).erosion
+    return crater + eroded["tip_depth_m"], eroded
 
 
 def eroding_nose(law, shot, projectile):
