@@ -195,3 +195,21 @@ def test_bad_erosion_values_are_refused_in_one_line(capsys):
     assert "'--erosion'" in capsys.readouterr().err
     with pytest.raises(Exception, match="friction"):
         ErosionLaw("bad", friction=0.0, heat=1e6)
+
+
+def test_committed_erosion_study_reruns():
+    """Three committed rows of results/erosion/erosion_bias.csv: a rerun agrees to the 6
+    digits written (half a unit of the 6th digit; the integrator's tolerance is 1e-9)."""
+    import csv
+
+    from cavex.verification.studies.erosion_study import MODELS, shot_rows
+
+    with open(ROOT / "results" / "erosion" / "erosion_bias.csv", newline="") as handle:
+        committed = {row["id"]: row for row in csv.DictReader(handle)}
+    chosen = [s for s in SHOTS if s.id in committed][::25]
+    assert len(chosen) == 3
+    for row in shot_rows(chosen):
+        written = committed[row["id"]]
+        for model in MODELS:
+            for kind, depth in zip(("rigid_m", "eroded_m"), row["depths"][model], strict=True):
+                assert depth == pytest.approx(float(written[f"{model} {kind}"]), rel=5e-6)

@@ -32,8 +32,9 @@ From a shot's columns (``f_c``, ``rho``, projectile mass, diameter, CRH, ``V0``)
 Li and Chen's (2003) empirical model (Forrestal's form with ``S = 72 f_c^-0.5``, the same
 crater) is :func:`li_chen_depth`. Rigid-regime flag (:func:`rigid_flag`): a shot is flagged
 ``non-rigid`` when the mean nose pressure at impact ``F(V0)/(pi a^2)`` of the model exceeds the
-projectile's listed yield strength (the nose then deforms or erodes, which no rigid model
-covers); flagged shots stay in every table.
+projectile's listed yield strength (the nose then deforms, which no model here covers; its
+abrasion is :mod:`cavex.analytic.penetration.erosion`, with :func:`table_depth`'s
+``erosion``); flagged shots stay in every table.
 """
 
 import math
