@@ -97,7 +97,8 @@ def test_the_nose_blunts_as_it_loses_mass():
 @pytest.mark.parametrize("A, B", [(2e5, 0.0), (2e5, 0.5)])
 @pytest.mark.parametrize("V0", [300.0, 600.0, 1200.0])
 def test_mass_lost_tends_to_the_published_proportionality_to_kinetic_energy(A, B, V0):
-    """Silling and Forrestal's result: the rigid projectile loses ``mu g m V0^2/(2Q)``. With
+    """The law's rigid limit (Silling and Forrestal's result as recalled; their text is not
+    here): the rigid projectile loses ``mu g m V0^2/(2Q)``. With
     the mass in the motion the integrator departs from it by O(mu) (the lighter projectile
     and its heating): measured -7.3e-7 to -1.2e-3 at mu 1e-5 to 1e-3, each tenfold smaller
     mu a tenfold smaller departure (ratios 0.095-0.104)."""

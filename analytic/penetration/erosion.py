@@ -11,7 +11,8 @@ its nose does work, over the heat that melts (ablates) a unit mass of it,
 sliding power (the target slides along the nose at ``V sin(phi)``). For a rigid projectile
 whose friction is a fixed fraction ``mu g`` of the axial force ``F`` this gives
 ``Delta m = (mu g / Q) int F dx = mu g m V0^2 / (2 Q)``: the mass lost is proportional to the
-striking kinetic energy, the published result (:func:`rigid_mass_loss`).
+striking kinetic energy (:func:`rigid_mass_loss`), the result the source is known for
+(recalled: its text is not here to check).
 
 **Constants (flagged).** The source's text and constants are not in the stored literature
 this project could search (docs/erosion.md says what was searched). The values below are
