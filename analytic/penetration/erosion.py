@@ -165,15 +165,26 @@ class ErodingNose:
         if mass == self._last[0]:
             return self._last[1]
         volume = self.volume0 - (self.m0 - mass) / self.density
-        if volume <= self.blunt_volume:
-            psi = HEMISPHERE
-        else:
-            from scipy.optimize import brentq
-
-            psi = brentq(lambda p: nose_volume(self.r, p) - volume, HEMISPHERE, self.psi0,
-                         xtol=1e-14, rtol=1e-14)
+        psi = HEMISPHERE if volume <= self.blunt_volume else self._solve_psi(volume)
         self._last = (mass, psi)
         return psi
+
+    def _solve_psi(self, volume):
+        """``psi`` in ``[1/2, psi_0]`` with ``nose_volume(r, psi) = volume``: Newton's method
+        from the last answer (forward-difference slope), to ``1e-13 v(psi_0)``; bisection
+        (``brentq``) where it does not converge in 6 steps."""
+        psi = self.psi0 if self._last[1] is None else self._last[1]
+        for _ in range(6):
+            residual = nose_volume(self.r, psi) - volume
+            if abs(residual) <= 1e-13 * self.volume0:
+                return psi
+            step = 1e-7 * psi
+            slope = (nose_volume(self.r, psi + step) - nose_volume(self.r, psi)) / step
+            psi = min(max(psi - residual / slope, HEMISPHERE), self.psi0)
+        from scipy.optimize import brentq
+
+        return brentq(lambda p: nose_volume(self.r, p) - volume, HEMISPHERE, self.psi0,
+                      xtol=1e-14, rtol=1e-14)
 
     def tip_setback(self, mass):
         """How far (m) the eroded nose tip sits behind the original one."""
