@@ -214,3 +214,28 @@ def test_committed_erosion_study_reruns():
         for model in MODELS:
             for kind, depth in zip(("rigid_m", "eroded_m"), row["depths"][model], strict=True):
                 assert depth == pytest.approx(float(written[f"{model} {kind}"]), rel=5e-6)
+
+
+def test_validate_with_erosion_against_the_committed_rigid_run(capsys, tmp_path):
+    """``cavex validate --erosion`` on Forrestal's 17 shots: the concrete model's depths fall
+    below the committed rigid ones (results/validation/predictions.csv), the empirical
+    formula's stay the same numbers, and the JSON and the provenance command say so."""
+    import csv
+    import json
+
+    shots = ROOT / "examples" / "shots_forrestal1994.csv"
+    code = main(["validate", "--shots", str(shots), "--models", "concrete", "li-chen-2003",
+                 "--erosion", "silling-forrestal", "--json", "--no-figures", "--no-progress",
+                 "--out", str(tmp_path / "v")])
+    out = capsys.readouterr().out
+    assert code == 0
+    result = json.loads(out)
+    assert result["erosion"] == "silling-forrestal"
+    assert "--erosion silling-forrestal" in result["command"]
+    with open(ROOT / "results" / "validation" / "predictions.csv", newline="") as handle:
+        rigid = {row["id"]: row for row in csv.DictReader(handle)}
+    for row in result["shots"]:
+        committed = rigid[row["id"]]
+        assert row["predicted_m"]["concrete"] < float(committed["concrete_m"]), row["id"]
+        assert row["predicted_m"]["li-chen-2003"] == pytest.approx(
+            float(committed["li_chen_2003_m"]), rel=5e-6)
