@@ -183,6 +183,11 @@ def test_erosion_through_the_layered_runway_and_its_interfaces():
         assert len(flight.mass) == len(flight.t) and flight.mass[-1] == masses[-1]
         assert flight.erosion["mass_lost_kg"] == pytest.approx(p.m - masses[-1], rel=1e-15)
         assert flight.depth[-1] < penetrate(layered, p, resistance).depth[-1]
+        given_by_crh = Projectile(r=p.r, l=p.l, m=p.m, V0=p.V0, crh=p.psi)  # R derived
+        again = penetrate(layered, given_by_crh, resistance,
+                          erosion=ErodingNose(SILLING_FORRESTAL, given_by_crh))
+        assert again.erosion["tip_depth_m"] == pytest.approx(flight.erosion["tip_depth_m"],
+                                                             rel=1e-9)
 
 
 def test_bad_erosion_values_are_refused_in_one_line(capsys):

@@ -179,8 +179,8 @@ def _eroding_penetrate(target, projectile, resistance, crater, rtol, atol, erosi
     mass = projectile.m - erosion.lost
     if crater is not None:
         depth0 = crater_depth(projectile, crater)
-        samples, t0, v0 = crater_stage(replace(projectile, m=mass), resistance.crater_force,
-                                       depth0)
+        samples, t0, v0 = crater_stage(replace(projectile, m=mass, crh=None),
+                                       resistance.crater_force, depth0)
         _append(columns, *samples, 0)
         depth0 = samples[1][-1]
         masses.append(np.full(len(samples[0]), mass))
@@ -278,7 +278,7 @@ def _eroding_interface_crater(target, projectile, resistance, start, columns, ph
                               erosion, mass, masses):
     """:func:`_interface_crater` of the eroding projectile (its current mass, its nose as it
     struck; the crater's loss at its end); returns the state at its end and the mass."""
-    flown = replace(projectile, m=mass)
+    flown = replace(projectile, m=mass, crh=None)
     n = len(columns[0])
     end = _interface_crater(target, flown, resistance, start, columns, phases, crater)
     if len(columns[0]) == n:  # no crater stage
