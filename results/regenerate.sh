@@ -51,4 +51,5 @@ cp "$shot"/*.png results/oblique/shot_20deg_600/ && rm -r "$shot"
 python -m cavex.verification.studies.concrete_validation --workers 2 > /dev/null
 python -m cavex.verification.studies.concrete_fe > /dev/null
 python -m cavex.verification.studies.rigid_form > /dev/null
+python -m cavex.verification.studies.erosion_study > /dev/null
 git status --short results

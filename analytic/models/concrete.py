@@ -20,10 +20,10 @@ class Concrete(Model):
     # tables of the development shots (0.16 s each)
     concrete_table_seconds = 0.2
 
-    def shot_depth(self, shot, *, constants=None, **options):
+    def shot_depth(self, shot, *, constants=None, erosion=None, **options):
         from cavex.analytic.penetration.concrete_table import model_depth
 
-        return model_depth(shot, constants)
+        return model_depth(shot, constants, erosion)
 
 
 register(Concrete())

@@ -57,10 +57,10 @@ class Derived(Model):
 
         return DerivedLaw(target, projectile.r, boundary, free_surface, bottom)
 
-    def shot_depth(self, shot, *, boundary=None, mapping=None, **options):
+    def shot_depth(self, shot, *, boundary=None, mapping=None, erosion=None, **options):
         from cavex.analytic.models.shots import flown_depth
 
-        return flown_depth(self, shot, mapping, boundary=boundary)
+        return flown_depth(self, shot, mapping, erosion, boundary=boundary)
 
 
 register(Derived())

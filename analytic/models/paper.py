@@ -47,10 +47,10 @@ class Paper(Model):
 
         return PaperLaw(target, projectile, epsilon)
 
-    def shot_depth(self, shot, *, mapping=None, **options):
+    def shot_depth(self, shot, *, mapping=None, erosion=None, **options):
         from cavex.analytic.models.shots import flown_depth
 
-        return flown_depth(self, shot, mapping)
+        return flown_depth(self, shot, mapping, erosion)
 
 
 register(Paper())

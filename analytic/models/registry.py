@@ -11,7 +11,9 @@ its own parameters"):
   model (:mod:`cavex.analytic.penetration.stress_laws`), where ``flies_3d``;
 - ``wall_stress(target, projectile, depth, velocity, **options)``: the closed form's cavity
   wall stress at one nose depth (``cavex stress``), where ``closed_form``;
-- ``shot_depth(shot, **options)``: the depth (m) of a measured shot (``cavex validate``),
+- ``shot_depth(shot, **options)``: the depth (m) of a measured shot (``cavex validate``;
+  ``erosion``, an :class:`~cavex.analytic.penetration.erosion.ErosionLaw` or None, is taken
+  by the models that fly the 1-D integrator and ignored by the empirical formulas),
   where ``predicts_shots``; a shot is any object with ``mass, diameter, crh, V0, fc, rho``;
 - its options (``boundaries``, ``takes_table``, ``takes_epsilon``, ``takes_law``) and their
   checks (:meth:`Model.check`), its label(s) (:meth:`Model.label`) and its words

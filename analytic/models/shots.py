@@ -17,11 +17,17 @@ def shot_projectile(shot):
     return Projectile.tangent_ogive(shot.mass, shot.diameter, shot.crh, shot.V0)
 
 
-def flown_depth(model, shot, mapping=None, **options):
+def flown_depth(model, shot, mapping=None, erosion=None, **options):
     """Final nose-tip depth (m) of the integrator with ``model``'s 1-D resistance (also where
-    the crater stops it: ``sqrt(m V0^2 L_c / F(0))``)."""
+    the crater stops it: ``sqrt(m V0^2 L_c / F(0))``); ``erosion``: an
+    :class:`~cavex.analytic.penetration.erosion.ErosionLaw` (None: rigid), then the eroded
+    nose tip's depth."""
+    from cavex.analytic.penetration.concrete_table import eroding_nose
     from cavex.analytic.penetration.integrator import penetrate
 
     target, projectile = shot_target(shot, mapping), shot_projectile(shot)
     resistance = model.resistance(target, projectile, **options)
-    return float(penetrate(target, projectile, resistance).depth[-1])
+    nose = eroding_nose(erosion, shot, projectile)
+    if nose is None:
+        return float(penetrate(target, projectile, resistance).depth[-1])
+    return penetrate(target, projectile, resistance, erosion=nose).erosion["tip_depth_m"]

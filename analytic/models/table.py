@@ -52,11 +52,11 @@ class Table(Model):
         require(table is not None, "table", "given for --resistance table", None)
         return TableLaw(TabulatedResistance(table, target, projectile))
 
-    def shot_depth(self, shot, *, mapping=None, tables=None, **options):
+    def shot_depth(self, shot, *, mapping=None, tables=None, erosion=None, **options):
         from cavex.analytic.models.shots import flown_depth
 
         require(tables is not None, "tables", "an FE-table source for the table model", None)
-        return flown_depth(self, shot, mapping, table=tables.table(shot, mapping))
+        return flown_depth(self, shot, mapping, erosion, table=tables.table(shot, mapping))
 
 
 register(Table())

@@ -32,8 +32,9 @@ From a shot's columns (``f_c``, ``rho``, projectile mass, diameter, CRH, ``V0``)
 Li and Chen's (2003) empirical model (Forrestal's form with ``S = 72 f_c^-0.5``, the same
 crater) is :func:`li_chen_depth`. Rigid-regime flag (:func:`rigid_flag`): a shot is flagged
 ``non-rigid`` when the mean nose pressure at impact ``F(V0)/(pi a^2)`` of the model exceeds the
-projectile's listed yield strength (the nose then deforms or erodes, which no rigid model
-covers); flagged shots stay in every table.
+projectile's listed yield strength (the nose then deforms, which no model here covers; its
+abrasion is :mod:`cavex.analytic.penetration.erosion`, with :func:`table_depth`'s
+``erosion``); flagged shots stay in every table.
 """
 
 import math
@@ -120,19 +121,55 @@ def _target(shot):
     return Target((Material(E=1.0, nu=0.2, rho=shot.rho, lam=0.0, tau=1.0),), ())
 
 
-def table_depth(shot, resistance):
-    """Depth (m) with the crater of :func:`crater_calibres` and cavex's tunnel integrator."""
+def table_depth(shot, resistance, erosion=None):
+    """Depth (m) with the crater of :func:`crater_calibres` and cavex's tunnel integrator.
+
+    ``erosion``: an :class:`~cavex.analytic.penetration.erosion.ErosionLaw` (None: rigid).
+    Where it is on for the shot, the crater's loss
+    (:meth:`~cavex.analytic.penetration.erosion.ErodingNose.crater_loss`) is taken at the
+    crater's end and the tunnel flies the eroding nose; the depth is then the eroded nose
+    tip's (:func:`table_flight`)."""
+    return table_flight(shot, resistance, erosion)[0]
+
+
+def table_flight(shot, resistance, erosion=None):
+    """``(depth, eroded)``: :func:`table_depth` and the flight's erosion summary
+    (:meth:`~cavex.analytic.penetration.erosion.ErodingNose.summary`; None where the
+    projectile flew rigid: no law, a law off at ``V0``, or a crater that stops it)."""
     crater = crater_calibres(shot.crh) * shot.diameter
     projectile = Projectile.tangent_ogive(shot.mass, shot.diameter, shot.crh, shot.V0)
     energy = shot.mass * shot.V0 ** 2
     static = resistance.force(0.0, 0.0)
     if energy <= crater * static:
-        return math.sqrt(energy * crater / static)
+        return math.sqrt(energy * crater / static), None
     v1, _ = crater_exit(projectile, resistance.crater_force, crater)
     tunnel = Projectile(r=projectile.r, l=projectile.l, m=projectile.m, V0=v1, R=projectile.R)
-    return crater + float(penetrate(_target(shot), tunnel, resistance, crater=None).depth[-1])
+    nose = eroding_nose(erosion, shot, projectile)
+    if nose is None:
+        return crater + float(penetrate(_target(shot), tunnel, resistance, crater=None)
+                              .depth[-1]), None
+    nose.lost = nose.crater_loss(projectile, 0.5 * shot.mass * (shot.V0 ** 2 - v1 ** 2))
+    eroded = penetrate(_target(shot), tunnel, resistance, crater=None, erosion=nose).erosion
+    return crater + eroded["tip_depth_m"], eroded
 
 
-def model_depth(shot, constants=None):
-    """Predicted depth (m) of the concrete cavity-expansion model for ``shot``."""
-    return table_depth(shot, TableResistance(shot, constants))
+def eroding_nose(law, shot, projectile):
+    """The :class:`~cavex.analytic.penetration.erosion.ErodingNose` of ``shot`` under
+    ``law`` (its listed ``proj_density``, else steel's), None where ``law`` is None or off
+    for the shot's striking velocity."""
+    from cavex.analytic.penetration.erosion import ErodingNose
+    from cavex.materials import DEFAULT_DENSITY
+
+    if law is None or shot.V0 <= law.onset:
+        return None
+    try:
+        density = float(getattr(shot, "extra", {}).get("proj_density", ""))
+    except ValueError:
+        density = DEFAULT_DENSITY
+    return ErodingNose(law, projectile, density)
+
+
+def model_depth(shot, constants=None, erosion=None):
+    """Predicted depth (m) of the concrete cavity-expansion model for ``shot`` (``erosion``:
+    :func:`table_depth`)."""
+    return table_depth(shot, TableResistance(shot, constants), erosion)

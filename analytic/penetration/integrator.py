@@ -55,6 +55,7 @@ class Phase:
     end_time: float
     end_reason: str
     stage: str = "tunnel"
+    end_mass: float | None = None  # kg, with erosion only (None: the rigid mass throughout)
 
 
 @dataclass(frozen=True)
@@ -67,11 +68,14 @@ class Trajectory:
     deceleration: np.ndarray
     phase: np.ndarray
     phases: tuple
+    mass: np.ndarray | None = None  # kg at every output point, with erosion only
+    erosion: dict | None = None  # :meth:`~cavex.analytic.penetration.erosion.ErodingNose.summary`
 
     def as_columns(self):
-        """Columns for CSV output, in SI units."""
-        return {"t_s": self.t, "depth_m": self.depth, "velocity_m_s": self.velocity,
-                "deceleration_m_s2": self.deceleration, "phase": self.phase}
+        """Columns for CSV output, in SI units (``mass_kg`` with erosion only)."""
+        columns = {"t_s": self.t, "depth_m": self.depth, "velocity_m_s": self.velocity,
+                   "deceleration_m_s2": self.deceleration, "phase": self.phase}
+        return columns if self.mass is None else {**columns, "mass_kg": self.mass}
 
 
 def crater_exit(projectile, force, depth, speed=None):
@@ -122,7 +126,8 @@ def crater_stage(projectile, force, depth, samples=50, start=None):
     return (t, depths, velocity, deceleration), t0 + tc, vc
 
 
-def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, atol=ATOL):
+def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, atol=ATOL,
+              erosion=None):
     """Integrate the projectile through the target.
 
     Parameters
@@ -136,11 +141,20 @@ def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, 
         below it): :class:`~cavex.analytic.penetration.resistance.ClosedFormResistance`.
     crater : {"nose-base", "nose-tip"}
         Where the crater depth ``4.5 r`` is measured from; ``None`` skips the crater stages.
+    erosion : ErodingNose, optional
+        Nose erosion (:mod:`cavex.analytic.penetration.erosion`): the mass and the nose's CRH
+        become state, the force is the current nose's; the crater's loss is applied at its
+        end. None, or a law that is off for this striking velocity (``erosion.active``
+        False): the rigid projectile, the same numbers bit for bit. With erosion the depths
+        (and so the layers' geometry and the interface stops) are the original nose tip's;
+        the eroded tip's final depth is ``Trajectory.erosion["tip_depth_m"]``.
 
     Returns
     -------
     Trajectory
     """
+    if erosion is not None and erosion.active:
+        return _eroding_penetrate(target, projectile, resistance, crater, rtol, atol, erosion)
     columns = [[] for _ in range(5)]
     phases = []
     t0, depth0, v0 = 0.0, 0.0, projectile.V0
@@ -153,6 +167,33 @@ def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, 
                             "crater depth reached" if v0 > 0.0 else STOPPED, "crater"))
     return _tunnel(target, projectile, resistance, (t0, depth0, v0), columns, phases,
                    crater=crater, rtol=rtol, atol=atol)
+
+
+def _eroding_penetrate(target, projectile, resistance, crater, rtol, atol, erosion):
+    """:func:`penetrate` with an eroding nose: the rigid crater stage, its loss
+    (:meth:`~cavex.analytic.penetration.erosion.ErodingNose.crater_loss`) applied at its end,
+    then the tunnel phases of the state ``(L, V, m)`` (:func:`_tunnel`)."""
+    columns = [[] for _ in range(5)]
+    phases, masses = [], []
+    t0, depth0, v0 = 0.0, 0.0, projectile.V0
+    mass = projectile.m - erosion.lost
+    if crater is not None:
+        depth0 = crater_depth(projectile, crater)
+        samples, t0, v0 = crater_stage(replace(projectile, m=mass, crh=None),
+                                       resistance.crater_force, depth0)
+        _append(columns, *samples, 0)
+        depth0 = samples[1][-1]
+        masses.append(np.full(len(samples[0]), mass))
+        mass -= erosion.crater_loss(projectile, 0.5 * mass * (projectile.V0 ** 2 - v0 ** 2))
+        masses[-1][-1] = mass
+        phases.append(Phase("crater", depth0, v0, t0,
+                            "crater depth reached" if v0 > 0.0 else STOPPED, "crater",
+                            end_mass=mass))
+    trajectory = _tunnel(target, projectile, resistance, (t0, depth0, v0), columns, phases,
+                         crater=crater, rtol=rtol, atol=atol, erosion=erosion, mass=mass,
+                         masses=masses)
+    end_mass = float(trajectory.mass[-1])
+    return replace(trajectory, erosion=erosion.summary(end_mass, float(trajectory.depth[-1])))
 
 
 def phase_stops(target, projectile):
@@ -172,9 +213,11 @@ def phase_stops(target, projectile):
     return stops
 
 
-def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol, atol):
+def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol, atol,
+            erosion=None, mass=None, masses=None):
     """Phases from ``start = (t0, L0, V0)`` to rest, each ended by :func:`integrate` (and a
-    crater stage below each debonded interface, :func:`phase_stops`)."""
+    crater stage below each debonded interface, :func:`phase_stops`). With ``erosion`` the
+    mass is state too: ``mass`` at the start, ``masses`` the list its samples go to."""
     label = resistance.label(start[1], start[2])
     stops = phase_stops(target, projectile)
     jumps = [(depth, FORCE_JUMP, None) for depth in getattr(resistance, "force_jumps", ())]
@@ -184,9 +227,17 @@ def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol
                                for s, d in zip(stops, stops[1:], strict=False)) else "tunnel"
     while start[2] > 0.0:
         stop_depth, stop_reason = (ahead[0][0], ahead[0][1]) if ahead else (None, None)
-        phase, sol = integrate(resistance, projectile.m, start, stop_depth=stop_depth,
-                               stop_reason=stop_reason, label=label, rtol=rtol, atol=atol)
-        _append_solution(columns, sol, phase, resistance, projectile.m, len(phases))
+        if erosion is None:
+            phase, sol = integrate(resistance, projectile.m, start, stop_depth=stop_depth,
+                                   stop_reason=stop_reason, label=label, rtol=rtol, atol=atol)
+            _append_solution(columns, sol, phase, resistance, projectile.m, len(phases))
+        else:
+            phase, sol = integrate(resistance, mass, start, stop_depth=stop_depth,
+                                   stop_reason=stop_reason, label=label, rtol=rtol, atol=atol,
+                                   erosion=erosion)
+            _append_solution(columns, sol, phase, resistance, None, len(phases), erosion)
+            masses.append(np.append(sol.sol(columns[0][-1][:-1])[2], phase.end_mass))
+            mass = phase.end_mass
         start = (phase.end_time, phase.end_depth, phase.end_velocity)
         if phase.end_reason == FORCE_JUMP:  # a step ends where the force jumps; the phase
             ahead.pop(0)                    # goes on past it unless the label changes there
@@ -199,6 +250,15 @@ def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol
         phases.append(replace(phase, stage=stage))
         if phase.end_reason == stop_reason:
             stage = ahead.pop(0)[2]
+            if stage == "crater" and erosion is not None:
+                start, mass = _eroding_interface_crater(target, projectile, resistance, start,
+                                                        columns, phases, crater, erosion,
+                                                        mass, masses)
+                stage = "tunnel"
+                ahead = [stop for stop in ahead if stop[0] > start[1]]
+                if start[2] > 0.0:
+                    label = resistance.label(start[1], start[2])
+                continue
             if stage == "crater":
                 start = _interface_crater(target, projectile, resistance, start, columns,
                                           phases, crater)
@@ -209,7 +269,24 @@ def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol
                 continue
         if start[2] > 0.0:
             label = _next_label(resistance, sol, phase.end_time, label)
+    if erosion is not None:
+        return replace(_trajectory(columns, phases), mass=np.concatenate(masses))
     return _trajectory(columns, phases)
+
+
+def _eroding_interface_crater(target, projectile, resistance, start, columns, phases, crater,
+                              erosion, mass, masses):
+    """:func:`_interface_crater` of the eroding projectile (its current mass, its nose as it
+    struck; the crater's loss at its end); returns the state at its end and the mass."""
+    flown = replace(projectile, m=mass, crh=None)
+    n = len(columns[0])
+    end = _interface_crater(target, flown, resistance, start, columns, phases, crater)
+    if len(columns[0]) == n:  # no crater stage
+        return end, mass
+    mass = float(mass - erosion.crater_loss(projectile, 0.5 * mass * (start[2] ** 2 - end[2] ** 2)))
+    masses.append(np.full(len(columns[0][-1]), mass))
+    phases[-1] = replace(phases[-1], end_mass=mass)
+    return end, mass
 
 
 def _interface_crater(target, projectile, resistance, start, columns, phases, crater):
@@ -230,7 +307,7 @@ def _interface_crater(target, projectile, resistance, start, columns, phases, cr
 
 
 def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REACHED,
-              label=None, rtol=RTOL, atol=ATOL):
+              label=None, rtol=RTOL, atol=ATOL, erosion=None):
     r"""Integrate ``m dV/dt = -F(L, V)``, ``dL/dt = V`` from ``start = (t0, L0, V0)`` to the first
     of: rest (``V = 0``), the nose tip at ``stop_depth``, the response state leaving ``label``.
 
@@ -256,6 +333,11 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
         ``resistance.label`` differs from it (None: the state is not watched).
     rtol, atol : float
         Tolerances of ``solve_ivp``.
+    erosion : ErodingNose, optional
+        The mass ``m`` becomes a third state, ``mass`` its start:
+        ``m dV/dt = -F_m(L, V)``, ``dm/dt = -V F_f / Q``
+        (:meth:`~cavex.analytic.penetration.erosion.ErodingNose.forces`); the phase's
+        ``end_mass`` is set. ``atol`` applies to the mass too (kg).
 
     Returns
     -------
@@ -268,8 +350,14 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
     def rhs(t, y):  # depth never falls below the start: a trial stage past rest is clamped
         return (y[1], -resistance.force(max(y[0], depth0), max(y[1], 0.0)) / mass)
 
+    def eroding_rhs(t, y):
+        v = max(y[1], 0.0)
+        force, friction = erosion.forces(resistance, max(y[0], depth0), v, y[2])
+        return (y[1], -force / y[2], erosion.mass_rate(friction, v))
+
     events = _phase_events(resistance, stop_depth, stop_reason, label, t0)
-    sol = solve_ivp(rhs, (t0, t0 + MAX_PHASE_DURATION), (depth0, v0),
+    sol = solve_ivp(rhs if erosion is None else eroding_rhs, (t0, t0 + MAX_PHASE_DURATION),
+                    (depth0, v0) if erosion is None else (depth0, v0, mass),
                     method="DOP853", events=[e for e, _ in events], dense_output=True,
                     rtol=rtol, atol=atol)
     if sol.status == 0:  # reached t0 + MAX_PHASE_DURATION: no event
@@ -281,13 +369,16 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
         raise CavexNumericalError(f"penetration integration failed at t={sol.t[-1]} s, "
                                   f"depth {sol.y[0, -1]} m: {sol.message}")
     which = next(i for i, te in enumerate(sol.t_events) if te.size)
-    t_end, (depth_end, v_end) = sol.t_events[which][0], sol.y_events[which][0]
+    t_end, (depth_end, v_end) = sol.t_events[which][0], sol.y_events[which][0][:2]
     reason = events[which][1]
     if (reason == STATE_CHANGED and stop_depth is not None
             and abs(depth_end - stop_depth) <= 1e-12 * stop_depth):
         reason = stop_reason  # a state change at the stop depth itself (nose-tip switch)
     if reason == STOPPED:
         v_end = 0.0
+    if erosion is not None:
+        return Phase(label, depth_end, v_end, t_end, reason,
+                     end_mass=float(sol.y_events[which][0][2])), sol
     return Phase(label, depth_end, v_end, t_end, reason), sol
 
 
@@ -334,7 +425,7 @@ def _depth_event(depth):
 def _next_label(resistance, sol, t_end, label):
     """Label just past a phase end (the event root may sit on either side of the jump)."""
     for nudge in (0.0, 1e-13, 1e-11, 1e-9):
-        depth, v = sol.sol(t_end * (1.0 + nudge))
+        depth, v = sol.sol(t_end * (1.0 + nudge))[:2]
         new = resistance.label(depth, max(v, 0.0))
         if new != label:
             return new
@@ -347,7 +438,7 @@ def _append(columns, t, depth, velocity, deceleration, phase):
         column.append(np.asarray(values, dtype=float))
 
 
-def _append_solution(columns, sol, phase_end, resistance, mass, phase):
+def _append_solution(columns, sol, phase_end, resistance, mass, phase, erosion=None):
     """The phase's samples up to its end; at a stop the last velocity is exactly 0 m/s, as
     :func:`integrate` returns it (the dense output there is round-off, ~1e-14 m/s, that differs
     between CPUs)."""
@@ -356,7 +447,12 @@ def _append_solution(columns, sol, phase_end, resistance, mass, phase):
     y = sol.sol(t)
     if phase_end.end_reason == STOPPED:
         y[1, -1] = 0.0
-    deceleration = np.array([resistance.force(depth, max(v, 0.0)) / mass for depth, v in y.T])
+    if erosion is None:
+        deceleration = np.array([resistance.force(depth, max(v, 0.0)) / mass
+                                 for depth, v in y.T])
+    else:
+        deceleration = np.array([erosion.forces(resistance, depth, max(v, 0.0), m)[0] / m
+                                 for depth, v, m in y.T])
     _append(columns, t, y[0], np.maximum(y[1], 0.0), deceleration, phase)
 
 

@@ -63,6 +63,18 @@ def add_resistance_options(command, offered=FITTED, table=True, epsilon=True):
     command.add_argument("--model", dest="old_model", help=argparse.SUPPRESS)
 
 
+def add_erosion_option(command):
+    """``--erosion {none,silling-forrestal}``: nose erosion by abrasion in the 1-D integrator
+    (:mod:`cavex.analytic.penetration.erosion`; ``penetrate``, ``validate``)."""
+    from cavex.analytic.penetration.erosion import CHOICES
+
+    command.add_argument("--erosion", choices=CHOICES, default="none",
+                         help="nose erosion by abrasion: silling-forrestal (Silling and Forrestal "
+                         "2007: mass lost at the frictional power over a heat of ablation, the "
+                         "nose blunting; mu 0.1 and Q 1.31 MJ/kg are not the source's, "
+                         "docs/erosion.md) or none (the rigid projectile)")
+
+
 def add_law_options(command):
     """``--law-A PA --law-B KG_PER_M3``: the global plain law of ``--resistance law`` (added by
     :func:`add_resistance_options` where "law" is offered: ``penetrate``, ``trajectory``)."""

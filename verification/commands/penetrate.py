@@ -12,8 +12,10 @@ from cavex.analytic.models import get
 from cavex.analytic.models.plain_law import law_echo
 from cavex.analytic.penetration.zones import crater_depth, scab_depth
 from cavex.config import load_config
+from cavex.errors import CavexInputError
 from cavex.verification.commands.options import (
     FLOWN,
+    add_erosion_option,
     add_interface_option,
     add_resistance_options,
     interface_target,
@@ -40,6 +42,7 @@ def add_arguments(parser):
     add_figures_option(parser, "the CSV trajectories and phase table")
     parser.add_argument("--crater", choices=("nose-base", "nose-tip"), default="nose-base",
                         help="where the crater depth 4.5 r is measured from")
+    add_erosion_option(parser)
 
 
 def run(args, target, projectile):
@@ -49,7 +52,8 @@ def run(args, target, projectile):
     target = interface_target(args, target, settings["resistance"])
     laws = law_settings(args, target)
     folder = check_output_dir(args.out, "out")
-    job = penetration_job(target, projectile, crater=args.crater, **settings, **laws)
+    job = penetration_job(target, projectile, crater=args.crater, erosion=args.erosion,
+                          **settings, **laws)
     job["outputs"] = write_staged(folder,
                                   lambda stage: write_outputs(job, stage, draw=args.figures))
     return job
@@ -57,7 +61,7 @@ def run(args, target, projectile):
 
 def penetration_job(target, projectile, *, resistance="derived", boundary=None,
                     epsilon="quasi-static", crater="nose-base", table=None, law_A=None,
-                    law_B=None):
+                    law_B=None, erosion="none"):
     """Run the target and its first layer alone (the paper's Fig. 4 pair); nothing is written.
 
     ``resistance`` is a flown model of the registry (:mod:`cavex.analytic.models`);
@@ -70,24 +74,41 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
     ``law_A`` (Pa), ``law_B`` (kg/m^3), or neither: each layer's ``law_A``, ``law_B`` keys
     (:class:`~cavex.analytic.penetration.plain_law.PlainLawResistance`); it has no boundary
     convention (``boundary`` None).
+
+    ``erosion``: a law of :data:`cavex.analytic.penetration.erosion.CHOICES` ("none": the rigid
+    projectile); both runs fly the eroding nose, each run's ``erosion`` summary says what it
+    lost. Not with an FE table (its interpolation-error estimate flies the rigid projectile).
     """
+    from cavex.analytic.penetration.erosion import ErodingNose, law_named
+
+    law = law_named(erosion)
+    if law is not None and table is not None:
+        raise CavexInputError("option '--erosion' goes with a closed form or the plain law, "
+                              "not '--resistance table' (the table's interpolation-error "
+                              "estimate flies the rigid projectile)")
     from cavex.analytic.models import make_resistance
     from cavex.analytic.penetration.integrator import penetrate
 
+    def nose():
+        return None if law is None else ErodingNose(law, projectile)
+
     model = get(resistance)
     first_model = get(model.first_layer or resistance)  # flies the first layer alone
-    law, closed = model.takes_law, first_model.name
+    closed = first_model.name
     label, first = model.label(boundary), first_model.label(boundary)
     boundary = first_model.boundary(boundary)
     single = target.single(0)
     laws = {"law_A": law_A, "law_B": law_B}
     runs = {"runway": penetrate(target, projectile, make_resistance(
                 target, projectile, resistance, boundary, epsilon, table, **laws),
-                crater=crater),
+                crater=crater, erosion=nose()),
             "first_layer_only": penetrate(single, projectile, make_resistance(
-                single, projectile, closed, boundary, epsilon, **laws), crater=crater)}
+                single, projectile, closed, boundary, epsilon, **laws), crater=crater,
+                erosion=nose())}
     paper = (target.with_interfaces("bonded"), projectile) == load_config()
-    settings = {"law": law_echo(target, law_A, law_B)} if law else {}
+    settings = {"law": law_echo(target, law_A, law_B)} if model.takes_law else {}
+    if erosion != "none":
+        settings["erosion"] = {name: run.erosion for name, run in runs.items()}
     if model.takes_table:
         settings["interpolation_error"] = table_error(target, projectile, table, crater,
                                                       runs["runway"])
@@ -128,7 +149,8 @@ def table_error(target, projectile, table, crater, runway):
 
 
 SETTINGS = ("model", "first_layer_model", "resistance", "boundary", "epsilon", "table",
-            "law", "crater", "interfaces", "target_label", "notes")  # "law": the plain law's
+            "law", "crater", "interfaces", "target_label", "notes",
+            "erosion")  # "law": the plain law's; "erosion": each run's, with a law only
 
 
 def interface_summary(target, projectile):
@@ -162,6 +184,8 @@ def text(job):
         lines.append("debonded interfaces at " + ", ".join(
             f"{i['depth_m']:g} m (rear zone {i['rear_zone_m']:.4g} m)" for i in debonded))
     lines += [f"note: {note}" for note in s["notes"]]
+    for run, eroded in (s.get("erosion") or {}).items():
+        lines.append(erosion_line(run, eroded))
     stage = (lambda p: f" {p['stage']:<9}") if debonded else (lambda p: "")
     width = max([24, *(len(p["label"]) for p in s["phases"])])  # a long layer name fits
     lines += ["", f"phases ({s['target_label']}):",
@@ -186,6 +210,16 @@ def text(job):
         lines.append(not_reproduced_line(s["table2"]))
     lines += ["", "wrote: " + ", ".join(s["outputs"])]
     return "\n".join(lines)
+
+
+def erosion_line(run, eroded):
+    """One run's nose erosion in words (``eroded`` None: the law is off at this velocity)."""
+    if eroded is None:
+        return f"erosion ({run}): off at this striking velocity (the rigid projectile)"
+    return (f"erosion ({run}, {eroded['law']}): {eroded['mass_lost_kg']:.4g} kg lost "
+            f"({100 * eroded['mass_loss_fraction']:.3g} %), nose CRH {eroded['crh_final']:.3g}, "
+            f"eroded tip {eroded['tip_setback_m']:.4g} m behind the original, at "
+            f"{eroded['tip_depth_m']:.4f} m")
 
 
 def interpolation_line(s):

@@ -21,6 +21,7 @@ import time
 
 from cavex.analytic.models import labels
 from cavex.errors import CavexInputError
+from cavex.verification.commands.options import add_erosion_option
 from cavex.verification.commands.shared_options import (
     add_figures_option,
     add_parallel_options,
@@ -63,6 +64,7 @@ def add_arguments(parser):
     parser.add_argument("--models", nargs="+", action="extend", metavar="NAME",
                         help="run only these models: " + ", ".join(labels(predicts_shots=True))
                         + " (default: all; calibrations add their columns)")
+    add_erosion_option(parser)
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.add_argument("--out", help="output folder (default results/validation)")
     add_figures_option(parser, "validation.json, predictions.csv and report.md")
@@ -97,9 +99,10 @@ def run(args, target, projectile):
     print(f"cavex: validate {size}", file=sys.stderr, flush=True)
     began = time.monotonic()
     result = job(shot_file, calibrations, workers=workers, scheduler=scheduler,
-                 progress=args.progress, models=models, tables=tables)
+                 progress=args.progress, models=models, tables=tables, erosion=args.erosion)
     seconds = time.monotonic() - began
-    result["command"] = command_line(shots_path, calibration_paths, out, args.models)
+    result["command"] = command_line(shots_path, calibration_paths, out, args.models,
+                                     args.erosion)
     written = write_staged(out, lambda stage: write_outputs(result, stage, draw=args.figures))
     result["seconds"], result["outputs"] = seconds, written
     return result
@@ -136,20 +139,23 @@ def estimate(shots, calibrations, tables, workers, models=None):
 
 
 def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=None,
-        progress=None, models=None, tables=None):
+        progress=None, models=None, tables=None, erosion="none"):
     """:func:`cavex.verification.validation.predict.validate` plus the compressibility column and
     the shots file's description; ``tables``: the :class:`TableCache` to use (default a new
-    one copying its tables into ``tables_dir``)."""
+    one copying its tables into ``tables_dir``); ``erosion``: a name of
+    :data:`cavex.analytic.penetration.erosion.CHOICES` ("none": rigid)."""
+    from cavex.analytic.penetration.erosion import law_named
     from cavex.verification.fedata.runner import show_progress
 
+    law = law_named(erosion)
     if tables is None:
         tables = TableCache(tables_dir, workers=workers, scheduler=scheduler,
                             progress=show_progress(progress))
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
-                      progress=progress, models=models)
+                      progress=progress, models=models, erosion=law)
     if any(c.model == FE_PARTNER for c in calibrations):
         columns = {COMPRESSIBILITY_COLUMN: columns_of(calibrations)[COMPRESSIBILITY_COLUMN]}
-        depths, failures = predictions(shot_file.shots, columns, tables, progress)
+        depths, failures = predictions(shot_file.shots, columns, tables, progress, law)
         for row, depth in zip(result["shots"], depths[COMPRESSIBILITY_COLUMN], strict=True):
             row["predicted_m"][COMPRESSIBILITY_COLUMN] = depth
             row["ratio"][COMPRESSIBILITY_COLUMN] = None if depth is None else \
@@ -223,6 +229,9 @@ def text(result):
     lines = [f"{result['shots_file']['n']} shots from {result['shots_file']['path']}; "
              f"FE tables built {result['tables']['built']}, reused "
              f"{result['tables']['reused']}; {result['seconds']:.1f} s", ""]
+    if result.get("erosion"):
+        lines[-1:-1] = [f"nose erosion: {result['erosion']} in every model that flies the "
+                        "integrator (the empirical formulas are rigid; docs/erosion.md)"]
     fitted = bool(result["calibrations"])
     parts = [("all shots" + (" (calibrated models: in-sample on their fitted shots)" if fitted
                              else ""), result["summary"])]
@@ -257,11 +266,13 @@ def text(result):
     return "\n".join(lines)
 
 
-def command_line(shots_path, calibration_paths, out_dir, models=None):
+def command_line(shots_path, calibration_paths, out_dir, models=None, erosion="none"):
     """The ``cavex validate`` command that makes these outputs (the report's provenance)."""
     words = ["cavex", "validate", "--shots", str(shots_path)]
     if models:
         words += ["--models", *models]
+    if erosion != "none":
+        words += ["--erosion", erosion]
     if calibration_paths:
         words += ["--calibration", *map(str, calibration_paths)]
     return " ".join(shlex.quote(w) for w in [*words, "--out", str(out_dir)])

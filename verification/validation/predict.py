@@ -99,15 +99,20 @@ def model_of(label):
     return parse_label(label, "models", labels(predicts_shots=True))[0]
 
 
-def predict(shot, model, mapping=None, tables=None):
+def predict(shot, model, mapping=None, tables=None, erosion=None):
     """Predicted depth (m) of ``model`` (one of :data:`MODELS`) for ``shot``.
 
-    ``tables`` (a :class:`TableCache`) gives the FE tables of the ``table`` model.
+    ``tables`` (a :class:`TableCache`) gives the FE tables of the ``table`` model; ``erosion``
+    an :class:`~cavex.analytic.penetration.erosion.ErosionLaw` (None: rigid), flown by the
+    models that integrate (the empirical formulas ignore it).
     """
     chosen, boundary = parse_label(model, "models", labels(predicts_shots=True))  # checked
     if chosen.takes_table:
         tables = tables or TableCache()
-    return chosen.shot_depth(shot, boundary=boundary, mapping=mapping, tables=tables)
+    if erosion is None:  # the rigid call, as before erosion existed
+        return chosen.shot_depth(shot, boundary=boundary, mapping=mapping, tables=tables)
+    return chosen.shot_depth(shot, boundary=boundary, mapping=mapping, tables=tables,
+                             erosion=erosion)
 
 
 # --- FE tables --------------------------------------------------------------------------------
@@ -309,10 +314,11 @@ def run_estimate(shots, models, tables, workers):
             f"{when} on {workers} worker(s) of an unloaded machine")
 
 
-def predictions(shots, models, tables=None, progress=None):
+def predictions(shots, models, tables=None, progress=None, erosion=None):
     """``{model: [depth or None]}`` and ``{model: {shot id: reason}}`` for the failures.
 
-    ``models`` maps a column name to ``(model, mapping)`` (``mapping`` None: default).
+    ``models`` maps a column name to ``(model, mapping)`` (``mapping`` None: default);
+    ``erosion``: :func:`predict`'s.
     """
     from cavex.verification.fedata.runner import Progress, show_progress
 
@@ -323,7 +329,8 @@ def predictions(shots, models, tables=None, progress=None):
     for name, (model, mapping) in models.items():
         for shot in shots:
             try:
-                value = round_significant(predict(shot, model, mapping, tables), DEPTH_DIGITS)
+                value = round_significant(predict(shot, model, mapping, tables, erosion),
+                                          DEPTH_DIGITS)
             except (CavexInputError, CavexNumericalError) as exc:
                 value = None
                 failures.setdefault(name, {})[shot.id] = str(exc).splitlines()[0]
@@ -373,7 +380,8 @@ def validation_columns(calibrations=(), mapping=None, models=None):
     return columns
 
 
-def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None, models=None):
+def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None, models=None,
+             erosion=None):
     """Per-shot predictions of every model and their statistics.
 
     Parameters
@@ -386,6 +394,10 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         The uncalibrated mapping (default :class:`~cavex.concrete.Mapping`).
     models : sequence of str, optional
         The uncalibrated models to run (labels of :data:`MODELS`; default all).
+    erosion : ErosionLaw, optional
+        Nose erosion in every model that flies the integrator
+        (:mod:`cavex.analytic.penetration.erosion`); None: rigid. Set, the result says so
+        (``erosion``: the law's name).
 
     Returns
     -------
@@ -404,11 +416,12 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
                 if model_of(model).concrete_table_seconds]
     ids = [shot.id for shot in shots]
     depths, failures = predictions(
-        shots, {k: v for k, v in columns.items() if k not in concrete}, tables, progress)
+        shots, {k: v for k, v in columns.items() if k not in concrete}, tables, progress,
+        erosion)
     flags = [None] * len(shots)
     if concrete:  # the concrete model's depths and flags, once for both models that use them
-        concrete_depths, flags, concrete_failures = concrete_predictions(shots, tables.workers,
-                                                                         progress)
+        concrete_depths, flags, concrete_failures = concrete_predictions(
+            shots, tables.workers, progress, erosion)
         for name in concrete:
             depths[name], failed = concrete_depths, concrete_failures
             if model_of(columns[name][0]).parts:
@@ -433,6 +446,8 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
               "failures": failures}
     if calibrations:
         result["held_out"] = [row["id"] for row in rows if row["id"] not in fitted]
+    if erosion is not None:
+        result["erosion"] = erosion.name
     return add_statistics(result)
 
 
@@ -445,12 +460,13 @@ def _split_depth(shot, concrete_depth):
     return None if concrete_depth is None else round_significant(concrete_depth, DEPTH_DIGITS)
 
 
-def concrete_predictions(shots, workers=None, progress=None):
+def concrete_predictions(shots, workers=None, progress=None, erosion=None):
     """The concrete model's ``(depths, flags, failures)`` for ``shots``: per shot the depth
     (rounded like every depth, None if it failed), the rigid-regime flag
     (:func:`~cavex.verification.validation.regimes.rigid_flag`, None if it failed) and
     ``{shot id: reason}``. The shots of one concrete (``f_c``, ``rho``) go to one task, so its
     cavity table is built once; tasks run on ``workers`` local processes (default: the CPUs).
+    ``erosion``: :func:`~cavex.analytic.penetration.concrete_table.table_depth`'s.
     """
     from cavex.analytic.penetration import concrete_table  # noqa: F401 (before the fork)
     from cavex.verification.fedata.runner import Progress, process_pool, show_progress
@@ -458,19 +474,19 @@ def concrete_predictions(shots, workers=None, progress=None):
     groups = {}
     for i, shot in enumerate(shots):
         groups.setdefault((shot.fc, shot.rho), []).append(i)
-    tasks = [[shots[i] for i in group] for group in groups.values()]
+    tasks = [([shots[i] for i in group], erosion) for group in groups.values()]
     workers = min(workers or os.cpu_count() or 1, len(tasks))
     bar = Progress(len(shots), 0, show_progress(progress), unit="prediction")
     results = []
     if workers > 1:
         with process_pool(workers) as pool:
-            for task, answers in zip(tasks, pool.map(concrete_group, tasks), strict=True):
+            for task, answers in zip(tasks, pool.map(_concrete_task, tasks), strict=True):
                 results.append(answers)
-                bar.update(len(task))
+                bar.update(len(task[0]))
     else:
         for task in tasks:
-            results.append(concrete_group(task))
-            bar.update(len(task))
+            results.append(_concrete_task(task))
+            bar.update(len(task[0]))
     bar.close()
     depths, flags, failures = [None] * len(shots), [None] * len(shots), {}
     for group, answers in zip(groups.values(), results, strict=True):
@@ -481,15 +497,21 @@ def concrete_predictions(shots, workers=None, progress=None):
     return depths, flags, failures
 
 
-def concrete_group(shots):
-    """``[(depth, flag, reason)]`` of the concrete model for ``shots`` (one concrete)."""
+def _concrete_task(task):
+    """:func:`concrete_group` of one task ``(shots, erosion)`` (a pool maps one argument)."""
+    return concrete_group(*task)
+
+
+def concrete_group(shots, erosion=None):
+    """``[(depth, flag, reason)]`` of the concrete model for ``shots`` (one concrete);
+    ``erosion``: :func:`~cavex.analytic.penetration.concrete_table.table_depth`'s."""
     from cavex.analytic.penetration.concrete_table import TableResistance, table_depth
 
     out = []
     for shot in shots:
         try:
             resistance = TableResistance(shot)
-            depth = round_significant(table_depth(shot, resistance), DEPTH_DIGITS)
+            depth = round_significant(table_depth(shot, resistance, erosion), DEPTH_DIGITS)
             out.append((depth, rigid_flag(shot, resistance), None))
         except (CavexInputError, CavexNumericalError) as exc:
             out.append((None, None, str(exc).splitlines()[0]))

@@ -11,6 +11,12 @@ A shot's regime follows from its inputs only (never from a measured depth):
   (:func:`cavex.verification.validation.regimes.rigid_flag`: the concrete model's mean
   nose pressure at impact at most the projectile's listed yield strength, or no yield listed).
 
+The flag is about the nose yielding (deforming), which no model here covers. Nose erosion by
+abrasion is modelled (``--erosion``, :mod:`cavex.analytic.penetration.erosion`), but its law
+(Silling and Forrestal 2007) has no velocity threshold that could replace the flag: its mass
+loss grows as ``V0^2`` from 0. So the flag is unchanged: 110 of the 286 development shots
+(49 of them above 800 m/s, 61 below; docs/erosion.md).
+
 Per regime and model: ``n``, the mean ``|ln(predicted/measured)|`` and the bias, the mean
 ``ln(predicted/measured)`` (positive: too deep), rounded like every statistic of a validation.
 """
