@@ -124,6 +124,8 @@ REGISTRY_AND_CLI = ("analytic/models/", "verification/cli.py", "verification/com
 NOT_SWITCHES = {
     ("core/concrete.py", "<module>", "concrete"): "the concrete layer's name",
     ("core/config.py", "parse_target", "concrete"): "a layer's key concrete = {fc, rho}",
+    ("analytic/penetration/erosion.py", "ErodingNose.summary", "law"):
+        "the JSON key of the erosion law's name",
     ("verification/commands/penetrate.py", "penetration_job", "law"): "the JSON key of the law",
     ("verification/commands/penetrate.py", "penetration_job", "table"): "the JSON key of --table",
     ("verification/commands/table.py", "job", "table"): "the command's result, an FE table",

@@ -15,6 +15,7 @@ class Concrete(Model):
                     "not use the mapping below")
     recommendation_reason = "uncalibrated, every constant published, none fitted to shots"
     predicts_shots = regime_figure = True
+    erodes = True
     prediction_seconds = 6.3e-3  # the integrator a shot, besides its table (docs/concrete.md)
     # one concrete's table of 33 cavity solutions: docs/concrete.md measured 15 s for the 96
     # tables of the development shots (0.16 s each)

@@ -13,6 +13,7 @@ class Derived(Model):
                     "(crater 4.5 r from the nose base)")
     help = "the derived closed form (--boundary)"
     flies = flies_3d = closed_form = predicts_shots = fits_mapping = True
+    erodes = True
     boundaries = ("quasi-static", "dynamic")  # the order of its labels
     default_boundary = "dynamic"
     debonded = True

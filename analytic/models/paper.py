@@ -10,6 +10,7 @@ class Paper(Model):
                     "(crater 4.5 r from the nose base)")
     help = "the paper's printed model"
     flies = flies_3d = closed_form = predicts_shots = fits_mapping = True
+    erodes = True
     default_boundary = "quasi-static"  # its own, and no other
     takes_epsilon = True
     compared_with_fe = True

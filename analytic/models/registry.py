@@ -118,6 +118,8 @@ class Model:
     marker_size = 7
     compressible_partner = None
     empirical_reference = regime_figure = False
+    #: its shots can be flown with nose erosion (``shot_depth(..., erosion=law)``)
+    erodes = False
 
     # --- labels and options -----------------------------------------------------------------
 

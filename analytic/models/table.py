@@ -15,6 +15,7 @@ class Table(Model):
                     "finite-strain, one FE table per distinct target")
     help = "an FE table (--table)"
     flies = flies_3d = predicts_shots = fits_mapping = True
+    erodes = True
     takes_table = True
     first_layer = "derived"
     free_surface_option = True  # its 3-D law (derived: its own; table: the FE's)

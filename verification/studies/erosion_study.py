@@ -24,7 +24,15 @@ DEFAULT_SHOTS = ROOT / "examples" / "shots_compilation_dev.csv"
 DEFAULT_OUT = ROOT / "results" / "erosion"
 FASTER_THAN = 800.0  # m/s: the shots studied (the issue's "above ~800 m/s")
 BANDS = ((800.0, 1000.0), (1000.0, 1200.0), (1200.0, 1500.0), (1500.0, math.inf))
-MODELS = ("concrete", "derived-dynamic", "derived-quasi-static", "paper")
+def _models():
+    """The labels of the models whose shots erode, but those that need FE tables."""
+    from cavex.analytic.models.registry import models
+
+    return tuple(label for model in models(erodes=True, takes_table=False)
+                 for label in model.labels())
+
+
+MODELS = _models()
 DIGITS = 6
 
 
@@ -32,6 +40,7 @@ def shot_rows(shots, models=MODELS, law=None):
     """Per shot: ``id``, ``V0_m_s``, ``measured_m``, ``{model: (rigid, eroded)}`` depths (m,
     None where a prediction failed) and the concrete model's ``mass_loss_fraction`` and
     ``crh_final`` (None without it)."""
+    from cavex.analytic.models.registry import parse_label
     from cavex.analytic.penetration.concrete_table import TableResistance, table_flight
     from cavex.analytic.penetration.erosion import SILLING_FORRESTAL
     from cavex.errors import CavexInputError, CavexNumericalError
@@ -44,7 +53,7 @@ def shot_rows(shots, models=MODELS, law=None):
                "mass_loss_fraction": None, "crh_final": None}
         for model in models:
             try:
-                if model == "concrete":
+                if parse_label(model)[0].concrete_table_seconds > 0.0:  # its summary
                     resistance = TableResistance(shot)
                     rigid = table_flight(shot, resistance)[0]
                     eroded, summary = table_flight(shot, resistance, law)
