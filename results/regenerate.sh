@@ -15,9 +15,9 @@
 # penetration runs on: it rewrote results/penetration* byte for byte (2026-11-27), yet another
 # CPU changed their velocities near the stop. tests/test_committed_results.py reruns them under
 # a model of another libm (1-ulp changes of the force); the trajectory CSVs are written
-# to the quanta number_format.TRAJECTORY_QUANTA sets from that spread. Its rows are the
-# integrator's steps: results/penetration_paper/trajectory_runway.csv changes its number of rows
-# under that model (a short phase's first step), and may still differ on another CPU.
+# to the quanta number_format.TRAJECTORY_QUANTA sets from that spread. Their rows are equally
+# spaced in time within each phase (integrator.ROWS_PER_PHASE), not the integrator's steps, whose
+# number changed under that model.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cavex penetrate --out results/penetration > results/penetration/summary.txt

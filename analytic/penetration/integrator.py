@@ -58,6 +58,9 @@ class Phase:
     end_mass: float | None = None  # kg, with erosion only (None: the rigid mass throughout)
 
 
+ROWS_PER_PHASE = 20  # intervals of an integrated phase in the written trajectory (rows)
+
+
 @dataclass(frozen=True)
 class Trajectory:
     """Time, nose depth, velocity, deceleration and phase index at every output point."""
@@ -70,12 +73,24 @@ class Trajectory:
     phases: tuple
     mass: np.ndarray | None = None  # kg at every output point, with erosion only
     erosion: dict | None = None  # :meth:`~cavex.analytic.penetration.erosion.ErodingNose.summary`
+    sampled: dict | None = None  # the rows of :meth:`rows`
 
     def as_columns(self):
         """Columns for CSV output, in SI units (``mass_kg`` with erosion only)."""
         columns = {"t_s": self.t, "depth_m": self.depth, "velocity_m_s": self.velocity,
                    "deceleration_m_s2": self.deceleration, "phase": self.phase}
         return columns if self.mass is None else {**columns, "mass_kg": self.mass}
+
+    def rows(self):
+        """The columns of the written trajectory: :data:`ROWS_PER_PHASE` equal intervals of
+        time within each integrated phase (its start and end included; the crater stages'
+        closed-form samples as they are), on the integrator's dense output with the force
+        evaluated at each row, instead of at the integrator's steps, whose places move with
+        the last bits of the force (another CPU would write other rows). With erosion: the
+        steps (:meth:`as_columns`)."""
+        if self.sampled is None or self.mass is not None:
+            return self.as_columns()
+        return dict(self.sampled)
 
 
 def crater_exit(projectile, force, depth, speed=None):
@@ -155,7 +170,7 @@ def penetrate(target, projectile, resistance, *, crater="nose-base", rtol=RTOL, 
     """
     if erosion is not None and erosion.active:
         return _eroding_penetrate(target, projectile, resistance, crater, rtol, atol, erosion)
-    columns = [[] for _ in range(5)]
+    columns = [[] for _ in range(6)]  # t, depth, velocity, deceleration, phase; rows
     phases = []
     t0, depth0, v0 = 0.0, 0.0, projectile.V0
     if crater is not None:
@@ -173,7 +188,7 @@ def _eroding_penetrate(target, projectile, resistance, crater, rtol, atol, erosi
     """:func:`penetrate` with an eroding nose: the rigid crater stage, its loss
     (:meth:`~cavex.analytic.penetration.erosion.ErodingNose.crater_loss`) applied at its end,
     then the tunnel phases of the state ``(L, V, m)`` (:func:`_tunnel`)."""
-    columns = [[] for _ in range(5)]
+    columns = [[] for _ in range(6)]  # t, depth, velocity, deceleration, phase; rows
     phases, masses = [], []
     t0, depth0, v0 = 0.0, 0.0, projectile.V0
     mass = projectile.m - erosion.lost
@@ -432,30 +447,50 @@ def _next_label(resistance, sol, t_end, label):
     return label
 
 
-def _append(columns, t, depth, velocity, deceleration, phase):
-    for column, values in zip(columns, (t, depth, velocity, deceleration,
-                                        np.full(len(t), phase)), strict=True):
-        column.append(np.asarray(values, dtype=float))
+def _append(columns, t, depth, velocity, deceleration, phase, rows=True):
+    """Append samples to the step columns ``columns[0:5]`` and (``rows``) as a block of the
+    written rows ``columns[5]``."""
+    block = [np.asarray(values, dtype=float) for values in (t, depth, velocity, deceleration,
+                                                             np.full(len(t), phase))]
+    for column, values in zip(columns[:5], block, strict=True):
+        column.append(values)
+    if rows:
+        columns[5].append(block)
 
 
 def _append_solution(columns, sol, phase_end, resistance, mass, phase, erosion=None):
-    """The phase's samples up to its end; at a stop the last velocity is exactly 0 m/s, as
-    :func:`integrate` returns it (the dense output there is round-off, ~1e-14 m/s, that differs
-    between CPUs)."""
+    """The phase's samples at the integrator's steps up to its end, and its written rows
+    (:meth:`Trajectory.rows`); at a stop the last velocity is exactly 0 m/s, as
+    :func:`integrate` returns it (the dense output there is round-off, ~1e-14 m/s, that
+    differs between CPUs)."""
     t_end = phase_end.end_time
-    t = np.append(sol.t[sol.t < t_end], t_end)
-    y = sol.sol(t)
-    if phase_end.end_reason == STOPPED:
-        y[1, -1] = 0.0
-    if erosion is None:
-        deceleration = np.array([resistance.force(depth, max(v, 0.0)) / mass
-                                 for depth, v in y.T])
-    else:
-        deceleration = np.array([erosion.forces(resistance, depth, max(v, 0.0), m)[0] / m
-                                 for depth, v, m in y.T])
-    _append(columns, t, y[0], np.maximum(y[1], 0.0), deceleration, phase)
+    for t, rows in ((np.append(sol.t[sol.t < t_end], t_end), False),
+                    (np.linspace(sol.t[0], t_end, ROWS_PER_PHASE + 1), True)):
+        t[-1] = t_end
+        y = sol.sol(t)
+        if phase_end.end_reason == STOPPED:
+            y[1, -1] = 0.0
+        depth = y[0].copy()
+        if rows:  # the force at the ends on the phase's own side of a jump in it
+            nudge = 1e-9 * abs(depth[-1] - depth[0])
+            depth[0], depth[-1] = depth[0] + nudge, depth[-1] - nudge
+        if erosion is None:
+            deceleration = np.array([resistance.force(x, max(v, 0.0)) / mass
+                                     for x, v in zip(depth, y[1], strict=True)])
+        else:
+            deceleration = np.array([erosion.forces(resistance, x, max(v, 0.0), m)[0] / m
+                                     for x, v, m in zip(depth, y[1], y[2], strict=True)])
+        if rows:
+            columns[5].append([t, y[0], np.maximum(y[1], 0.0), deceleration,
+                               np.full(len(t), float(phase))])
+        else:
+            _append(columns, t, y[0], np.maximum(y[1], 0.0), deceleration, phase, rows=False)
 
 
 def _trajectory(columns, phases):
-    t, depth, velocity, deceleration, phase = (np.concatenate(c) for c in columns)
-    return Trajectory(t, depth, velocity, deceleration, phase.astype(int), tuple(phases))
+    t, depth, velocity, deceleration, phase = (np.concatenate(c) for c in columns[:5])
+    sampled = dict(zip(("t_s", "depth_m", "velocity_m_s", "deceleration_m_s2", "phase"),
+                       (np.concatenate(c) for c in zip(*columns[5], strict=True)), strict=True))
+    sampled["phase"] = sampled["phase"].astype(int)
+    return Trajectory(t, depth, velocity, deceleration, phase.astype(int), tuple(phases),
+                      sampled=sampled)

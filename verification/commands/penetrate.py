@@ -259,7 +259,7 @@ def write_outputs(job, out_dir, draw=True):
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, trajectory in job["runs"].items():
-        written.append(write_columns_csv(out / f"trajectory_{name}.csv", trajectory.as_columns(),
+        written.append(write_columns_csv(out / f"trajectory_{name}.csv", trajectory.rows(),
                                          TRAJECTORY_QUANTA))
     rows = phases_as_dicts(job["runs"]["runway"])
     if not job["debonded"]:  # the stage column only where there is more than one tunnel

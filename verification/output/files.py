@@ -92,15 +92,19 @@ def write_text_atomic(path, text, durable=True):
 
 def write_columns_csv(path, columns, quanta=None):
     """``columns`` (name -> sequence) as CSV, atomically, every number through
-    :func:`~cavex.verification.output.number_format.format_number`, with the absolute quantum
-    ``quanta[name]`` where given; returns ``path``."""
-    from cavex.verification.output.number_format import format_number
+    :func:`~cavex.verification.output.number_format.format_number`, with the rule
+    ``quanta[name]`` where given (a ``Decimals``: the absolute quantum; an int: that many
+    significant digits); returns ``path``."""
+    from cavex.verification.output.number_format import TRAJECTORY_DIGITS, Decimals, format_number
 
     text = io.StringIO(newline="")
     writer = csv.writer(text)
     writer.writerow(columns)
-    column_quanta = [(quanta or {}).get(name) for name in columns]
-    writer.writerows([format_number(x, quantum=q) for x, q in zip(row, column_quanta, strict=True)]
+    rules = [(quanta or {}).get(name) for name in columns]
+    rules = [(q, TRAJECTORY_DIGITS) if isinstance(q, Decimals) or q is None else (None, q)
+             for q in rules]
+    writer.writerows([format_number(x, digits, quantum) for x, (quantum, digits)
+                      in zip(row, rules, strict=True)]
                      for row in zip(*columns.values(), strict=True))
     write_text_atomic(path, text.getvalue())
     return path

@@ -42,16 +42,21 @@ justification each:
 - other relative differences against FE (``relative_difference_*``): 6, the FE's digits.
 - any other float variable: 6 (unknown provenance, treated as FE output).
 
-Trajectory CSVs of ``cavex penetrate`` (:data:`TRAJECTORY_QUANTA`): a row sits at a step of the
-integrator, and where that step lands is not reproducible: a 1-ulp change of the force (a model of
+Trajectory CSVs of ``cavex penetrate`` (:data:`TRAJECTORY_QUANTA`): the rows of a phase are
+equally spaced in time from its start to its end (the same number whatever the integrator's steps,
+which used to be the rows and moved with the last bits of the force), but the phase's end is an
+event whose time is not reproducible to the last digits: a 1-ulp change of the force (a model of
 another CPU's libm: each force evaluation times ``1 + k eps``, ``k`` in -1, 0, +1 by a hash of its
-arguments, 16 seeds; tests/test_committed_results.py) moves the steps near the stop by up to
+arguments, 16 seeds; tests/test_committed_results.py) moved the steps near the stop by up to
 5.8e-9 s (1.6e-6 relative) and so the velocity there by ``a dt``, up to 9.3e-4 m/s (at
 0.95 m/s: 1e-3 relative, the 0.952771 against 0.95264 m/s that another CPU wrote). Such a
 column is written to the coarser of :data:`TRAJECTORY_DIGITS` significant digits and an absolute
 quantum that is 10 or more of those spreads wide: ``t_s`` 1e-7 s (17 spreads), ``velocity_m_s``
-1e-2 m/s (10 spreads; 1e-3 m/s changed 10 values in the 16 seeds, 1e-2 none). Depth and
-deceleration keep 6 digits (spreads 5e-8 m, 4e-8 relative: none changed).
+1e-2 m/s (10 spreads; 1e-3 m/s changed 10 values in the 16 seeds, 1e-2 none). Depth keeps 6
+digits (spread 5e-8 m: none changed). The deceleration of a row at a fixed time within a phase
+moves with the phase's start time: by up to 2.3e-6 relative (the paper model's runway, 7 values
+in the 16 seeds at 6 digits), so it is written to 5 significant digits (a quantum of 1e-5 to
+1e-4 relative, 4 to 40 spreads; none changed).
 
 Coordinates (velocity, depth) are inputs, not results, and are never rounded (the switch nodes
 sit 1e-9 m past the switch depths); integer, boolean and string variables are written as they
@@ -89,9 +94,9 @@ class Decimals(int):
 
 ESTIMATE = Decimals(ESTIMATE_DECIMALS)
 
-# Absolute quanta of ``cavex penetrate``'s trajectory columns (module docstring): each such value
-# is written to the coarser of TRAJECTORY_DIGITS significant digits and this quantum.
-TRAJECTORY_QUANTA = {"t_s": Decimals(7), "velocity_m_s": Decimals(2)}
+# Rules of ``cavex penetrate``'s trajectory columns (module docstring): a Decimals is an absolute
+# quantum (the coarser of it and TRAJECTORY_DIGITS significant digits), an int significant digits.
+TRAJECTORY_QUANTA = {"t_s": Decimals(7), "velocity_m_s": Decimals(2), "deceleration_m_s2": 5}
 
 # (variable-name pattern, significant digits, Decimals or KEPT); the first matching pattern
 # decides.
