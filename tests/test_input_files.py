@@ -52,8 +52,9 @@ def config_faults(text):
                    f"line {line_of(text, 'E = 25e9')}, column 8 is not valid TOML (Expected "
                    "newline or end of document after a statement)"),
         "unknown key": (text.replace("tau = 6e6", "tau = 6e6\ncolour = 1"),
-                        "layers[2].colour is not a known key (accepted: E, bottom, lam, law_A, "
-                        "law_B, name, nu, rho, scab_depth, sigma_c, tau, tau_max, "
+                        "layers[2].colour is not a known key (accepted: E, bottom, "
+                        "crush_pressure, lam, law_A, law_B, lock_pressure, lock_strain, "
+                        "locked_modulus, name, nu, rho, scab_depth, sigma_c, tau, tau_max, "
                         "tensile_strength, thickness, tunnel_wall)"),
         "missing key": (text.replace("lam = 0.50\n", ""), "layers[2].lam is missing (required)"),
         "wrong type": (text.replace("E = 25e9", 'E = "x"'),
