@@ -93,8 +93,9 @@ STRUCTURES = {ELASTIC_PLASTIC: "elastic-comminuted", CRACKED: "elastic-cracked-c
 DEFAULT_STEPS = 256  # RK4 steps across the comminuted zone (see the convergence test)
 # columns of the parameter vector of the compiled functions
 (E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, LOCKED, TENSILE, W, WB, PHI, POWER_B, POWER_N,
- CRUSH, P_LOCK, E_LOCK, S_CAP, S_CRUSH, S_LOCK) = range(20)
-NPAR = 20  # S_CAP, S_CRUSH, S_LOCK: the kinks (kink_stresses), computed once per vector
+ CRUSH, P_LOCK, E_LOCK, OPEN, S_CAP, S_OPEN, S_CRUSH, S_LOCK) = range(22)
+NPAR = 22  # S_CAP ... S_LOCK: the kinks (kink_stresses), computed once per vector; OPEN: the
+# crack opening the comminuted material carries (set_opening, per front tried)
 
 
 @dataclass(frozen=True)
@@ -232,7 +233,7 @@ class ConcreteCavity:
         p[W], p[WB], p[PHI] = w, wb, phi
         p[POWER_B], p[POWER_N] = self.power_B, self.power_N
         p[CRUSH], p[P_LOCK], p[E_LOCK] = self.crush, self.lock_pressure, self.lock_strain
-        p[S_CAP], p[S_CRUSH], p[S_LOCK] = kink_stresses(p)
+        set_opening(p, 0.0)
         return p
 
 
@@ -393,21 +394,43 @@ def lock_pressure(p):
 
 
 @njit(cache=True, error_model="numpy")
+def set_opening(p, opening):
+    """Set the crack opening ``theta_o >= 0`` (plastic volumetric strain of the tension
+    cut-off) that the comminuted material carries from the cracked zone, and the kinks
+    (:func:`kink_stresses`) that move with it."""
+    p[OPEN] = max(opening, 0.0)
+    p[S_CAP], p[S_OPEN], p[S_CRUSH], p[S_LOCK] = kink_stresses(p)
+
+
+@njit(cache=True, error_model="numpy")
 def crush_pressure(p):
-    """Cauchy pressure at which the compaction hydrostat crushes, ``P_c exp(P_c/K)`` (inf
-    without it)."""
+    """Cauchy pressure at which the compaction hydrostat crushes on its loading curve,
+    ``P_c exp(P_c/K)`` (inf without it)."""
     if math.isnan(p[CRUSH]):
         return np.inf
     return p[CRUSH] * math.exp(p[CRUSH] / p[BULK])
 
 
 @njit(cache=True, error_model="numpy")
+def opening_pressure(p):
+    """Cauchy pressure at which the crack opening ``theta_o`` starts closing at the crush
+    pressure, ``P_c exp(P_c/K - theta_o)`` (inf without the compaction hydrostat)."""
+    if math.isnan(p[CRUSH]):
+        return np.inf
+    return p[CRUSH] * math.exp(p[CRUSH] / p[BULK] - p[OPEN])
+
+
+@njit(cache=True, error_model="numpy")
 def compaction_piece(p, branch):
     """``(a, b)`` of the compaction hydrostat's piece ``P = a + b e`` at the Cauchy pressure
-    ``branch``: elastic, compaction or locked."""
+    ``branch``: elastic with the crack opening ``theta_o`` (``P = K (e + theta_o)``), the
+    opening closing at the crush pressure (``P = P_c``), compaction, or locked (the FE's
+    :func:`cavex.fem.constitutive.hydrostat` on loading from ``theta_p = theta_o``)."""
     K, P_c, P_l, e_l = p[BULK], p[CRUSH], p[P_LOCK], p[E_LOCK]
+    if branch < opening_pressure(p):
+        return K * p[OPEN], K
     if branch < crush_pressure(p):
-        return 0.0, K
+        return P_c, 0.0
     if branch < lock_pressure(p):
         e_0 = P_c / K
         slope = (P_l - P_c) / (e_l - e_0)
@@ -480,7 +503,8 @@ def _rk4(p, t, s, U, h, floor=-np.inf, ceiling=np.inf):
 def kink_stresses(p):
     """Radial stresses of the comminuted zone's kinks: where the strength below the cap
     (``tau_0 + lam p`` or ``B p^N``) reaches ``tau_max``, where the compaction hydrostat
-    crushes and where the hydrostat locks (inf: none)."""
+    crushes (where the crack opening starts closing and where it has closed) and where the
+    hydrostat locks (inf: none)."""
     lam, cap = p[LAM], p[TAU_MAX]
     s_cap = np.inf
     if math.isfinite(cap):
@@ -488,7 +512,8 @@ def kink_stresses(p):
             s_cap = (cap / p[POWER_B]) ** (1.0 / p[POWER_N]) + 2.0 * cap / 3.0
         elif lam > 0.0:
             s_cap = (cap - p[TAU0]) / lam + 2.0 * cap / 3.0
-    return s_cap, _radial_stress(p, crush_pressure(p)), _radial_stress(p, lock_pressure(p))
+    return (s_cap, _radial_stress(p, opening_pressure(p)), _radial_stress(p, crush_pressure(p)),
+            _radial_stress(p, lock_pressure(p)))
 
 
 @njit(cache=True, error_model="numpy")
@@ -549,7 +574,7 @@ def integrate(p, beta, s, U, steps):
     t0 = math.log(beta)
     h = -t0 / steps
     t = t0
-    kinks = (p[S_CAP], p[S_CRUSH], p[S_LOCK])
+    kinks = (p[S_CAP], p[S_OPEN], p[S_CRUSH], p[S_LOCK])
     ordered = np.sort(np.array(kinks))
     shocks = 0
     for k in range(steps):
@@ -662,9 +687,11 @@ def jump(p, beta, s_ahead, U_ahead, R_ahead, strong=False):
 
 
 @njit(cache=True, error_model="numpy")
-def wall_residual(p, beta, s_ahead, U_ahead, R_ahead, steps):
+def wall_residual(p, beta, s_ahead, U_ahead, R_ahead, steps, opening=0.0):
     """``(U(1) - 1, s(1))``: the front at ``beta`` with the state ahead, then the comminuted
-    zone to the wall (:func:`jump`, :func:`integrate`)."""
+    zone to the wall (:func:`jump`, :func:`integrate`); the comminuted material carries the
+    crack opening ``opening`` (:func:`set_opening`)."""
+    set_opening(p, opening)
     s0, U0 = jump(p, beta, s_ahead, U_ahead, R_ahead)
     s1, U1 = integrate(p, beta, s0, U0, steps)
     return U1 - 1.0, s1
@@ -745,8 +772,19 @@ def cracked(p, gamma, steps):
     beta, s_a, U_a, ev_a, C = cracked_front(p, gamma)
     if not beta > 1.0:
         return np.nan, np.nan, beta, C
-    residual, S = wall_residual(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a), steps)
+    residual, S = wall_residual(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a), steps,
+                                crack_opening(p, s_a, ev_a))
     return residual, S, beta, C
+
+
+@njit(cache=True, error_model="numpy")
+def crack_opening(p, s, eps_v):
+    """The crack opening (plastic volumetric strain, tension positive) of cracked material at
+    radial stress ``s`` and volumetric strain ``eps_v``: ``eps_v`` less the elastic part
+    ``(1 - 2 nu)(2t - s)/e`` (hoop stress ``-t``)."""
+    e, t = p[E_], p[TENSILE]
+    nu = 0.5 * e / p[MU] - 1.0
+    return eps_v - (1.0 - 2.0 * nu) * (2.0 * t - s) / e
 
 
 # ------------------------------------------------------------------------------------------

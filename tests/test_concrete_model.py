@@ -17,7 +17,7 @@ from cavex.analytic.penetration.concrete_table import (
     model_depth,
     table_depth,
 )
-from cavex.concrete import tensile_strength
+from cavex.concrete import Concrete, aci_modulus, tensile_strength
 from cavex.verification.studies import concrete_validation as study
 from cavex.verification.validation.regimes import rigid_flag
 from cavex.verification.validation.shots import read_shots, shot_projectile
@@ -105,9 +105,19 @@ def test_material_from_correlations():
     material = concrete_cavity(40e6, 2300.0)
     assert material.lam == pytest.approx(3.0 * 3.1 / 6.1)
     assert material.tau_max == 7.0
-    assert material.eta_lock == pytest.approx(0.1 / 1.1)
-    assert material.bulk * 40e6 == pytest.approx(0.8e9 / (0.1 / 1.1))
+    # HJC's hydrostat in the FE's measures: crush at f_c/3, the lock point (mu_l, p_l) =
+    # (0.1, 0.8 GPa) as (ln 1.1, 0.8 GPa/1.1), the locked slope (K_1 - p_l)/1.1
+    E = aci_modulus(40e6, 2300.0)
+    assert material.eta_lock == 0.0 and material.compacts
+    assert material.bulk * 40e6 == pytest.approx(E / (3.0 * (1.0 - 2.0 * 0.2)))
+    assert material.crush == pytest.approx(1.0 / 3.0)
+    assert material.lock_pressure * 40e6 == pytest.approx(0.8e9 / 1.1)
+    assert material.lock_strain == pytest.approx(math.log(1.1))
+    assert material.bulk_locked * 40e6 == pytest.approx((85e9 - 0.8e9) / 1.1)
     assert material.tensile * 40e6 == pytest.approx(tensile_strength(40e6))
+    layer = Concrete(40e6, 2300.0).fe_layer()
+    assert (layer.crush_pressure / 40e6, layer.lock_strain) == (material.crush,
+                                                               material.lock_strain)
 
 
 def test_table_resistance_is_the_nose_quadrature(shots):
