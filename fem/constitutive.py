@@ -29,6 +29,35 @@ Kirchhoff stress with the intercepts scaled by ``J``. With ``s = sign(Q)``:
   ``|sigma_r - sigma_theta| <= min(lam sigma + tau, tau_max)``; ``tau_max = inf`` (the default)
   is no cap.
 
+Compaction (a layer's hydrostat, :data:`cavex.materials.HYDROSTAT`; Holmquist, Johnson and
+Cook 1993, "HJC", in the kernel's measures): with the log volumetric strain ``e = -theta``
+(compression positive) the Kirchhoff pressure on loading is the piecewise-linear curve
+
+.. math:: H(e) = K e \ (e \le e_0 = P_c/K), \qquad
+          P_c + K_c (e - e_0) \ (e_0 \le e \le e_l), \qquad
+          P_l + K_l (e - e_l) \ (e \ge e_l),
+
+``K_c = (P_l - P_c)/(e_l - e_0) < K``: elastic to the crush pressure ``P_c``, compaction to the
+lock point ``(e_l, P_l)``, then locked (``K_l``); continuous at the crush and lock points.
+Compaction is irreversible, written as volumetric plasticity whose hardening variable is the
+plastic volumetric strain ``theta_p`` (the cap models' rule): ``e_c = -theta_p`` is the net
+compaction, the elastic strain ``x = e - e_c = theta_p - theta`` gives ``P = K x``, and the crush
+surface ``P <= P_c + h max(e_c, 0)``, ``h = K K_c/(K - K_c)``, is the loading curve seen from
+the elastic line (a point unloaded from ``H(e_max)`` unloads and reloads elastically with ``K``
+and crushes again on ``H`` at ``e_max``). Return (:func:`hydrostat`), for ``P_tr = K x_tr > `` the
+crush surface: a crack opening ``theta_p > 0`` (left by the tension cut-off) first closes at the
+crush pressure (``P = P_c``, tangent 0, while ``P_tr - K theta_p <= P_c``: on loading ``P =
+H(e)`` again once it is closed, whatever the opening was); then ``dl = theta_p^+ + (P_tr - K
+theta_p^+ - P_c - h max(e_c, 0))/(K + h)``, ``theta_p -= dl``, ``P = P_tr - K dl = H(e)``
+(tangent ``K_c``); past full compaction ``e_c^l = e_l - P_l/K`` the point is locked: ``theta_p =
+-e_c^l`` and ``P = P_l + K_l (x - P_l/K)`` for ``x > P_l/K`` (tangent ``K_l``), elastic ``K x``
+below (the locked branch is reversible). The deviatoric returns below then act at the
+hydrostat's pressure and tangent (``P_tr``, ``K`` replaced by ``K_t``): exact where no volume
+flows plastically through them (dilatancy 0 and the cut-off inactive: every point of the
+cavity's comminuted zone); where the cut-off or dilatancy moves ``theta_p`` the volumetric
+correction runs along that piece's modulus (an operator split). Without a hydrostat (``crush
+= inf``) the pressure is ``-K (theta - theta_p)``, the same arithmetic as before.
+
 Flow: Mohr-Coulomb is non-associated with plastic potential ``g = c_s(psi)|Q| - lam_psi P``
 (``lam_psi = 6 sin psi / (3 - sin psi)`` from the dilatancy angle ``psi``; zero by default, i.e.
 volume-preserving plastic strain); the cut-off is associated (Rankine). With multipliers
@@ -55,8 +84,10 @@ from its trial state by the three-surface return :func:`_capped_point` (the acti
 surface or a corner of two, the first of MC, cap, TC, MC+cap, MC+TC, cap+TC with positive
 multipliers that violates no other surface; the same closed-form solve and tangent). Without a
 cap (``inf``) those tests are false and every point takes the code path above, bit for bit.
-An independent numpy implementation of the same equations is kept in ``tests/oracles.py`` and
-compared with this kernel point by point (``tests/test_fem_kernels.py``).
+An independent numpy implementation of the same equations (the hydrostat written from its
+loading curve in the total strain) is kept in ``tests/oracles.py`` and compared with this
+kernel point by point (``tests/test_fem_kernels.py``, which also drives a point along
+hydrostatic and uniaxial-strain paths against the exact hydrostat).
 """
 
 
