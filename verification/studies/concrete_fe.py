@@ -20,14 +20,18 @@ Per cell (``f_c`` in :data:`STRENGTHS` x ``V`` in :data:`VELOCITIES`): the close
 
 - ``estimate``: the FE's own error estimate (:func:`cavex.fem.estimate.richardson_error`, the
   finest run against its companion at half the resolution, second order assumed);
-- ``spread``: the measured spread of the series, ``max |S_k/S_finest - 1|`` over the two
-  coarser levels ``k = finest/2, finest/4``. Where the wall stress converges unevenly (the
-  compaction shock, the fronts crossing elements) the Richardson estimate can be smaller than
-  the change between levels; the spread is not an assumption about the order.
+- ``spread``: the measured spread of the series, ``max |S_k/S_finest - 1|`` over every coarser
+  level. The wall stress converges unevenly at speed (the compaction shock, the fronts crossing
+  elements, the start from the seed cavity: the levels move by up to 1.7 % at 20 MPa, 1200 m/s),
+  where the Richardson estimate, which assumes second order, is far smaller than the change
+  between levels; the spread assumes no order.
 
-The bound of a cell is the larger of the two; ``ratio_to_bound = |difference| / bound`` is at
-most 1 where the FE agrees with the closed form within what its refinement resolves
-(tests/test_concrete_model.py asserts every committed cell, and recomputes some).
+The bound of a cell is the larger of the two plus ``f_c/E``, the closed form's own modelling
+term (its elastic and cracked zones are small-strain, the FE's Hencky: docs/fem.md, measured
+linear in ``f_c/E`` in tests/test_fem_concrete.py); ``ratio_to_bound = |difference| / bound``
+is at most 1 where the FE agrees with the closed form within what its refinement resolves
+(tests/test_concrete_model.py asserts every committed cell, and recomputes two). The table
+also counts the cells within the FE's part alone.
 """
 
 import argparse
@@ -57,7 +61,7 @@ RHO = 2300.0
 RADIUS = 0.01
 DIGITS = 6
 COLUMNS = ("fc_Pa", "V_m_s", "structure", "S_closed", "S_fe", "difference", "estimate",
-           "spread", "ratio_to_bound") + tuple(f"S_fe_{k}" for k in LEVELS)
+           "spread", "fc_over_E", "bound", "ratio_to_bound") + tuple(f"S_fe_{k}" for k in LEVELS)
 
 
 def fe_stress(fc, velocity, level):
@@ -74,12 +78,19 @@ def cell(fc, velocity):
     closed = solve(ConcreteCavity(**Concrete(fc, RHO).cavity_parameters()),
                    RHO * velocity ** 2 / fc)
     series = [fe_stress(fc, velocity, k) for k in LEVELS]
+    return cell_row(fc, velocity, closed.name, closed.S, series)
+
+
+def cell_row(fc, velocity, structure, S_closed, series):
+    """The row of a cell from the closed form's ``S`` and the FE's series (one per level)."""
     finest = series[-1]
-    row = {"fc_Pa": fc, "V_m_s": velocity, "structure": closed.name, "S_closed": closed.S,
-           "S_fe": finest, "difference": finest / closed.S - 1.0,
+    row = {"fc_Pa": fc, "V_m_s": velocity, "structure": structure, "S_closed": S_closed,
+           "S_fe": finest, "difference": finest / S_closed - 1.0,
            "estimate": richardson_error(finest, series[-2]),
-           "spread": max(abs(s / finest - 1.0) for s in series[-3:-1])}
-    row["ratio_to_bound"] = abs(row["difference"]) / max(row["estimate"], row["spread"])
+           "spread": max(abs(s / finest - 1.0) for s in series[:-1]),
+           "fc_over_E": fc / Concrete(fc, RHO).fe_layer().E}
+    row["bound"] = max(row["estimate"], row["spread"]) + row["fc_over_E"]
+    row["ratio_to_bound"] = abs(row["difference"]) / row["bound"]
     row.update({f"S_fe_{k}": s for k, s in zip(LEVELS, series, strict=True)})
     return row
 
@@ -114,9 +125,13 @@ def report_md(rows):
              "tension cut-off f_t, HJC's compaction hydrostat) at rho = 2300 kg/m^3, the FE at "
              f"{LEVELS[-1]} times the default resolution. Per cell: FE / closed form - 1, then "
              "(the FE's Richardson estimate / the spread of the refinement series); `*` where "
-             "|difference| exceeds the larger of the two.", "",
+             "|difference| exceeds the bound, the larger of the two plus f_c/E (the closed "
+             "form's small-strain term).", "",
              f"Cells: {len(rows)}; within the bound: "
-             f"{sum(r['ratio_to_bound'] <= 1.0 for r in rows)}; largest |difference| "
+             f"{sum(r['ratio_to_bound'] <= 1.0 for r in rows)}; within the FE's part alone "
+             "(without f_c/E): "
+             f"{sum(abs(r['difference']) <= max(r['estimate'], r['spread']) for r in rows)}; "
+             "largest |difference| "
              f"{abs(worst['difference']):.2e} ({worst['fc_Pa'] / 1e6:g} MPa, "
              f"{worst['V_m_s']:g} m/s).", "",
              "| f_c (MPa) | " + " | ".join(f"{v:g} m/s" for v in VELOCITIES) + " |",
