@@ -443,7 +443,10 @@ def compaction_strain(a, b, pressure):
     """The log volumetric strain ``e`` with ``exp(e) (a + b e) = pressure`` (Cauchy: the
     Kirchhoff ``a + b e`` times ``R = exp(e)``), by Newton from ``e = (p - a)/(a + b)`` (the
     root of its linearisation ``(1 + e)(a + b e)``, to the right of the root: the left side is
-    increasing and convex there, so the iterates fall to it monotonically)."""
+    increasing and convex there, so the iterates fall to it monotonically); on the closing
+    piece (``b = 0``) the root ``ln(p/a)``."""
+    if b == 0.0:
+        return math.log(pressure / a)
     e = (pressure - a) / (a + b)
     for _ in range(60):
         R = math.exp(e)
