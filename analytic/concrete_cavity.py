@@ -93,8 +93,9 @@ STRUCTURES = {ELASTIC_PLASTIC: "elastic-comminuted", CRACKED: "elastic-cracked-c
 DEFAULT_STEPS = 256  # RK4 steps across the comminuted zone (see the convergence test)
 # columns of the parameter vector of the compiled functions
 (E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, LOCKED, TENSILE, W, WB, PHI, POWER_B, POWER_N,
- S_CAP, S_LOCK) = range(16)
-NPAR = 16  # S_CAP, S_LOCK: the kinks (kink_stresses), computed once per parameter vector
+ CRUSH, P_LOCK, E_LOCK, OPEN, S_CAP, S_OPEN, S_CRUSH, S_LOCK) = range(22)
+NPAR = 22  # S_CAP ... S_LOCK: the kinks (kink_stresses), computed once per vector; OPEN: the
+# crack opening the comminuted material carries (set_opening, per front tried)
 
 
 @dataclass(frozen=True)
@@ -120,6 +121,14 @@ class ConcreteCavity:
         Modulus ``K_l / f_c`` past the locking strain (> 0; ``inf``: rigid).
     tensile : float
         Tensile strength ``f_t / f_c`` (> 0; ``inf``: no cracking).
+    crush, lock_pressure, lock_strain : float
+        The compaction hydrostat of the FE (:func:`cavex.fem.constitutive.hydrostat`,
+        Holmquist, Johnson and Cook's form; docs/concrete.md "Hydrostat"), given all three:
+        in the log volumetric strain ``e = ln R`` and the Kirchhoff pressure ``P = p/R``,
+        elastic ``P = K e`` (``K`` = :attr:`bulk`, the elastic bulk modulus) up to ``crush``
+        (``P_c/f_c > 0``), linear to ``lock_pressure`` (``P_l/f_c``) at ``lock_strain``
+        (``e_l``), then ``P_l + K_l (e - e_l)`` (``K_l`` = :attr:`bulk_locked`). Default
+        ``nan``: the hydrostat in ``eta`` above (``bulk`` the compaction modulus).
     power_B, power_N : float
         The comminuted (fully damaged) strength as a power law of the pressure,
         ``D = min(B p^N, tau_max)`` (Holmquist, Johnson and Cook 1993: ``B = 1.6``,
@@ -138,12 +147,23 @@ class ConcreteCavity:
     tensile: float = math.inf
     power_B: float = math.nan
     power_N: float = 1.0
+    crush: float = math.nan
+    lock_pressure: float = math.nan
+    lock_strain: float = math.nan
 
     def __repr__(self):
-        """The fields, the power law's only when it is used (no ``nan`` in a message)."""
+        """The fields, the power law's and the compaction hydrostat's only when they are used
+        (no ``nan`` in a message)."""
         names = [f.name for f in fields(self)
-                 if self.power_law or f.name not in ("power_B", "power_N")]
+                 if (self.power_law or f.name not in ("power_B", "power_N"))
+                 and (self.compacts or f.name not in HYDROSTAT)]
         return f"ConcreteCavity({', '.join(f'{n}={getattr(self, n)!r}' for n in names)})"
+
+    @property
+    def compacts(self):
+        """True when the comminuted hydrostat is the FE's compaction hydrostat (:attr:`crush`
+        given)."""
+        return not math.isnan(self.crush)
 
     @property
     def power_law(self):
@@ -168,6 +188,28 @@ class ConcreteCavity:
                     "a finite number > 0 (nan: the straight line)", self.power_B)
             require(is_finite_number(self.power_N) and 0.0 < self.power_N <= 1.0, "power_N",
                     "in (0, 1]", self.power_N)
+        if any(not math.isnan(getattr(self, name)) for name in HYDROSTAT):
+            self._check_hydrostat()
+
+    def _check_hydrostat(self):
+        """The compaction hydrostat: all three given, the elastic ``bulk`` and ``bulk_locked``
+        finite, ``eta_lock`` 0 (unused), each in the range of :class:`cavex.materials.Material`."""
+        for name in HYDROSTAT:
+            require(is_finite_number(getattr(self, name)), name, "a finite number (the "
+                    "hydrostat: crush, lock_pressure, lock_strain all given)", getattr(self, name))
+        require(math.isfinite(self.bulk) and self.bulk > 0.0, "bulk",
+                "the elastic K/f_c, finite and > 0, with the compaction hydrostat", self.bulk)
+        require(math.isfinite(self.bulk_locked), "bulk_locked",
+                "finite with the compaction hydrostat", self.bulk_locked)
+        require(self.eta_lock == 0.0, "eta_lock", "0 with the compaction hydrostat",
+                self.eta_lock)
+        require(self.crush > 0.0, "crush", "P_c/f_c > 0", self.crush)
+        require(self.lock_pressure > self.crush, "lock_pressure", f"> crush = {self.crush:g}",
+                self.lock_pressure)
+        least = self.lock_pressure / self.bulk
+        require(least < self.lock_strain < 1.0, "lock_strain",
+                f"in ({least:.6g}, 1) (compaction softer than the bulk modulus)",
+                self.lock_strain)
 
     @property
     def shear(self):
@@ -190,8 +232,13 @@ class ConcreteCavity:
         p[ETA], p[LOCKED], p[TENSILE] = self.eta_lock, self.bulk_locked, self.tensile
         p[W], p[WB], p[PHI] = w, wb, phi
         p[POWER_B], p[POWER_N] = self.power_B, self.power_N
-        p[S_CAP], p[S_LOCK] = kink_stresses(p)
+        p[CRUSH], p[P_LOCK], p[E_LOCK] = self.crush, self.lock_pressure, self.lock_strain
+        set_opening(p, 0.0)
         return p
+
+
+#: The compaction hydrostat's fields of :class:`ConcreteCavity` (all or none).
+HYDROSTAT = ("crush", "lock_pressure", "lock_strain")
 
 
 @dataclass(frozen=True)
@@ -339,14 +386,89 @@ def constitutive(p, s, branch=np.nan):
 
 @njit(cache=True, error_model="numpy")
 def lock_pressure(p):
-    """Pressure ``K eta_l`` at which the hydrostat locks (0 without compaction)."""
+    """Cauchy pressure at which the hydrostat locks (0 without compaction): ``K eta_l``, or
+    ``P_l exp(e_l)`` for the compaction hydrostat."""
+    if not math.isnan(p[CRUSH]):
+        return p[P_LOCK] * math.exp(p[E_LOCK])
     return p[BULK] * p[ETA] if p[ETA] > 0.0 else 0.0
 
 
 @njit(cache=True, error_model="numpy")
+def set_opening(p, opening):
+    """Set the crack opening ``theta_o >= 0`` (plastic volumetric strain of the tension
+    cut-off) that the comminuted material carries from the cracked zone, and the kinks
+    (:func:`kink_stresses`) that move with it."""
+    p[OPEN] = max(opening, 0.0)
+    p[S_CAP], p[S_OPEN], p[S_CRUSH], p[S_LOCK] = kink_stresses(p)
+
+
+@njit(cache=True, error_model="numpy")
+def crush_pressure(p):
+    """Cauchy pressure at which the compaction hydrostat crushes on its loading curve,
+    ``P_c exp(P_c/K)`` (inf without it)."""
+    if math.isnan(p[CRUSH]):
+        return np.inf
+    return p[CRUSH] * math.exp(p[CRUSH] / p[BULK])
+
+
+@njit(cache=True, error_model="numpy")
+def opening_pressure(p):
+    """Cauchy pressure at which the crack opening ``theta_o`` starts closing at the crush
+    pressure, ``P_c exp(P_c/K - theta_o)`` (inf without the compaction hydrostat)."""
+    if math.isnan(p[CRUSH]):
+        return np.inf
+    return p[CRUSH] * math.exp(p[CRUSH] / p[BULK] - p[OPEN])
+
+
+@njit(cache=True, error_model="numpy")
+def compaction_piece(p, branch):
+    """``(a, b)`` of the compaction hydrostat's piece ``P = a + b e`` at the Cauchy pressure
+    ``branch``: elastic with the crack opening ``theta_o`` (``P = K (e + theta_o)``), the
+    opening closing at the crush pressure (``P = P_c``), compaction, or locked (the FE's
+    :func:`cavex.fem.constitutive.hydrostat` on loading from ``theta_p = theta_o``)."""
+    K, P_c, P_l, e_l = p[BULK], p[CRUSH], p[P_LOCK], p[E_LOCK]
+    if branch < opening_pressure(p):
+        return K * p[OPEN], K
+    if branch < crush_pressure(p):
+        return P_c, 0.0
+    if branch < lock_pressure(p):
+        e_0 = P_c / K
+        slope = (P_l - P_c) / (e_l - e_0)
+        return P_c - slope * e_0, slope
+    return P_l - p[LOCKED] * e_l, p[LOCKED]
+
+
+@njit(cache=True, error_model="numpy")
+def compaction_strain(a, b, pressure):
+    """The log volumetric strain ``e`` with ``exp(e) (a + b e) = pressure`` (Cauchy: the
+    Kirchhoff ``a + b e`` times ``R = exp(e)``), by Newton from ``e = (p - a)/(a + b)`` (the
+    root of its linearisation ``(1 + e)(a + b e)``, to the right of the root: the left side is
+    increasing and convex there, so the iterates fall to it monotonically); on the closing
+    piece (``b = 0``) the root ``ln(p/a)``."""
+    if b == 0.0:
+        return math.log(pressure / a)
+    e = (pressure - a) / (a + b)
+    for _ in range(60):
+        R = math.exp(e)
+        g = R * (a + b * e) - pressure
+        step = g / (R * (a + b + b * e))
+        e -= step
+        if abs(step) <= 1e-16 * (1.0 + abs(e)):
+            break
+    return e
+
+
+@njit(cache=True, error_model="numpy")
 def hydrostat(p, pressure, branch):
-    """``(eta, d eta/dp)``: linear to the locking strain, then the locked modulus (the piece
-    chosen at the pressure ``branch``)."""
+    """``(eta, d eta/dp)`` at the Cauchy ``pressure`` (the piece chosen at the pressure
+    ``branch``): linear to the locking strain, then the locked modulus; or the compaction
+    hydrostat (``crush`` given): ``e`` from :func:`compaction_strain`, ``eta = 1 - exp(-e)``,
+    ``d eta/dp = exp(-2e)/(P + dP/de)``."""
+    if not math.isnan(p[CRUSH]):
+        a, b = compaction_piece(p, branch)
+        e = compaction_strain(a, b, pressure)
+        inverse_R = math.exp(-e)
+        return 1.0 - inverse_R, inverse_R * inverse_R / (a + b * e + b)
     p_lock = lock_pressure(p)
     if branch < p_lock:
         return pressure / p[BULK], 1.0 / p[BULK]
@@ -383,8 +505,9 @@ def _rk4(p, t, s, U, h, floor=-np.inf, ceiling=np.inf):
 @njit(cache=True, error_model="numpy")
 def kink_stresses(p):
     """Radial stresses of the comminuted zone's kinks: where the strength below the cap
-    (``tau_0 + lam p`` or ``B p^N``) reaches ``tau_max`` and where the hydrostat locks (inf:
-    none)."""
+    (``tau_0 + lam p`` or ``B p^N``) reaches ``tau_max``, where the compaction hydrostat
+    crushes (where the crack opening starts closing and where it has closed) and where the
+    hydrostat locks (inf: none)."""
     lam, cap = p[LAM], p[TAU_MAX]
     s_cap = np.inf
     if math.isfinite(cap):
@@ -392,15 +515,21 @@ def kink_stresses(p):
             s_cap = (cap / p[POWER_B]) ** (1.0 / p[POWER_N]) + 2.0 * cap / 3.0
         elif lam > 0.0:
             s_cap = (cap - p[TAU0]) / lam + 2.0 * cap / 3.0
-    p_lock = lock_pressure(p)
-    s_lock = np.inf
-    if p_lock > 0.0 and math.isfinite(p_lock):
-        if math.isnan(p[POWER_B]):
-            below = p[TAU0] + lam * p_lock
-        else:
-            below = p[POWER_B] * p_lock ** p[POWER_N]
-        s_lock = p_lock + 2.0 * min(below, cap) / 3.0
-    return s_cap, s_lock
+    return (s_cap, _radial_stress(p, opening_pressure(p)), _radial_stress(p, crush_pressure(p)),
+            _radial_stress(p, lock_pressure(p)))
+
+
+@njit(cache=True, error_model="numpy")
+def _radial_stress(p, pressure):
+    """The comminuted zone's radial stress ``p + 2D/3`` at the pressure ``pressure`` (inf when
+    it is 0 or inf: no kink)."""
+    if not (pressure > 0.0 and math.isfinite(pressure)):
+        return np.inf
+    if math.isnan(p[POWER_B]):
+        below = p[TAU0] + p[LAM] * pressure
+    else:
+        below = p[POWER_B] * pressure ** p[POWER_N]
+    return pressure + 2.0 * min(below, p[TAU_MAX]) / 3.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -448,7 +577,8 @@ def integrate(p, beta, s, U, steps):
     t0 = math.log(beta)
     h = -t0 / steps
     t = t0
-    kinks = (p[S_CAP], p[S_LOCK])
+    kinks = (p[S_CAP], p[S_OPEN], p[S_CRUSH], p[S_LOCK])
+    ordered = np.sort(np.array(kinks))
     shocks = 0
     for k in range(steps):
         t_end = t0 + (k + 1) * h
@@ -478,7 +608,7 @@ def integrate(p, beta, s, U, steps):
                     return np.nan, np.nan
                 continue
             crossed = False
-            for s_kink in (min(kinks), max(kinks)):  # in the order met
+            for s_kink in ordered:  # in the order met
                 if s < s_kink < s_new:
                     part, s, U = _split_step(p, t, s, U, rest, s_kink, floor)
                     t += part
@@ -560,9 +690,11 @@ def jump(p, beta, s_ahead, U_ahead, R_ahead, strong=False):
 
 
 @njit(cache=True, error_model="numpy")
-def wall_residual(p, beta, s_ahead, U_ahead, R_ahead, steps):
+def wall_residual(p, beta, s_ahead, U_ahead, R_ahead, steps, opening=0.0):
     """``(U(1) - 1, s(1))``: the front at ``beta`` with the state ahead, then the comminuted
-    zone to the wall (:func:`jump`, :func:`integrate`)."""
+    zone to the wall (:func:`jump`, :func:`integrate`); the comminuted material carries the
+    crack opening ``opening`` (:func:`set_opening`)."""
+    set_opening(p, opening)
     s0, U0 = jump(p, beta, s_ahead, U_ahead, R_ahead)
     s1, U1 = integrate(p, beta, s0, U0, steps)
     return U1 - 1.0, s1
@@ -605,25 +737,36 @@ def superseismic(p, beta, steps):
 def cracked_front(p, gamma):
     """``(beta, s, U, eps_v, C)`` at the plastic front of the cracked solution with the crack
     front at ``gamma`` (``beta = nan`` when it does not lie in ``(1, gamma)``)."""
-    e, phi, wb = p[E_], p[PHI], p[WB]
+    e, phi, wb, t, nu = p[E_], p[PHI], p[WB], p[TENSILE], 0.5 * p[E_] / p[MU] - 1.0
     C = crack_amplitude(p, gamma)
     s_e, D_e, U_e, F_e, dF_e, ev_e = elastic_state(p, C, gamma)
     stiff = e - phi * gamma * gamma
     if not (0.0 < C <= yield_amplitude(p, gamma) and stiff > 0.0):
         return np.nan, 0.0, 0.0, 0.0, C
-    dF_c = -(s_e + phi * gamma * gamma * dF_e) / stiff
-    K1 = dF_c / (1.0 / gamma ** 2 - wb ** 2)
-    K0 = F_e + K1 * (1.0 / gamma + wb ** 2 * gamma)
-    s_yield = min(1.0, p[TAU_MAX])
-    inverse_square = wb ** 2 - s_yield / (e * K1)
+    # cracked: s = -e F' - 2 nu t (the hoop stress held at -t), F' = K1 (1/xi^2 - wb^2) + c
+    c = t * (1.0 - 2.0 * nu) / e
+    dF_c = -(s_e + 2.0 * nu * t + phi * gamma * gamma * dF_e) / stiff
+    K1 = (dF_c - c) / (1.0 / gamma ** 2 - wb ** 2)
+    K0 = F_e + K1 * (1.0 / gamma + wb ** 2 * gamma) - c * gamma
+    s_yield = cracked_yield(p)
+    inverse_square = wb ** 2 - (s_yield + t) / (e * K1)
     if not (K1 < 0.0 and inverse_square > 0.0):
         return np.nan, 0.0, 0.0, 0.0, C
     beta = 1.0 / math.sqrt(inverse_square)
     if not (1.0 < beta < gamma):
         return np.nan, 0.0, 0.0, 0.0, C
-    F = K0 - K1 * (1.0 / beta + wb ** 2 * beta)
-    dF = K1 * (1.0 / beta ** 2 - wb ** 2)
+    F = K0 - K1 * (1.0 / beta + wb ** 2 * beta) + c * beta
+    dF = K1 * (1.0 / beta ** 2 - wb ** 2) + c
     return beta, s_yield, K0 - 2.0 * K1 / beta, dF + 2.0 * F / beta, C
+
+
+@njit(cache=True, error_model="numpy")
+def cracked_yield(p):
+    """Radial stress at which the cracked material (hoop stress ``-t``) comminutes: on the
+    Mohr-Coulomb line, ``s + t = tau_0 + lam (s - 2t)/3``, i.e. ``s = 1 - N t`` with ``N =
+    (3 + 2 lam)/(3 - lam)``, or on the cap, ``s + t = tau_max``, whichever is lower."""
+    t, lam = p[TENSILE], p[LAM]
+    return min(1.0 - t * (3.0 + 2.0 * lam) / (3.0 - lam), p[TAU_MAX] - t)
 
 
 @njit(cache=True, error_model="numpy")
@@ -632,8 +775,19 @@ def cracked(p, gamma, steps):
     beta, s_a, U_a, ev_a, C = cracked_front(p, gamma)
     if not beta > 1.0:
         return np.nan, np.nan, beta, C
-    residual, S = wall_residual(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a), steps)
+    residual, S = wall_residual(p, beta, s_a, U_a, 1.0 / (1.0 + ev_a), steps,
+                                crack_opening(p, s_a, ev_a))
     return residual, S, beta, C
+
+
+@njit(cache=True, error_model="numpy")
+def crack_opening(p, s, eps_v):
+    """The crack opening (plastic volumetric strain, tension positive) of cracked material at
+    radial stress ``s`` and volumetric strain ``eps_v``: ``eps_v`` less the elastic part
+    ``(1 - 2 nu)(2t - s)/e`` (hoop stress ``-t``)."""
+    e, t = p[E_], p[TENSILE]
+    nu = 0.5 * e / p[MU] - 1.0
+    return eps_v - (1.0 - 2.0 * nu) * (2.0 * t - s) / e
 
 
 # ------------------------------------------------------------------------------------------

@@ -98,11 +98,13 @@ def concrete_material(fc, rho, mapping=None):
 class Constants:
     """The global constants of the mapping (defaults: the published values in the docstring).
 
-    ``cap`` is ``S_max = tau_max/f_c``, ``lock_pressure`` ``p_l`` (Pa), ``lock_strain`` HJC's
-    ``mu_l``, ``locked_modulus`` ``K_1`` (Pa), ``confinement`` Richart's ``k``.
+    ``cap`` is ``S_max = tau_max/f_c``, ``crush`` HJC's crush pressure over ``f_c`` (``p_c =
+    f_c/3``), ``lock_pressure`` ``p_l`` (Pa), ``lock_strain`` HJC's ``mu_l``, ``locked_modulus``
+    ``K_1`` (Pa), ``confinement`` Richart's ``k``.
     """
 
     cap: float = 7.0
+    crush: float = 1.0 / 3.0
     lock_pressure: float = 0.8e9
     lock_strain: float = 0.1
     locked_modulus: float = 85e9
@@ -167,21 +169,43 @@ class Concrete:
         :class:`Mapping`)."""
         return concrete_material(self.fc, self.rho, mapping)
 
+    def hydrostat(self):
+        """HJC's hydrostat (Holmquist, Johnson and Cook 1993) in the FE's measures, the
+        :data:`cavex.materials.HYDROSTAT` keys of a layer (Pa; ``lock_strain`` 1): crush at
+        ``P_c = crush f_c`` (Kirchhoff; the Cauchy pressure differs by ``exp(-P_c/K)``, ~1e-3),
+        HJC's lock point ``(mu_l, p_l)`` exactly (``e_l = ln(1 + mu_l)``, Kirchhoff ``P_l =
+        p_l/(1 + mu_l)``), and the locked modulus ``dP/de`` of HJC's ``p = p_l + K_1 (mu -
+        mu_l)/(1 + mu_l)`` there, ``(K_1 - p_l)/(1 + mu_l)``."""
+        c = self.constants
+        J_lock = 1.0 / (1.0 + c.lock_strain)
+        return {"crush_pressure": c.crush * self.fc, "lock_pressure": c.lock_pressure * J_lock,
+                "lock_strain": math.log1p(c.lock_strain),
+                "locked_modulus": (c.locked_modulus - c.lock_pressure) * J_lock}
+
     def fe_layer(self, mapping=None, cracking=True):
-        """:meth:`layer` with the cap ``tau_max = cap f_c`` and, if ``cracking``, the tension
-        cut-off at :attr:`tensile_strength`: the concrete the FE carries."""
-        return replace(self.layer(mapping), tau_max=self.constants.cap * self.fc,
-                       tensile_strength=self.tensile_strength if cracking else None)
+        """:meth:`layer` with the cap ``tau_max = cap f_c``, the compaction :meth:`hydrostat`
+        and, if ``cracking``, the tension cut-off at :attr:`tensile_strength`: the concrete
+        the FE carries."""
+        try:
+            return replace(self.layer(mapping), tau_max=self.constants.cap * self.fc,
+                           tensile_strength=self.tensile_strength if cracking else None,
+                           **self.hydrostat())
+        except CavexInputError as exc:
+            raise CavexInputError(f"concrete f_c = {self.fc:g} Pa, rho = {self.rho:g} kg/m^3: "
+                                  f"{exc}") from None
 
     def cavity_parameters(self):
         """The concrete cavity model's constants, stresses over ``f_c``: ``modulus = E/f_c``,
-        ``nu``, ``lam`` (Richart's ``k``), ``tau_max = S_max``, the HJC hydrostat's ``bulk =
-        p_l/(eta_l f_c)`` with ``eta_l = mu_l/(1 + mu_l)``, ``bulk_locked = K_1/f_c`` and
+        ``nu``, ``lam`` (Richart's ``k``), ``tau_max = S_max``, the FE's compaction
+        :meth:`hydrostat` (``bulk`` the elastic ``K/f_c``, ``crush``, ``lock_pressure`` over
+        ``f_c``, ``lock_strain``, ``bulk_locked`` the locked modulus over ``f_c``) and
         ``tensile = f_t/f_c``."""
         c, fc = self.constants, self.fc
-        eta_lock = c.lock_strain / (1.0 + c.lock_strain)
-        return {"modulus": aci_modulus(fc, self.rho) / fc, "nu": c.nu,
+        E = aci_modulus(fc, self.rho)
+        h = self.hydrostat()
+        return {"modulus": E / fc, "nu": c.nu,
                 "lam": mohr_coulomb_lambda(c.confinement), "tau_max": c.cap,
-                "bulk": c.lock_pressure / eta_lock / fc, "eta_lock": eta_lock,
-                "bulk_locked": c.locked_modulus / fc, "tensile": tensile_strength(fc) / fc,
+                "bulk": E / (3.0 * (1.0 - 2.0 * c.nu)) / fc, "crush": h["crush_pressure"] / fc,
+                "lock_pressure": h["lock_pressure"] / fc, "lock_strain": h["lock_strain"],
+                "bulk_locked": h["locked_modulus"] / fc, "tensile": tensile_strength(fc) / fc,
                 "power_B": c.power_B, "power_N": c.power_N}

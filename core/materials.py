@@ -55,6 +55,17 @@ class Material:
         Tension cut-off (Pa) on the least compressive principal stress, ``sigma_3 >=
         -tensile_strength``, in (0, 3 tau/(3 - lam)]; None (the default): the FE's
         ``tension_cutoff`` setting (through the cone's apex unless set). FE only.
+    crush_pressure, lock_pressure, lock_strain, locked_modulus : float, optional
+        The compaction hydrostat (Holmquist, Johnson and Cook 1993; :data:`HYDROSTAT`),
+        given all four or none (None, the default: the linear elastic bulk ``K``). In the FE's
+        measures, the log volumetric strain ``e = -ln J`` and the Kirchhoff pressure ``P``
+        (compression positive): elastic ``P = K e`` up to ``crush_pressure`` (Pa, > 0),
+        compaction linear to ``lock_pressure`` (Pa, > ``crush_pressure``) at ``lock_strain``
+        (> ``lock_pressure/K``, so that compaction is softer than ``K``; < 1), then locked,
+        ``P = lock_pressure + locked_modulus (e - lock_strain)`` (``locked_modulus`` in Pa,
+        > 0). Compaction is irreversible; unloading is elastic (docs/fem.md "Compaction").
+        FE only (the concrete closed form takes the same four numbers from
+        :class:`cavex.concrete.Concrete`).
     """
 
     E: float = field(metadata={"unit": "Pa"})
@@ -69,6 +80,10 @@ class Material:
     tau_max: float | None = field(default=None, metadata={"unit": "Pa", "fe_only": True})
     tensile_strength: float | None = field(default=None,
                                            metadata={"unit": "Pa", "fe_only": True})
+    crush_pressure: float | None = field(default=None, metadata={"unit": "Pa", "fe_only": True})
+    lock_pressure: float | None = field(default=None, metadata={"unit": "Pa", "fe_only": True})
+    lock_strain: float | None = field(default=None, metadata={"unit": "1", "fe_only": True})
+    locked_modulus: float | None = field(default=None, metadata={"unit": "Pa", "fe_only": True})
 
     def __post_init__(self):
         require_name(self.name, "name")
@@ -97,6 +112,32 @@ class Material:
             require(self.tensile_strength <= uniaxial * (1.0 + 1e-12), "tensile_strength",
                     f"<= the uniaxial compressive strength 3 tau/(3 - lam) = {uniaxial:.6g} Pa",
                     self.tensile_strength)
+        self._check_hydrostat()
+
+    def _check_hydrostat(self):
+        """The compaction hydrostat's four numbers: all or none, each in its range."""
+        values = [getattr(self, name) for name in HYDROSTAT]
+        if all(v is None for v in values):
+            return
+        for name, value in zip(HYDROSTAT, values, strict=True):
+            require(value is not None, name, "given with " + ", ".join(
+                n for n in HYDROSTAT if n != name) + " (the hydrostat: all four or none)",
+                    value)
+        _positive("crush_pressure", self.crush_pressure)
+        require(is_finite_number(self.lock_pressure) and math.isfinite(self.lock_pressure)
+                and self.lock_pressure > self.crush_pressure, "lock_pressure",
+                f"a finite number > crush_pressure = {self.crush_pressure:.6g} Pa",
+                self.lock_pressure)
+        least = self.lock_pressure / self.bulk_modulus
+        require(is_finite_number(self.lock_strain) and least < self.lock_strain < 1.0,
+                "lock_strain", f"in ({least:.6g}, 1) (lock_pressure/K: compaction softer than "
+                "the bulk modulus K)", self.lock_strain)
+        _positive("locked_modulus", self.locked_modulus)
+
+    @property
+    def compacts(self):
+        """True when the layer has a compaction hydrostat (:data:`HYDROSTAT` given)."""
+        return self.crush_pressure is not None
 
     @property
     def uniaxial_strength(self):
@@ -129,6 +170,10 @@ class Material:
     def quasi_static_epsilon(self):
         """``epsilon = a/b`` of the quasi-static convention, ``epsilon^3 = 3 tau / (2 E)``."""
         return (1.5 * self.tau / self.E) ** (1.0 / 3.0)
+
+
+#: The compaction hydrostat's parameters of a :class:`Material` (all four or none).
+HYDROSTAT = ("crush_pressure", "lock_pressure", "lock_strain", "locked_modulus")
 
 
 #: How a layer's bottom face holds to the layer below (``bottom`` of a layer, docs/config.md):

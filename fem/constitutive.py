@@ -29,6 +29,35 @@ Kirchhoff stress with the intercepts scaled by ``J``. With ``s = sign(Q)``:
   ``|sigma_r - sigma_theta| <= min(lam sigma + tau, tau_max)``; ``tau_max = inf`` (the default)
   is no cap.
 
+Compaction (a layer's hydrostat, :data:`cavex.materials.HYDROSTAT`; Holmquist, Johnson and
+Cook 1993, "HJC", in the kernel's measures): with the log volumetric strain ``e = -theta``
+(compression positive) the Kirchhoff pressure on loading is the piecewise-linear curve
+
+.. math:: H(e) = K e \ (e \le e_0 = P_c/K), \qquad
+          P_c + K_c (e - e_0) \ (e_0 \le e \le e_l), \qquad
+          P_l + K_l (e - e_l) \ (e \ge e_l),
+
+``K_c = (P_l - P_c)/(e_l - e_0) < K``: elastic to the crush pressure ``P_c``, compaction to the
+lock point ``(e_l, P_l)``, then locked (``K_l``); continuous at the crush and lock points.
+Compaction is irreversible, written as volumetric plasticity whose hardening variable is the
+plastic volumetric strain ``theta_p`` (the cap models' rule): ``e_c = -theta_p`` is the net
+compaction, the elastic strain ``x = e - e_c = theta_p - theta`` gives ``P = K x``, and the crush
+surface ``P <= P_c + h max(e_c, 0)``, ``h = K K_c/(K - K_c)``, is the loading curve seen from
+the elastic line (a point unloaded from ``H(e_max)`` unloads and reloads elastically with ``K``
+and crushes again on ``H`` at ``e_max``). Return (:func:`hydrostat`), for ``P_tr = K x_tr > `` the
+crush surface: a crack opening ``theta_p > 0`` (left by the tension cut-off) first closes at the
+crush pressure (``P = P_c``, tangent 0, while ``P_tr - K theta_p <= P_c``: on loading ``P =
+H(e)`` again once it is closed, whatever the opening was); then ``dl = theta_p^+ + (P_tr - K
+theta_p^+ - P_c - h max(e_c, 0))/(K + h)``, ``theta_p -= dl``, ``P = P_tr - K dl = H(e)``
+(tangent ``K_c``); past full compaction ``e_c^l = e_l - P_l/K`` the point is locked: ``theta_p =
+-e_c^l`` and ``P = P_l + K_l (x - P_l/K)`` for ``x > P_l/K`` (tangent ``K_l``), elastic ``K x``
+below (the locked branch is reversible). The deviatoric returns below then act at the
+hydrostat's pressure and tangent (``P_tr``, ``K`` replaced by ``K_t``): exact where no volume
+flows plastically through them (dilatancy 0 and the cut-off inactive: every point of the
+cavity's comminuted zone); where the cut-off or dilatancy moves ``theta_p`` the volumetric
+correction runs along that piece's modulus (an operator split). Without a hydrostat (``crush
+= inf``) the pressure is ``-K (theta - theta_p)``, the same arithmetic as before.
+
 Flow: Mohr-Coulomb is non-associated with plastic potential ``g = c_s(psi)|Q| - lam_psi P``
 (``lam_psi = 6 sin psi / (3 - sin psi)`` from the dilatancy angle ``psi``; zero by default, i.e.
 volume-preserving plastic strain); the cut-off is associated (Rankine). With multipliers
@@ -55,8 +84,10 @@ from its trial state by the three-surface return :func:`_capped_point` (the acti
 surface or a corner of two, the first of MC, cap, TC, MC+cap, MC+TC, cap+TC with positive
 multipliers that violates no other surface; the same closed-form solve and tangent). Without a
 cap (``inf``) those tests are false and every point takes the code path above, bit for bit.
-An independent numpy implementation of the same equations is kept in ``tests/oracles.py`` and
-compared with this kernel point by point (``tests/test_fem_kernels.py``).
+An independent numpy implementation of the same equations (the hydrostat written from its
+loading curve in the total strain) is kept in ``tests/oracles.py`` and compared with this
+kernel point by point (``tests/test_fem_kernels.py``, which also drives a point along
+hydrostatic and uniaxial-strain paths against the exact hydrostat).
 """
 
 
@@ -89,10 +120,11 @@ def _finish_point(P, Q, T00, T01, T10, T11, lam, tau, J, theta_p, gamma_p):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension):
-    """Mohr-Coulomb-only return; returns ``(plastic, needs_multi_surface, outputs)``
-    (:data:`OUTPUTS`; not to be used when the multi-surface return is needed)."""
-    P = -K * (theta - theta_p)
+def _mohr_coulomb_point(P_tr, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension):
+    """Mohr-Coulomb-only return from the trial pressure ``P_tr`` (:func:`hydrostat`; ``K`` its
+    tangent); returns ``(plastic, needs_multi_surface, outputs)`` (:data:`OUTPUTS`; not to be
+    used when the multi-surface return is needed)."""
+    P = P_tr
     Q = -2.0 * G * (gamma - gamma_p)
     positive = Q >= 0.0
     sign = 1.0 if positive else -1.0
@@ -125,11 +157,11 @@ def _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_p
 
 
 @njit(cache=True, error_model="numpy")
-def _trial(theta, gamma, theta_p, gamma_p, K, G, lam, lam_psi):
-    """The elastic trial state ``(P, Q)`` and the side of the Mohr-Coulomb pyramid it lies on:
+def _trial(P_tr, gamma, gamma_p, G, lam, lam_psi):
+    """The trial state ``(P, Q)`` (``P_tr`` given: :func:`hydrostat`) and the side of the
+    Mohr-Coulomb pyramid it lies on:
     ``pos`` (``Q >= 0``: compression-dominated branch), its ``sign`` and the yield and flow
     coefficients ``c_mc``, ``c_psi`` of that side (shared by every return)."""
-    P_tr = -K * (theta - theta_p)
     Q_tr = -2.0 * G * (gamma - gamma_p)
     pos = Q_tr >= 0.0
     sign = 1.0 if pos else -1.0
@@ -139,11 +171,10 @@ def _trial(theta, gamma, theta_p, gamma_p, K, G, lam, lam_psi):
 
 
 @njit(cache=True, error_model="numpy")
-def _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension):
+def _multi_surface_point(P_tr, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension):
     """Multi-surface return (Mohr-Coulomb, tension cut-off or their corner); returns
     ``(plastic, outputs)``."""
-    P_tr, Q_tr, pos, sign, c_mc, c_psi = _trial(theta, gamma, theta_p, gamma_p, K, G, lam,
-                                                lam_psi)
+    P_tr, Q_tr, pos, sign, c_mc, c_psi = _trial(P_tr, gamma, gamma_p, G, lam, lam_psi)
     # surface normals a_k, flow vectors g_k and stress corrections d_k = E g_k
     a10, a11 = -lam, c_mc * sign
     g10, g11_ = lam_psi, -1.5 * c_psi * sign
@@ -193,7 +224,7 @@ def _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_
 
 
 @njit(cache=True, error_model="numpy")
-def _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap):
+def _capped_point(P_tr, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, tension, cap):
     """Three-surface return (Mohr-Coulomb, Tresca cap, tension cut-off; one surface or a
     corner of two) from the trial state; returns ``(plastic, outputs)``.
 
@@ -202,8 +233,7 @@ def _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, te
     state violates no other surface (within ``1e-12 tau J``); if round-off leaves none
     admissible, the one with the smallest violation.
     """
-    P_tr, Q_tr, pos, sign, c_mc, c_psi = _trial(theta, gamma, theta_p, gamma_p, K, G, lam,
-                                                lam_psi)
+    P_tr, Q_tr, pos, sign, c_mc, c_psi = _trial(P_tr, gamma, gamma_p, G, lam, lam_psi)
     # surfaces k = 0 (MC), 1 (cap), 2 (TC): f_k = a0[k] P + a1[k] Q - k_k J, flow g_k
     a0 = (-lam, 0.0, -1.0)
     a1 = (c_mc * sign, sign, 1.0 / 3.0 if pos else -2.0 / 3.0)
@@ -276,6 +306,35 @@ def _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau, lam_psi, te
                                       gamma_p + m[0] * g1[0] + m[1] * g1[1] + m[2] * g1[2])
 
 
+@njit(cache=True, error_model="numpy")
+def hydrostat(theta, theta_p, K, crush, lock_pressure, lock_strain, locked_modulus):
+    """The compaction hydrostat at the point (module docstring, "Compaction"): the trial
+    Kirchhoff pressure ``P_tr``, its tangent ``K_t = dP/de`` and the plastic volumetric strain
+    ``theta_p`` after compaction."""
+    x = theta_p - theta                     # elastic volumetric strain e - e_c
+    e_c = -theta_p                          # net plastic compaction
+    x_lock = lock_pressure / K
+    e_c_lock = lock_strain - x_lock
+    if e_c >= e_c_lock:                     # fully compacted: elastic, then locked
+        if x > x_lock:
+            return lock_pressure + locked_modulus * (x - x_lock), locked_modulus, theta_p
+        return K * x, K, theta_p
+    K_c = (lock_pressure - crush) / (lock_strain - crush / K)
+    h = K * K_c / (K - K_c)
+    P_tr = K * x
+    opened = max(theta_p, 0.0)
+    crush_now = crush + h * max(e_c, 0.0)
+    if not P_tr > crush_now:                # elastic
+        return P_tr, K, theta_p
+    if P_tr - K * opened <= crush:          # closing opened volume at the crush pressure
+        return crush, 0.0, theta_p - (P_tr - crush) / K
+    dl = opened + (P_tr - K * opened - crush_now) / (K + h)
+    if e_c + dl < e_c_lock:                 # compaction
+        return P_tr - K * dl, K_c, theta_p - dl
+    return (lock_pressure + locked_modulus * (x - (e_c_lock - e_c) - x_lock), locked_modulus,
+            -e_c_lock)                      # compacted through the locking strain
+
+
 @njit(cache=True, error_model="numpy", inline="always")
 def return_point(eps_r, eps_t, theta_p, gamma_p, material):
     """Return map of one point from its total log strains: ``(plastic, outputs)``, whether the
@@ -284,23 +343,34 @@ def return_point(eps_r, eps_t, theta_p, gamma_p, material):
     ``material`` is the point's record of :data:`cavex.fem.material_records.MATERIAL`; the
     only place where the kernels read its constitutive fields. Its ``cap`` is the Tresca cap
     ``tau_max`` (Pa) on ``|sigma_r - sigma_theta|``; ``inf`` (no cap) takes exactly the
-    Mohr-Coulomb/tension code path (the cap tests are false)."""
+    Mohr-Coulomb/tension code path (the cap tests are false). Its ``crush`` is the hydrostat's
+    crush pressure (Pa); ``inf`` (no compaction) is the linear ``P = -K (theta - theta_p)``,
+    the same arithmetic as without the hydrostat. A point that compacts in this step is
+    plastic."""
     K, G, lam, tau = material.K, material.G, material.lam, material.tau
     lam_psi, tension, cap = material.lam_psi, material.tension, material.cap
     theta = eps_r + 2.0 * eps_t
     gamma = eps_r - eps_t
     J = math.exp(theta)
-    plastic, multi, out = _mohr_coulomb_point(theta, gamma, J, theta_p, gamma_p, K, G, lam,
+    compacted = False
+    if material.crush < np.inf:
+        P_tr, K, th_p = hydrostat(theta, theta_p, K, material.crush, material.lock_pressure,
+                                  material.lock_strain, material.locked_modulus)
+        compacted = th_p != theta_p
+        theta_p = th_p
+    else:
+        P_tr = -K * (theta - theta_p)
+    plastic, multi, out = _mohr_coulomb_point(P_tr, gamma, J, theta_p, gamma_p, K, G, lam,
                                               tau, lam_psi, tension)
     if multi:
-        plastic, out = _multi_surface_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
+        plastic, out = _multi_surface_point(P_tr, gamma, J, theta_p, gamma_p, K, G, lam, tau,
                                             lam_psi, tension)
     if cap < np.inf:
         capJ = cap * J
         tol = 1e-12 * tau * J
         trial_deviator = 2.0 * G * abs(gamma - gamma_p)
         if trial_deviator - capJ > tol or abs(out[1] - out[0]) - capJ > tol:
-            plastic, out = _capped_point(theta, gamma, J, theta_p, gamma_p, K, G, lam, tau,
+            plastic, out = _capped_point(P_tr, gamma, J, theta_p, gamma_p, K, G, lam, tau,
                                          lam_psi, tension, cap)
         out = out[:6] + (max(out[6], abs(out[1] - out[0]) / capJ),) + out[7:]
-    return plastic, out
+    return plastic or compacted, out

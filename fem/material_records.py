@@ -17,7 +17,11 @@ Fields (SI units):
 - ``tension``: the tension cut-off ``T`` on ``sigma_3 >= -T`` (Pa): the layer's
   ``tensile_strength`` where given, else the FE setting ``tension_cutoff``, else
   ``tau/lam`` (through the cone's apex; ``inf`` for Tresca, ``lam = 0``);
-- ``cap``: the Tresca cap ``tau_max`` on ``|sigma_r - sigma_theta|`` (Pa); ``inf``: none.
+- ``cap``: the Tresca cap ``tau_max`` on ``|sigma_r - sigma_theta|`` (Pa); ``inf``: none;
+- ``crush``, ``lock_pressure``, ``lock_strain``, ``locked_modulus``: the compaction
+  hydrostat (the layer's ``crush_pressure`` and the others of
+  :data:`cavex.materials.HYDROSTAT`; :func:`cavex.fem.constitutive.hydrostat`); ``crush =
+  inf`` (the others ``inf``, ``inf``, ``K``): none, the linear bulk ``K``.
 """
 
 import numpy as np
@@ -25,7 +29,17 @@ import numpy as np
 #: One element's material constants (module docstring), aligned so that numba reads a struct.
 MATERIAL = np.dtype([("K", np.float64), ("G", np.float64), ("rho", np.float64),
                      ("lam", np.float64), ("tau", np.float64), ("lam_psi", np.float64),
-                     ("tension", np.float64), ("cap", np.float64)], align=True)
+                     ("tension", np.float64), ("cap", np.float64), ("crush", np.float64),
+                     ("lock_pressure", np.float64), ("lock_strain", np.float64),
+                     ("locked_modulus", np.float64)], align=True)
+
+
+def _hydrostat(m):
+    """``(crush, lock_pressure, lock_strain, locked_modulus)`` of layer ``m`` (no compaction:
+    ``(inf, inf, inf, K)``)."""
+    if getattr(m, "crush_pressure", None) is None:
+        return np.inf, np.inf, np.inf, m.bulk_modulus
+    return m.crush_pressure, m.lock_pressure, m.lock_strain, m.locked_modulus
 
 
 def pack_layers(layers, element_layer, dilatancy_deg=0.0, tension_cutoff=None):
@@ -35,7 +49,8 @@ def pack_layers(layers, element_layer, dilatancy_deg=0.0, tension_cutoff=None):
     ``layers`` are :class:`cavex.materials.Material`. ``tension_cutoff`` is ``None`` (through
     the apex, ``tau/lam``), a number (Pa) applied to every layer, or a sequence with one value
     per layer; a layer's own ``tensile_strength`` takes its place in that layer, and its
-    ``tau_max`` (None: no cap) is the Tresca cap. ``dilatancy_deg`` is the dilatancy angle
+    ``tau_max`` (None: no cap) is the Tresca cap and its compaction hydrostat (None: none)
+    the volumetric law. ``dilatancy_deg`` is the dilatancy angle
     ``psi`` of every layer.
     """
     if tension_cutoff is None:
@@ -51,5 +66,6 @@ def pack_layers(layers, element_layer, dilatancy_deg=0.0, tension_cutoff=None):
         records[i] = (m.bulk_modulus, m.shear_modulus, m.rho, m.lam, m.tau, lam_psi,
                       cut[i] if getattr(m, "tensile_strength", None) is None
                       else m.tensile_strength,
-                      np.inf if getattr(m, "tau_max", None) is None else m.tau_max)
+                      np.inf if getattr(m, "tau_max", None) is None else m.tau_max,
+                      *_hydrostat(m))
     return records[np.asarray(element_layer)]

@@ -372,16 +372,27 @@ class RadialSolver:
         return 0.5 * float(v @ (self.stack.discs[c].mass @ v))
 
     def stored_energy(self, c=0):
-        """Hencky energy ``K theta_e^2/2 + (2/3) G gamma_e^2`` integrated over case ``c``."""
+        """Hencky energy ``K theta_e^2/2 + (2/3) G gamma_e^2`` integrated over case ``c``;
+        where the hydrostat is locked (fully compacted, ``x = -theta_e`` past ``x_l =
+        lock_pressure/K``), the volumetric part ``K x_l^2/2 + P_l (x - x_l) + K_l (x -
+        x_l)^2/2`` (:func:`cavex.fem.constitutive.hydrostat`)."""
         one = self.case(c)
         disc = one.disc
         g_r, g_t = disc.displacement_gradients(one.u)
         eps_r, eps_t = np.log1p(g_r), np.log1p(g_t)
         theta_e = eps_r + 2.0 * eps_t - one.state["theta_p"]
         gamma_e = eps_r - eps_t - one.state["gamma_p"]
-        K, G = disc.material["K"][:, None], disc.material["G"][:, None]  # per element
-        return float(np.sum(disc.weights * (0.5 * K * theta_e ** 2
-                                            + (2.0 / 3.0) * G * gamma_e ** 2)))
+        m = disc.material[:, None]  # per element
+        K, G = m["K"], m["G"]
+        volumetric = 0.5 * K * theta_e ** 2
+        if np.any(np.isfinite(m["crush"])):
+            x_l = m["lock_pressure"] / K
+            x = -theta_e
+            locked = (-one.state["theta_p"] >= m["lock_strain"] - x_l) & (x > x_l)
+            past = np.where(locked, x - x_l, 0.0)
+            volumetric = np.where(locked, 0.5 * K * x_l ** 2 + m["lock_pressure"] * past
+                                  + 0.5 * m["locked_modulus"] * past ** 2, volumetric)
+        return float(np.sum(disc.weights * (volumetric + (2.0 / 3.0) * G * gamma_e ** 2)))
 
     # single-case shorthands (the solver of one problem)
     u = property(lambda self: self.case().u)

@@ -2,7 +2,9 @@
 
 - :func:`hencky_mohr_coulomb`: the Hencky/Mohr-Coulomb return map of
   :mod:`cavex.fem.constitutive`, vectorised in numpy (masks over all points; the multi-surface
-  return for every point of a group in which some point needs it);
+  return for every point of a group in which some point needs it), with the compaction
+  hydrostat written as its loading curve in the total volumetric strain
+  (:func:`compaction_hydrostat`);
 - :func:`assemble_forms`: the internal force and tangent of :mod:`cavex.fem.element` assembled
   from scikit-fem ``LinearForm``/``BilinearForm``s written like the weak form, with this numpy
   return map.
@@ -52,6 +54,48 @@ def _surfaces(sign, mat):
     return (a_mc, mat.tau, g_mc), (a_tc, mat.tension, g_tc)
 
 
+def compaction_hydrostat(theta, theta_p, mat):
+    """``(P, K_t, theta_p)``: the trial Kirchhoff pressure, its tangent ``dP/de`` and the
+    plastic volumetric strain after compaction, written from the loading curve.
+
+    With ``e = -theta`` (log volumetric strain, compression positive), ``e_c = -theta_p`` and
+    the crush strain ``e_0 = P_c/K``, the loading curve is ``H(e) = P_c + K_c (e - e_0)``,
+    ``K_c = (P_l - P_c)/(e_l - e_0)``, up to ``e_l``, then ``P_l + K_l (e - e_l)``. A point
+    unloaded to ``e_c`` crushes again where the elastic line ``K (e - e_c)`` meets ``H``
+    (``e_c <= 0``: at ``P_c``, the opened volume ``-e_c`` closing at the crush pressure while
+    ``e <= e_0``). Fully compacted (``e_c >= e_l - P_l/K``): elastic ``K x``, ``x = e - e_c``,
+    up to ``x_l = P_l/K``, then ``P_l + K_l (x - x_l)``. No hydrostat (``crush = inf``): the
+    linear ``K (e - e_c)``.
+    """
+    K = mat.K
+    e, e_c = -theta, -theta_p
+    x = e - e_c
+    linear = K * x
+    has = np.isfinite(mat.crush)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        P_c, P_l, e_l, K_l = mat.crush, mat.lock_pressure, mat.lock_strain, mat.locked_modulus
+        e_0 = P_c / K
+        K_c = (P_l - P_c) / (e_l - e_0)
+        x_l = P_l / K
+        e_c_lock = e_l - x_l
+        full = has & (e_c >= e_c_lock)
+        # where the elastic line of e_c meets the loading curve (the crush point now)
+        e_meet = e_0 + np.maximum(e_c, 0.0) * K / (K - K_c)
+        crushes = has & ~full & (linear > P_c + K_c * (e_meet - e_0))
+        plateau = crushes & (e <= e_0)
+        locks = crushes & ~plateau & (e >= e_l)
+        compacts = crushes & ~plateau & ~locks
+        P = np.where(full & (x > x_l), P_l + K_l * (x - x_l), linear)
+        K_t = np.where(full & (x > x_l), K_l, K)
+        P = np.where(plateau, P_c, P)
+        P = np.where(compacts, P_c + K_c * (e - e_0), P)
+        P = np.where(locks, P_l + K_l * (e - e_l), P)
+        K_t = np.where(plateau, 0.0, np.where(compacts, K_c, np.where(locks, K_l, K_t)))
+        new_e_c = np.where(plateau, e - e_0, np.where(compacts, e - P / K,
+                                                      np.where(locks, e_c_lock, e_c)))
+    return P, K_t, -new_e_c
+
+
 def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat, groups=None):
     """Return-map the trial state; see the module docstring for the equations solved.
 
@@ -76,8 +120,10 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat, groups=None):
     theta = eps_r + 2.0 * eps_t
     gamma = eps_r - eps_t
     J = np.exp(theta)
-    K, G = mat.K, mat.G
-    P = -K * (theta - theta_p)
+    G = mat.G
+    P, K, compacted_theta_p = compaction_hydrostat(theta, theta_p, mat)
+    compacted = compacted_theta_p != theta_p
+    theta_p = compacted_theta_p
     Q = -2.0 * G * (gamma - gamma_p)
     positive = Q >= 0.0
     sign = np.where(positive, 1.0, -1.0)
@@ -90,7 +136,7 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat, groups=None):
     plastic = (f_mc > tol) | (f_tc > tol)
     general = f_tc > tol
     if groups is None and np.any(general):
-        return _general_return(theta, gamma, J, theta_p, gamma_p, mat)
+        return _general_return(P, K, gamma, J, theta_p, gamma_p, mat, compacted)
     # Mohr-Coulomb alone (tension cut-off inactive everywhere): one multiplier per point
     c_psi = np.where(positive, 1.0, 1.0 + mat.lam_psi / 3.0)
     d_P, d_Q = -K * mat.lam_psi, 3.0 * G * c_psi * sign          # stress correction direction
@@ -101,7 +147,7 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat, groups=None):
     trial_ok = _tension_ok(P_new, Q_new, J, mat)
     general |= plastic & ~trial_ok
     if groups is None and np.any(general):
-        return _general_return(theta, gamma, J, theta_p, gamma_p, mat)
+        return _general_return(P, K, gamma, J, theta_p, gamma_p, mat, compacted)
     th_p = theta_p + dl * mat.lam_psi
     ga_p = gamma_p - dl * 1.5 * c_psi * sign
     # tangent d(P, Q)/d(theta, gamma): E - d (a^T E - k J e_theta^T) / g on plastic points
@@ -109,13 +155,14 @@ def hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, mat, groups=None):
     row_t = (mat.lam * K - mat.tau * J) * pl
     row_g = (-2.0 * G * c_mc * sign) * pl
     T = np.array([[-K - d_P * row_t, -d_P * row_g], [-d_Q * row_t, -2.0 * G - d_Q * row_g]])
-    response = _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P_new, Q_new, T, plastic, J,
-                       mat)
+    response = _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P_new, Q_new, T,
+                       plastic | compacted, J, mat)
     if groups is not None and np.any(general):
         redo = np.isin(groups, np.unique(groups[general]))
-        replace_points(response, redo, _general_return(theta[redo], gamma[redo], J[redo],
+        replace_points(response, redo, _general_return(P[redo], K[redo], gamma[redo], J[redo],
                                                        theta_p[redo], gamma_p[redo],
-                                                       take_points(mat, redo)))
+                                                       take_points(mat, redo),
+                                                       compacted[redo]))
     return response
 
 
@@ -156,10 +203,11 @@ def _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P, Q, T, plastic, J, mat
                          energy=energy, yield_ratio=yield_ratio)
 
 
-def _general_return(theta, gamma, J, theta_p, gamma_p, mat):
-    """Multi-surface return (Mohr-Coulomb, tension cut-off, or their corner)."""
-    K, G = mat.K, mat.G
-    P_tr = -K * (theta - theta_p)
+def _general_return(P_tr, K, gamma, J, theta_p, gamma_p, mat, compacted):
+    """Multi-surface return (Mohr-Coulomb, tension cut-off, or their corner) from the trial
+    pressure ``P_tr`` (tangent ``K``)."""
+    G = mat.G
+    theta = np.log(J)
     Q_tr = -2.0 * G * (gamma - gamma_p)
     sign = np.where(Q_tr >= 0.0, 1.0, -1.0)
     (a1, k1, g1), (a2, k2, g2) = _surfaces(sign, mat)
@@ -205,7 +253,8 @@ def _general_return(theta, gamma, J, theta_p, gamma_p, mat):
             D = np.array([[d1[0], d2[0]], [d1[1], d2[1]]])
             corr = np.einsum("ik...,kl...,lj...->ij...", D, inv, A)
         T = np.where(use3, E - corr, T)
-    return _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P, Q, T, ~elastic, J, mat)
+    return _finish(theta, gamma, theta_p, gamma_p, th_p, ga_p, P, Q, T, ~elastic | compacted, J,
+                   mat)
 
 
 # ----------------------------------------------------------------------------- the weak form

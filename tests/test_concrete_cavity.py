@@ -80,32 +80,37 @@ def cracked_locked_closed_form(modulus, nu, lam, tensile, eta_lock):
     """Quasi-static elastic - cracked - locked comminuted solution, written from the equations
     of docs/concrete.md independently of the module: returns ``(S, beta, gamma)``.
 
-    Elastic ``F = C/xi^2``, crack front ``2 mu C/gamma^3 = f_t``; cracked ``s = 2 f_t
-    (gamma/xi)^2``, ``F = K0 - K1/xi``; comminution at ``s = 1`` (``beta = gamma sqrt(2 f_t)``);
-    the locked zone has ``R = 1/(1 - eta)``, ``U = U^- beta^2/xi^2`` and
-    ``(s + k/alpha) xi^(2 alpha)`` constant; the wall condition ``U(1) = 1`` fixes ``gamma``.
+    Elastic ``F = C/xi^2``, crack front ``2 mu C/gamma^3 = f_t`` (there ``s = 2 f_t``); cracked
+    (hoop stress held at ``-f_t``, ``s = -e F' - 2 nu f_t``): ``F' = K1/xi^2 + c``,
+    ``c = f_t (1 - 2 nu)/e``, so ``s = 3 f_t (gamma/xi)^2 - f_t``; comminution on the
+    Mohr-Coulomb line with that hoop tension, ``s = 1 - N f_t``, ``N = (3 + 2 lam)/(3 - lam)``
+    (``beta = gamma sqrt(3 f_t/(1 - (N - 1) f_t))``); the locked zone has ``R = 1/(1 - eta)``,
+    ``U = U^- beta^2/xi^2`` and ``(s + k/alpha) xi^(2 alpha)`` constant; the wall condition
+    ``U(1) = 1`` fixes ``gamma``.
     """
     from scipy.optimize import brentq
 
     mu = modulus / (2.0 * (1.0 + nu))
     tau0 = 1.0 - lam / 3.0
     alpha, k = 3.0 * lam / (3.0 + 2.0 * lam), 3.0 * tau0 / (3.0 + 2.0 * lam)
+    s_yield = 1.0 - tensile * (3.0 + 2.0 * lam) / (3.0 - lam)
+    c = tensile * (1.0 - 2.0 * nu) / modulus
 
     def fronts(gamma):
         C = tensile * gamma ** 3 / (2.0 * mu)
-        K1 = -2.0 * tensile * gamma ** 2 / modulus
-        K0 = C / gamma ** 2 + K1 / gamma
-        beta = gamma * math.sqrt(2.0 * tensile)
+        K1 = -3.0 * tensile * gamma ** 2 / modulus
+        K0 = C / gamma ** 2 + K1 / gamma - c * gamma
+        beta = gamma * math.sqrt(3.0 * tensile / (s_yield + tensile))
         U_ahead = K0 - 2.0 * K1 / beta
-        eps_v = 2.0 * K0 / beta - K1 / beta ** 2
+        eps_v = 2.0 * K0 / beta - K1 / beta ** 2 + 3.0 * c
         j = (beta - U_ahead) / (1.0 + eps_v)
         U_behind = beta - j * (1.0 - eta_lock)
         return beta, U_behind * beta ** 2 - 1.0
 
-    gamma = brentq(lambda g: fronts(g)[1], 1.0 / math.sqrt(2.0 * tensile) * 1.0001, 1e4,
-                   xtol=1e-15, rtol=1e-15)
+    lowest = math.sqrt((s_yield + tensile) / (3.0 * tensile))  # beta = 1
+    gamma = brentq(lambda g: fronts(g)[1], lowest * 1.0001, 1e4, xtol=1e-15, rtol=1e-15)
     beta = fronts(gamma)[0]
-    return (1.0 + k / alpha) * beta ** (2.0 * alpha) - k / alpha, beta, gamma
+    return (s_yield + k / alpha) * beta ** (2.0 * alpha) - k / alpha, beta, gamma
 
 
 @pytest.mark.parametrize("eta_lock", [0.0, 0.05])

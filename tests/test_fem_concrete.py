@@ -379,3 +379,32 @@ def test_keys_round_trip_and_absent_keys_are_not_written():
     assert parse_target([table]) == target
     assert "tau_max" not in target_table(parse_target([LAYER]))[0]
     assert "tensile_strength" not in target_table(parse_target([LAYER]))[0]
+
+
+HYDROSTAT_KEYS = {"crush_pressure": 13e6, "lock_pressure": 0.8e9 / 1.1,
+                  "lock_strain": math.log(1.1), "locked_modulus": 76.5e9}
+
+
+@pytest.mark.parametrize(("change", "key", "message"), [
+    ({"lock_pressure": None}, "lock_pressure", "the hydrostat: all four or none"),
+    ({"crush_pressure": -1.0}, "crush_pressure", "a finite number > 0"),
+    ({"lock_pressure": 10e6}, "lock_pressure", "> crush_pressure"),
+    ({"lock_strain": 0.03}, "lock_strain", "compaction softer than the bulk modulus"),
+    ({"lock_strain": 1.0}, "lock_strain", "in ("),
+    ({"locked_modulus": math.inf}, "locked_modulus", "a finite number > 0"),
+])
+def test_bad_hydrostat_keys_are_refused_naming_the_key(change, key, message):
+    """K = 30e9/(3 0.6) = 16.7 GPa: lock_strain must exceed lock_pressure/K = 0.0436."""
+    keys = {k: v for k, v in {**HYDROSTAT_KEYS, **change}.items() if v is not None}
+    with pytest.raises(CavexInputError) as info:
+        parse_target([{**LAYER, **keys}])
+    assert f"layers[0].{key}" in str(info.value)
+    assert message in str(info.value)
+
+
+def test_hydrostat_keys_round_trip_and_absent_keys_are_not_written():
+    target = parse_target([{**LAYER, **HYDROSTAT_KEYS}])
+    table = target_table(target)[0]
+    assert all(table[k] == v for k, v in HYDROSTAT_KEYS.items())
+    assert parse_target([table]) == target and target.layers[0].compacts
+    assert not set(HYDROSTAT_KEYS) & set(target_table(parse_target([LAYER]))[0])

@@ -9,6 +9,8 @@ associated differently): bound 1e-11. Element force and tangent against the scik
 measured <= 1.1e-15 of the largest entry (P1 and P2): bound 1e-12.
 """
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from fem_helpers import advance, point_material, return_map
@@ -18,6 +20,7 @@ from cavex import load_config
 from cavex.fem.expansion import build_model
 from cavex.fem.settings import Numerics
 from cavex.fem.solver import RadialSolver
+from cavex.materials import Material
 
 LAYERS = load_config()[0].layers
 
@@ -139,3 +142,151 @@ def test_block_banded_solver_equals_lapack():
             reference = solve_banded((p, p), band[:, s], rhs[s])
             assert np.max(np.abs(du[s] - reference)) <= 1e-12 * np.max(np.abs(reference))
         assert np.all(du[starts[4]:] == 0.0)
+
+
+# ------------------------------------------------------------------ the compaction hydrostat
+def hjc_concrete(fc, tensile_strength=None, lam=1.525):
+    """A concrete of strength ``fc`` with HJC's hydrostat (Holmquist, Johnson and Cook 1993):
+    crush at ``f_c/3``, locking at ``p_l = 0.8`` GPa, ``mu_l = 0.1``, ``K_l = 85`` GPa, the lock
+    point in the FE's measures (``e_l = ln(1 + mu_l)``, Kirchhoff ``p_l/(1 + mu_l)``)."""
+    E = 0.043 * 2300.0 ** 1.5 * np.sqrt(fc / 1e6) * 1e6
+    return Material(E=E, nu=0.2, rho=2300.0, lam=lam, sigma_c=fc,
+                    tensile_strength=tensile_strength, crush_pressure=fc / 3.0,
+                    lock_pressure=0.8e9 / 1.1, lock_strain=np.log(1.1), locked_modulus=85e9)
+
+
+COMPACTING = [hjc_concrete(20e6), hjc_concrete(48e6, tensile_strength=4e6),
+              hjc_concrete(160e6, tensile_strength=6e6)]
+
+
+def compaction_points(rng, n, material):
+    """Volumetric strains from tension to past the locking strain, deviators from elastic to
+    far past yield, plastic volumetric strains from opened (cut-off) to fully compacted
+    (``material``: the points' records)."""
+    e_lock = material.lock_strain
+    theta = -rng.uniform(-0.2, 1.6, n) * e_lock
+    spread = rng.choice([0.1, 1.0, 10.0, 100.0], n)
+    gamma = rng.normal(0, 1, n) * material.tau / material.G * spread
+    eps_r = (theta + 2.0 * gamma) / 3.0
+    eps_t = (theta - gamma) / 3.0
+    e_c_lock = e_lock - material.lock_pressure / material.K
+    theta_p = -rng.uniform(-0.1, 1.3, n) * e_c_lock * rng.choice([0.0, 1.0], n, p=[0.3, 0.7])
+    gamma_p = rng.normal(0, 1, n) * material.tau / material.G * rng.choice([0.0, 10.0], n)
+    return eps_r, eps_t, theta_p, gamma_p
+
+
+@pytest.mark.parametrize(("dilatancy", "cutoff"), [(0.0, None), (20.0, None), (0.0, 2e6)])
+def test_point_kernel_with_compaction_equals_the_numpy_return_map(dilatancy, cutoff):
+    """The kernel's hydrostat (the compaction return in the plastic volumetric strain) against
+    the oracle's loading curve in the total strain (tests/oracles.py), then the same
+    Mohr-Coulomb and cut-off returns. The two compute the compacted pressure by different
+    arithmetic (``K x_tr - K dl`` against ``P_c + K_c (e - e_0)``), so their round-off is of the
+    elastic trial pressure ``K |x_tr|`` (up to ~3 GPa here), which the returns can bring down to a
+    much smaller stress: the stress scale includes it. Measured on this sample (with the apex
+    points): stresses <= 4.9e-14, plastic strains <= 1.8e-14 of their scale, tangents
+    <= 7.8e-15 of K + G: bounds 2e-13 (1e-10 at the apex, as above) and 1e-11."""
+    rng = np.random.default_rng(17)
+    n = 150_000
+    material = point_material(COMPACTING, rng.integers(0, 3, n), dilatancy, cutoff)
+    eps_r, eps_t, theta_p, gamma_p = compaction_points(rng, n, material)
+    kernel = return_map(eps_r, eps_t, theta_p, gamma_p, material)
+    oracle = hencky_mohr_coulomb(eps_r, eps_t, theta_p, gamma_p, material, groups=np.arange(n))
+    assert np.array_equal(kernel["plastic"], oracle.plastic)
+    theta = eps_r + 2.0 * eps_t
+    stress = (np.abs(oracle.tau_r) + np.abs(oracle.tau_t) + material.tau
+              + material.K * np.abs(theta - theta_p))
+    strain = np.abs(eps_r) + np.abs(eps_t) + material.tau / material.K
+    P = -(oracle.tau_r + 2.0 * oracle.tau_t) / 3.0
+    J = np.exp(theta)
+    apex = oracle.plastic & (np.abs(material.lam * P + material.tau * J) <= 1e-9 * stress)
+    tolerance = np.where(apex, 1e-10, 2e-13)
+    for name in ("tau_r", "tau_t"):
+        assert np.all(np.abs(kernel[name] - getattr(oracle, name)) <= tolerance * stress)
+    for name in ("theta_p", "gamma_p"):
+        scale = strain + np.abs(getattr(oracle, name))
+        assert np.all(np.abs(kernel[name] - getattr(oracle, name)) <= tolerance * scale)
+    for i, name in enumerate(("C_rr", "C_rt", "C_tr", "C_tt")):
+        diff = np.abs(kernel[name] - oracle.tangent[i // 2, i % 2]) / (material.K + material.G)
+        assert np.max(diff) <= 1e-11
+    # every branch of the hydrostat is sampled: elastic, the opened volume closing at the crush
+    # pressure, compaction, compacted through the lock, fully compacted (elastic and locked)
+    e = -(eps_r + 2.0 * eps_t)
+    x_l = material.lock_pressure / material.K
+    e_c_lock = material.lock_strain - x_l
+    full = -theta_p >= e_c_lock
+    compacted = oracle.theta_p != theta_p
+    assert np.sum(compacted & (P < material.crush * (1 + 1e-9)) & (theta_p > 0)) > 100
+    assert np.sum(compacted & (e < material.lock_strain) & (P > material.crush * 1.01)) > 1000
+    assert np.sum(compacted & (e > material.lock_strain)) > 1000
+    assert np.sum(full & (e + theta_p > x_l)) > 1000 and np.sum(full & (e + theta_p < x_l)) > 1000
+    assert np.sum(~compacted & ~full & (P > 0)) > 1000
+
+
+def exact_hydrostat(m, path):
+    """The Kirchhoff pressure of the hydrostat along a path of log volumetric strains ``e``
+    (compression positive), written from its definition: loading on ``H(e)``; unloading from
+    the largest strain ``e_max`` elastic, ``H(e_max) - K (e_max - e)``; once past the lock,
+    reversibly on the locked line down to ``x_l = P_l/K`` above the compaction left,
+    ``e_l - x_l``, elastic below."""
+    K, P_c, P_l, e_l, K_l = (m.bulk_modulus, m.crush_pressure, m.lock_pressure, m.lock_strain,
+                             m.locked_modulus)
+    e_0 = P_c / K
+
+    def loading(e):
+        if e <= e_0:
+            return K * e
+        if e <= e_l:
+            return P_c + (P_l - P_c) * (e - e_0) / (e_l - e_0)
+        return P_l + K_l * (e - e_l)
+
+    pressures, e_max = [], 0.0
+    for e in path:
+        e_max = max(e_max, e)
+        if e_max > e_l:
+            left = e_l - P_l / K
+            pressures.append(P_l + K_l * (e - e_l) if e > e_l else K * (e - left))
+        else:
+            pressures.append(loading(e_max) - K * (e_max - e))
+    return np.array(pressures)
+
+
+@pytest.mark.parametrize("uniaxial", [False, True])
+def test_the_kernel_follows_the_exact_hydrostat_on_a_loading_path(uniaxial):
+    """A point driven hydrostatically (``eps_r = eps_t``) or in uniaxial strain (``eps_t = 0``:
+    the cavity's comminuted zone is near it) through crushing, unloading, reloading, locking and
+    unloading from the lock: its pressure is the hydrostat's (:func:`exact_hydrostat`; dilatancy
+    0, so the Mohr-Coulomb and cap returns leave it alone), and in uniaxial strain its deviator is
+    the strength ``min(lam P + tau J, tau_max J)``. Measured: <= 2.6e-16 of the largest
+    pressure, the deviator <= 1.8e-15 of the largest strength: bound 1e-13 (the kernel tests'
+    bound for a different CPU's ``exp``)."""
+    m = replace(hjc_concrete(48e6), tau_max=7.0 * 48e6)
+    e_l = m.lock_strain
+    path = e_l * np.concatenate([np.linspace(0.0, 0.5, 40), np.linspace(0.5, 0.42, 20),
+                                 np.linspace(0.42, 1.6, 80), np.linspace(1.6, 0.65, 60)])
+    material = point_material([m], [0])
+    theta_p = gamma_p = 0.0
+    pressure, deviator = [], []
+    for e in path:
+        eps_r, eps_t = (-e, 0.0) if uniaxial else (-e / 3.0, -e / 3.0)
+        out = return_map(np.array([eps_r]), np.array([eps_t]), np.array([theta_p]),
+                         np.array([gamma_p]), material)
+        theta_p, gamma_p = out["theta_p"][0], out["gamma_p"][0]
+        pressure.append(-(out["tau_r"][0] + 2.0 * out["tau_t"][0]) / 3.0)
+        deviator.append(out["tau_t"][0] - out["tau_r"][0])
+    pressure, deviator = np.array(pressure), np.array(deviator)
+    exact = exact_hydrostat(m, path)
+    assert np.max(np.abs(pressure - exact)) <= 1e-13 * np.max(exact)
+    if uniaxial:
+        J = np.exp(-path)
+        strength = np.minimum(m.lam * pressure + m.tau * J, m.tau_max * J)
+        # past the largest strain so far, beyond the elastic deviator: on the strength
+        first = (path >= np.maximum.accumulate(path)) & (path > 0.0)
+        yielded = first & (2.0 * m.shear_modulus * path > strength)
+        assert yielded.sum() > 80 and np.any(strength[yielded] == m.tau_max * J[yielded])
+        assert np.max(np.abs(deviator[yielded] - strength[yielded])) <= 1e-13 * np.max(strength)
+        assert np.all(deviator <= strength * (1.0 + 1e-13))
+    else:
+        assert np.all(deviator == 0.0)
+    # the path crushed, unloaded from compaction, locked and unloaded below the lock
+    assert np.max(path) > e_l and 0.0 < exact[-1] < 0.5 * m.lock_pressure
+    assert np.min(np.diff(exact)) < 0.0

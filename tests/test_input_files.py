@@ -53,7 +53,8 @@ def config_faults(text):
                    "newline or end of document after a statement)"),
         "unknown key": (text.replace("tau = 6e6", "tau = 6e6\ncolour = 1"),
                         "layers[2].colour is not a known key (accepted: E, bottom, concrete, "
-                        "lam, law_A, law_B, name, nu, rho, scab_depth, sigma_c, tau, tau_max, "
+                        "crush_pressure, lam, law_A, law_B, lock_pressure, lock_strain, "
+                        "locked_modulus, name, nu, rho, scab_depth, sigma_c, tau, tau_max, "
                         "tensile_strength, thickness, tunnel_wall)"),
         "missing key": (text.replace("lam = 0.50\n", ""), "layers[2].lam is missing (required)"),
         "wrong type": (text.replace("E = 25e9", 'E = "x"'),

@@ -80,13 +80,15 @@ def source(shot):
 
 def grid_depths(shots, point):
     """Depths (m) of the model for ``shots`` with ``(S_max, p_l) = point`` (NaN where the cavity
-    expansion has no self-similar solution: the point is then left out of the fits)."""
+    expansion has no self-similar solution, or where the hydrostat has no compaction range for
+    that concrete, ``p_l`` above the elastic line at HJC's ``mu_l``: the point is then left out
+    of the fits)."""
     constants = Constants().with_values(FITTED, point)
     out = []
     for s in shots:
         try:
             out.append(round_significant(table_depth(s, TableResistance(s, constants)), DIGITS))
-        except CavexNumericalError:
+        except (CavexInputError, CavexNumericalError):
             out.append(math.nan)
     return out
 
