@@ -30,6 +30,7 @@ import sys
 import numpy as np
 
 from cavex.analytic.models import fly
+from cavex.analytic.penetration.low_pass import low_pass
 from cavex.analytic.penetration.oblique import PEAK_SPAN, Strike, overload_peaks, peaks
 from cavex.analytic.penetration.refinement import (
     PEAK_TOLERANCE,
@@ -462,23 +463,6 @@ def turn_after_interface(result, interface=1):
     if k is None or k + 1 >= len(result.phases):
         return None
     return result.phases[k + 1]["end_pitch_deg"] - result.phases[k]["end_pitch_deg"]
-
-
-def low_pass(history, length):
-    """Lateral overload averaged over the time the body takes to travel ``length`` (the nose
-    length) around each sample (trapezoidal mean over ``[t - T/2, t + T/2]``, ``T = length /
-    speed``): the raw samples switch with the shank's contact."""
-    t, g, v = history["t_s"], history["lateral_g"], history["speed_m_s"]
-    out = np.empty_like(g)
-    for i in range(t.size):
-        half = 0.5 * length / max(v[i], 1e-9)
-        lo, hi = t[i] - half, t[i] + half
-        grid = np.concatenate([[max(lo, t[0])], t[(t > lo) & (t < hi)], [min(hi, t[-1])]])
-        values = np.interp(grid, t, g)
-        span = grid[-1] - grid[0]
-        area = float(np.sum(0.5 * (values[1:] + values[:-1]) * np.diff(grid)))
-        out[i] = area / span if span > 0 else g[i]
-    return out
 
 
 SHOT = Strike(600.0, obliquity=20.0)  # the paper's shot that reaches the first interface
