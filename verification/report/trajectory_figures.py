@@ -437,6 +437,9 @@ def view_3d(job, path):
     # is either on the block's back walls or in front of them, so no depth sorting is needed
     ax = fig.add_axes((0.0, 0.12, 1.0, 0.78), projection="3d", computed_zorder=False)
     handles = draw_view_3d(ax, job)
+    rows = math.ceil(len(handles) / 2)  # the legend's rows below the axes (0.19 in each)
+    bottom = (0.45 + 0.19 * rows) / VIEW_3D_SIZE_IN[1]  # and the x label above it
+    ax.set_position((0.0, bottom, 1.0, 0.9 - bottom))
     fig.suptitle(shot_title(job).replace("; ", "\n") + "\nx: horizontal in the plane of obliquity; "
                  "the block cut open along it", fontsize=9, y=0.985)
     fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=min(len(handles), 2),
@@ -501,5 +504,5 @@ def draw_view_3d(ax, job):
     ax.tick_params(labelsize=8, pad=1)
     ax.set_xlabel("x (m)", fontsize=8, labelpad=6)
     ax.set_ylabel("y (m)", fontsize=8, labelpad=4)
-    ax.set_zlabel("depth z (m)", fontsize=8, labelpad=6)
+    ax.set_zlabel("depth z (m)", fontsize=8, labelpad=9)
     return handles
