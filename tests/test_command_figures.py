@@ -62,7 +62,8 @@ class Drawn:
 
 
 def figure_words(fig):
-    """Every text of ``fig``: figure and axes texts, titles, axis labels, legend entries."""
+    """Every text of ``fig``: figure and axes texts, titles, axis labels, legend entries (its
+    words, a wrapped line joined)."""
     texts = [t.get_text() for t in fig.texts]
     for legend in fig.legends:
         texts += [t.get_text() for t in legend.get_texts()]
@@ -71,7 +72,7 @@ def figure_words(fig):
         texts += [t.get_text() for t in ax.texts]
         if ax.get_legend() is not None:
             texts += [t.get_text() for t in ax.get_legend().get_texts()]
-    return " ".join(texts)
+    return " ".join(" ".join(texts).split())
 
 
 def data_lines(ax):
