@@ -244,7 +244,8 @@ def draw_pitch(ax, job):
     moving = turning_runs(job)
     for k, name, result in moving:
         h = result.history
-        ax.plot(h["t_s"] * 1e3, h["pitch_deg"], color=f"C{k}", label=legend_label(job, name))
+        ax.plot(h["t_s"] * 1e3, h["pitch_deg"], color=f"C{k}",
+                label=textwrap.fill(legend_label(job, name), 18))  # the right margin's width
         for ph in result.phases[:-1]:
             ax.axvline(ph["end_time_s"] * 1e3, color=f"C{k}", lw=0.6, ls=":")
     if moving:
