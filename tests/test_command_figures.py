@@ -35,14 +35,44 @@ class Drawn:
     def __init__(self):
         self.checked = {}
         self.limits_3d = {}
+        self.words = {}  # per figure: every text drawn (labels, titles, notes, legends)
+        self.axes = {}  # per figure: per axes {xlabel, lines (x data), shaded spans}
+        self.legend_styles = {}  # per figure: its figure legend's (label, linestyle)
 
     def wrap(self, original):
         def save(fig, path, **kwargs):
-            self.checked[Path(path).name] = check_axes(fig)
-            self.limits_3d.update({Path(path).name: (ax.get_xlim(), ax.get_ylim(), ax.get_zlim())
-                                   for ax in fig.axes if ax.name == "3d"})
+            name = Path(path).name
+            self.checked[name] = check_axes(fig)
+            for ax in fig.axes:
+                if ax.name == "3d":
+                    self.limits_3d[name] = (ax.get_xlim(), ax.get_ylim(), ax.get_zlim())
+            self.words[name] = figure_words(fig)
+            self.axes[name] = [{"xlabel": ax.get_xlabel(),
+                                "x": [np.asarray(x, dtype=float) for x, _ in data_lines(ax)],
+                                "spans": sum(type(p).__name__ in ("Rectangle", "Polygon")
+                                             for p in ax.patches)}
+                               for ax in fig.axes if ax.name != "3d"]
+            self.legend_styles[name] = [(t.get_text(), h.get_linestyle())
+                                        for legend in fig.legends
+                                        for t, h in zip(legend.get_texts(),
+                                                        legend.legend_handles, strict=True)
+                                        if hasattr(h, "get_linestyle")]
             return original(fig, path, **kwargs)
         return save
+
+
+def figure_words(fig):
+    """Every text of ``fig``: figure and axes texts, titles, axis labels, legend entries (its
+    words, a wrapped line joined)."""
+    texts = [t.get_text() for t in fig.texts]
+    for legend in fig.legends:
+        texts += [t.get_text() for t in legend.get_texts()]
+    for ax in fig.axes:
+        texts += [ax.get_title(), ax.get_title(loc="left"), ax.get_xlabel(), ax.get_ylabel()]
+        texts += [t.get_text() for t in ax.texts]
+        if ax.get_legend() is not None:
+            texts += [t.get_text() for t in ax.get_legend().get_texts()]
+    return " ".join(" ".join(texts).split())
 
 
 def data_lines(ax):
@@ -196,10 +226,16 @@ def test_trajectory_figures(capsys, tmp_path, drawn, case, argv, config):
     assert drawn.checked["path_3d.png"] == 1
     for name in drawn.checked:
         not_blank(out / name)
-    # the whole target in the 3-D view: the surface and every interface inside the depth range
+    # the 3-D block holds the surface and every interface the path reaches; the layers below
+    # it are named in its legend (a ricochet's block is not the whole target, issue 33)
     target, _ = load_config(tmp_path / "target.toml" if config else None)
     (_, _, (bottom, top)) = drawn.limits_3d["path_3d.png"]  # depth downward
-    assert top < 0.0 <= max(target.interface_depths, default=0.0) < bottom
+    deepest = np.loadtxt(out / "history_runway.csv", delimiter=",", skiprows=1,
+                         usecols=6).max()
+    assert top < 0.0 < deepest < bottom
+    for name, H in zip(target.layer_names()[1:], target.interface_depths, strict=True):
+        assert (top < H < bottom) or (H > deepest and f"below the block: {name}"
+                                      in drawn.words["path_3d.png"]), (name, H, bottom)
 
 
 @pytest.mark.parametrize(("case", "strike"), [
@@ -231,6 +267,76 @@ def test_a_normal_shot_draws_notes_not_round_off(tmp_path, drawn, capsys):
     capsys.readouterr()
     assert drawn.checked["pitch_time.png"] == 0  # a note only
     assert drawn.checked["overload.png"] == 2  # the axial row; the lateral row is a note
+
+
+def test_a_ricochet_is_drawn_to_its_own_scale(tmp_path, drawn, capsys):
+    """Issue 33: the 75 deg, 300 m/s ricochet (the nose tip 9 mm deep at most) once sat in a
+    1.2 m block and its overload against depth was a loop. Its block now scales with the body
+    (0.15 m long): no side beyond 4 body lengths (it was 8 deep); the overloads are drawn
+    against the nose tip's path length, which only grows; the lateral overload has its mean
+    over one nose length drawn and the steps of its samples explained; the side view's two
+    legend entries of a run differ in style."""
+    from cavex.config import load_config
+
+    out = tmp_path / "t"
+    assert main(["trajectory", "--obliquity", "75", "--velocity", "300", "--out", str(out),
+                 "--no-progress"]) == 0
+    assert "ricochet" in capsys.readouterr().out
+    _, projectile = load_config()
+    length = projectile.body_length
+    sides = [abs(hi - lo) for lo, hi in drawn.limits_3d["path_3d.png"]]
+    assert max(sides) <= 4.0 * length, (sides, length)
+    assert "below the block: macadam" in drawn.words["path_3d.png"]
+    depth_panels = [a for a in drawn.axes["overload.png"] if "path length" in a["xlabel"]]
+    assert len(depth_panels) == 2  # axial and lateral
+    for panel in depth_panels:
+        assert all(np.all(np.diff(x) >= 0.0) for x in panel["x"])
+    assert "mean over one nose length" in drawn.words["overload.png"]
+    styles = dict(drawn.legend_styles["path_side.png"])
+    assert styles["runway: centre of mass"] != styles[
+        "runway: outline at 9 equal time intervals"]
+
+
+def test_overloads_shade_the_open_zones(tmp_path, drawn, capsys):
+    """Issue 33: a debonded shot's overload figure shades its open zones (craters and rear
+    zones at the interfaces) on every panel, as the study's figures do; a bonded one has none
+    to shade."""
+    out = tmp_path / "t"
+    assert main(["trajectory", "--obliquity", "20", "--velocity", "600", "--interfaces",
+                 "debonded", "--out", str(out), "--no-progress"]) == 0
+    capsys.readouterr()
+    assert "shaded: open zones" in drawn.words["overload.png"]
+    assert all(a["spans"] >= 1 for a in drawn.axes["overload.png"])
+    assert main(["trajectory", "--obliquity", "20", "--velocity", "600", "--out",
+                 str(tmp_path / "b"), "--no-progress"]) == 0
+    capsys.readouterr()
+    assert "shaded" not in drawn.words["overload.png"]
+    assert all(a["spans"] == 0 for a in drawn.axes["overload.png"])
+
+
+def test_the_homogeneous_run_says_it_has_no_interfaces(tmp_path, drawn, capsys):
+    """Issue 33: with --compare-homogeneous the concrete-only shot is drawn past the first
+    interface: its legend says the first layer is its material throughout, and the layers
+    below are marked as the layered target's only."""
+    assert main(["trajectory", "--obliquity", "20", "--velocity", "600",
+                 "--compare-homogeneous", "--out", str(tmp_path / "t"), "--no-progress"]) == 0
+    capsys.readouterr()
+    words = drawn.words["path_side.png"]
+    assert "first layer only (concrete throughout)" in words
+    assert "macadam (runway only)" in words
+    assert "first layer only (concrete throughout)" in drawn.words["overload.png"]
+
+
+@pytest.mark.parametrize(("argv", "noted"), [
+    (["--resistance", "law", "--law-A", "1e8", "--law-B", "2000"], True), ([], False)])
+def test_penetrate_says_when_the_two_curves_coincide(tmp_path, drawn, capsys, argv, noted):
+    """Issue 33: the global plain law is one law in every layer, so the layered run and the
+    first layer alone are one curve (measured: 2.2e-6 of the depth apart): both figures say
+    so; the default runs differ (6.8e-2) and say nothing."""
+    assert main(["penetrate", *argv, "--out", str(tmp_path / "p")]) == 0
+    capsys.readouterr()
+    for name in ("velocity_time.png", "deceleration_depth.png"):
+        assert ("one curve, drawn on each other" in drawn.words[name]) is noted
 
 
 @pytest.mark.parametrize("calibrated", [True, False])

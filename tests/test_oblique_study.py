@@ -4,6 +4,7 @@ input: every shot at the default discretisation and refined, each number with it
 import csv
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from cavex.verification.studies.oblique_study import (
@@ -114,3 +115,117 @@ def test_committed_debonded_low_pass_peaks():
     for row in rows:
         raw, mean = float(row["max_lateral_g"]), float(row["max_lateral_low_pass_g"])
         assert mean <= raw * (1.0 + 1e-2) + 1.0  # 3 digits each; 1 g the noise floor
+
+
+def _study_rows(name):
+    """The committed study.csv of ``results/oblique/<name>`` as the study's result dicts
+    (numbers as floats, "-" as None)."""
+    path = Path(__file__).resolve().parents[1] / "results" / "oblique" / name / "study.csv"
+    rows = []
+    for row in csv.DictReader(path.open()):
+        entry = {}
+        for key, value in row.items():
+            try:
+                entry[key] = float(value)
+            except ValueError:
+                entry[key] = None if value == "-" else value
+        rows.append(entry)
+    return rows
+
+
+def _boxes_overlap(artists, renderer):
+    boxes = [a.get_window_extent(renderer) for a in artists if a.get_text()]
+    return any(a.overlaps(b) for i, a in enumerate(boxes) for b in boxes[i + 1:])
+
+
+def test_pitch_change_gives_the_turn_over_its_own_panel(tmp_path, monkeypatch):
+    """Issue 33: the debonded 45 deg turn-over (~50 deg) squashed the other added turns
+    (within +-1.3 deg) to a line. Now it is drawn in a panel of its own above them, the lower
+    panel spans at most 4 deg, and the two panels' titles do not overlap; the bonded study
+    (no such gap) keeps one panel per quantity."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from cavex.verification.studies import oblique_study
+
+    saved = {}
+    monkeypatch.setattr(oblique_study, "save_figure",
+                        lambda fig, path, **_: saved.setdefault(path.parent.name, fig))
+    for name in ("debonded", "bonded"):
+        folder = tmp_path / name
+        folder.mkdir()
+        rows = _study_rows("debonded" if name == "debonded" else "")
+        oblique_study.pitch_change_figure(rows, folder, plt)
+    fig = saved["debonded"]
+    fig.canvas.draw()
+    assert len(fig.axes) == 4  # two quantities, each a broken axis
+    added = oblique_study._added(_study_rows("debonded"), "default")
+    large = max(added.values())
+    low, high = fig.axes[2].get_ylim()  # the added turn's lower panel
+    assert high - low <= 4.0 and large > 40.0
+    upper_low, upper_high = fig.axes[3].get_ylim()
+    assert upper_low < 13.0 and large < upper_high  # the 45 deg turns in the upper panel
+    titles = [ax.title for ax in fig.axes if ax.get_title()]
+    assert len(titles) == 2 and not _boxes_overlap(titles, fig.canvas.get_renderer())
+    assert len(saved["bonded"].axes) == 2
+
+
+def test_symlog_axis_labels_both_sides_of_zero():
+    """Issue 33: the debonded study's symmetric-log axes had no labelled negative tick. Data
+    from -1.2 to 50 get -1, -0.5, 0, 0.5, 1, 10 (and 100 if in view), each labelled."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from cavex.verification.studies.study_axes import symlog_axis
+
+    fig, ax = plt.subplots()
+    values = [-1.2, -0.3, 0.1, 0.28, 13.0, 50.0]
+    ax.plot(range(len(values)), values)
+    symlog_axis(ax, values)
+    fig.canvas.draw()
+    labels = {t.get_text() for t in ax.get_yticklabels() if t.get_text()}
+    assert {"-1", "-0.5", "0", "0.5", "1", "10"} <= labels
+    low, high = ax.get_ylim()
+    assert low <= min(values) and max(values) <= high
+    plt.close(fig)
+
+
+def test_sensitivity_figure_labels_do_not_overlap_and_an_empty_panel_says_why(tmp_path,
+                                                                              monkeypatch):
+    """Issue 33: the two rows' long y labels overlapped and the crater column's peak panel was
+    empty (no crater size gives an interface peak). Now each panel's title names the answer,
+    no two y labels of a column overlap, and the empty panel holds a note."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from cavex.verification.studies import oblique_study
+
+    numbers = {}
+    for v, added, peak in ((1.5, 0.05, None), (2.12, 0.09, None), (2.5, 0.2, (0.67, 1.07e4)),
+                           (3.0, -0.45, (0.66, 1.071e4)), (3.5, 48.0, (0.66, 1.056e4))):
+        numbers[("rear zone (calibres)", v)] = {"added": (added, added * 0.9),
+                                                "peak": (peak, peak)}
+    for v in (3.0, 4.0, 4.5, 5.0, 6.0):
+        numbers[("crater (shank radii)", v)] = {"added": (0.0948, 0.0961),
+                                                "peak": (None, None)}
+    saved = {}
+    monkeypatch.setattr(oblique_study, "save_figure",
+                        lambda fig, path, **_: saved.setdefault("fig", fig))
+    oblique_study.sensitivity_figure(tmp_path, numbers, plt)
+    fig = saved["fig"]
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    axes = np.array(fig.axes).reshape(2, 2)
+    for col in range(2):
+        assert not _boxes_overlap([axes[0, col].yaxis.label, axes[1, col].yaxis.label],
+                                  renderer)
+    assert "no axial peak" in " ".join(t.get_text() for t in axes[1, 1].texts)
+    assert axes[0, 0].get_yscale() == "symlog"
+    assert any(t.get_text().startswith("-") for t in axes[0, 0].get_yticklabels())
+    plt.close(fig)

@@ -201,3 +201,46 @@ def test_markdown_to_html_is_self_contained(tmp_path):
     assert cells["+1.234 %"] == cells["600 / 0.685"] == cells["1.5e-03"] == "num"
     assert cells["x"] is None and cells["long text cell"] is None
     assert '<a href="#other">Other</a>' in html
+
+
+def test_stress_figure_warns_when_V_outruns_a_layers_elastic_wave(tmp_path, monkeypatch):
+    """Issue 33: a user's target whose subgrade (E 50 MPa, nu 0.3, rho 1600: c_p = 205 m/s)
+    is slower than the 600 m/s of verify's stress figure showed jagged FE fields without a
+    word. The figure and its caption (verify's text output) now warn, naming the layer and
+    its c_p = sqrt((K + 4G/3)/rho); the paper's target (slowest c_p 11 km/s) gets none."""
+    from dataclasses import replace
+
+    from cavex.materials import Target
+    from cavex.verification.output import files
+    from cavex.verification.report import picture
+
+    target, _ = load_config()
+    named = [replace(layer, name=name) for layer, name in zip(
+        target.layers, ("asphalt", "crushed stone base", "subgrade"), strict=True)]
+    soft = replace(named[2], E=50e6, nu=0.3)
+    user = Target((*named[:2], soft), target.thicknesses)
+    c_p = picture.elastic_wave_speed(soft)
+    G, K = soft.E / (2.0 * 1.3), soft.E / (3.0 * 0.4)
+    assert c_p == pytest.approx(np.sqrt((K + 4.0 * G / 3.0) / 1600.0), rel=1e-12)
+    assert 200.0 < c_p < 210.0
+    warning = picture.wave_speed_warning(user, 600.0)
+    assert warning is not None and f"({c_p:.0f} m/s)" in warning
+    assert user.layer_names()[2] in warning and user.layer_names()[0] not in warning
+    assert picture.wave_speed_warning(target, 600.0) is None
+    assert picture.wave_speed_warning(user, 600.0, names=user.layer_names()[:2]) is None
+    r = np.geomspace(0.0125, 0.5, 200)
+    fields = {"r": r, "sigma_r": 1e9 * (0.0125 / r) ** 2, "sigma_theta": 5e8 * (0.0125 / r) ** 2,
+              "layer": np.where(r < 0.3, 1, 2), "a": 0.0125, "b": 0.06, "interfaces": [0.3],
+              "layers": user.layer_names()[1:], "cavity_stress": 1e9,
+              "closed_form": {"dynamic": {"b": 0.05, "stress": 1.1e9, "state": "f"},
+                              "quasi-static": {"b": 0.1, "stress": 1.2e9, "state": "f"}}}
+    drawn = {}
+    monkeypatch.setattr(files, "save_figure", lambda fig, path, **_: drawn.setdefault(
+        "texts", " ".join(t.get_text() for t in fig.texts)) and path)
+    picture.plot_stresses(fields, tmp_path / "s.png", "title", warning)
+    assert "exceeds the elastic wave speed" in drawn["texts"].replace("\n", " ")
+    # verify's text output and report.md carry make_picture's caption: the warning is in it
+    monkeypatch.setattr(picture, "fe_fields", lambda *args: fields)
+    path, caption = picture.make_picture(user, load_config()[1], 600.0, 0.7,
+                                         tmp_path / "t.png")
+    assert path is not None and caption.endswith(warning)

@@ -47,6 +47,48 @@ def subtitle(job):
     return textwrap.fill(words, 70)
 
 
+#: The two runs' curves are called identical when their depths at every common time differ by
+#: less than this fraction of the final depth: far below a pixel (1/600 of an axis), far
+#: above the interpolation between the runs' own samples (measured: 2.2e-6 for the global
+#: plain law, whose runs are the same; 6.8e-2 for the default derived runs, which differ).
+SAME_CURVES = 1e-4
+
+
+def same_curves(job):
+    """Whether the layered run and its first layer alone coincide (:data:`SAME_CURVES`):
+    the layered target's resistance does not depend on the layer (``--resistance law`` with
+    the global ``--law-A/--law-B``: one law everywhere). The first layer alone's depth is
+    interpolated at the layered run's times by the cubic Hermite of its depths and
+    velocities (``dL/dt = V``)."""
+    import numpy as np
+    from scipy.interpolate import CubicHermiteSpline
+
+    runway, single = job["runs"]["runway"], job["runs"]["first_layer_only"]
+    end = max(float(runway.depth[-1]), float(single.depth[-1]))
+    if abs(float(runway.depth[-1]) - float(single.depth[-1])) > SAME_CURVES * end:
+        return False
+    t, k = np.unique(single.t, return_index=True)  # a phase end is sampled twice
+    depth = CubicHermiteSpline(t, single.depth[k], single.velocity[k])
+    inside = runway.t <= t[-1]
+    gap = np.abs(depth(runway.t[inside]) - runway.depth[inside])
+    return bool(np.max(gap, initial=0.0) <= SAME_CURVES * end)
+
+
+def note_same_curves(ax, job):
+    """Where the two runs coincide (:func:`same_curves`), say so inside ``ax``: otherwise
+    the dashed curve of the first layer alone hides the layered one without a word."""
+    if not same_curves(job):
+        return
+    runway_label, single_label = _labels(job)
+    why = (" (the global --law-A/--law-B is one law in every layer)"
+           if isinstance(job.get("law"), dict) else "")
+    ax.text(0.98, 0.97, textwrap.fill(f"{runway_label} and {single_label}: one curve, "
+                                      f"drawn on each other{why}", 42),
+            transform=ax.transAxes, ha="right", va="top", multialignment="left",
+            fontsize=8.5, color="0.2",
+            bbox={"boxstyle": "round", "facecolor": "white", "edgecolor": "0.6"})
+
+
 def draw_velocity(ax, job):
     """On ``ax``: velocity against time of the runway and of its first layer alone (dashed),
     titled with the resistance (``job["title"]``), the legend below the axes."""
@@ -55,6 +97,7 @@ def draw_velocity(ax, job):
     ax.plot(runway.t * 1e3, runway.velocity, label=runway_label)
     ax.plot(single.t * 1e3, single.velocity, "--", label=single_label)
     ax.set(xlabel="time (ms)", ylabel="velocity (m/s)")
+    note_same_curves(ax, job)
     ax.set_title(f"Velocity against time\n{subtitle(job)}", fontsize=10)
     legend_below(ax)
 
@@ -74,6 +117,7 @@ def draw_deceleration(ax, job):
     ax.set_xlim(left, right)
     rows = layer_names(ax, job.get("layer_names", []), bounds)
     ax.set(xlabel="nose-tip depth (m)", ylabel=r"deceleration ($10^3$ g)")
+    note_same_curves(ax, job)
     ax.set_title(f"Deceleration against depth\n{subtitle(job)}", fontsize=10,
                  pad=14 + NAME_ROW_PT * (rows - 1))
     legend_below(ax)

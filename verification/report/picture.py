@@ -66,6 +66,30 @@ def fe_fields(target, projectile, velocity, depth, numerics=None, nu=None):
             "cavity_stress": result.cavity_stress, "closed_form": closed}
 
 
+def elastic_wave_speed(layer):
+    """The layer's elastic (dilatational) wave speed ``c_p = sqrt((K + 4 G / 3) / rho)``
+    (m/s): the fastest signal in the elastic solid."""
+    return float(np.sqrt((layer.bulk_modulus + 4.0 * layer.shear_modulus / 3.0) / layer.rho))
+
+
+def wave_speed_warning(target, velocity, names=None):
+    """One sentence when the expansion velocity exceeds a layer's elastic wave speed
+    (:func:`elastic_wave_speed`), naming the layers (of ``names``, default every layer) and
+    their speeds; None otherwise. The cavity then outruns every elastic signal in that layer:
+    the FE fields there are a shock the mesh resolves as jagged steps, and the closed form's
+    elastic zone (a wave speed far above V) does not describe it."""
+    names = names if names is not None else target.layer_names()
+    fast = [(name, elastic_wave_speed(layer))
+            for name, layer in zip(target.layer_names(), target.layers, strict=True)
+            if name in names and velocity > elastic_wave_speed(layer)]
+    if not fast:
+        return None
+    which = ", ".join(f"{name} ({c:.0f} m/s)" for name, c in fast)
+    return (f"warning: V = {velocity:g} m/s exceeds the elastic wave speed c_p = sqrt((K + "
+            f"4G/3)/rho) of {which}: the cavity outruns every elastic signal there, so the FE "
+            "fields are a shock (jagged on the mesh) and the closed form does not apply")
+
+
 def picture_extent(fields):
     """Outer radius of the figure: beyond every ``b`` and the first interface, inside the mesh."""
     radii = [fields["b"], *(c["b"] for c in fields["closed_form"].values()), 2.0 * fields["a"]]
@@ -73,8 +97,9 @@ def picture_extent(fields):
     return min(EXTENT_FACTOR * max(r for r in radii if np.isfinite(r)), float(fields["r"][-1]))
 
 
-def plot_stresses(fields, path, title):
-    """Draw the stress figure to ``path`` (PNG); raises if drawing fails."""
+def plot_stresses(fields, path, title, warning=None):
+    """Draw the stress figure to ``path`` (PNG), with ``warning`` (one sentence, e.g.
+    :func:`wave_speed_warning`) in a box under the title; raises if drawing fails."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -121,7 +146,18 @@ def plot_stresses(fields, path, title):
                   f"{mm * a:g} mm)", ylabel="stress (MPa, compression positive)")
     ax.set_title(title, pad=16)
     ax.legend(fontsize=7.5, loc="upper right")
-    fig.tight_layout()
+    if warning:
+        import textwrap
+
+        text = textwrap.fill(warning, 110)
+        room = 0.16 * (text.count("\n") + 1) + 0.15  # in: the box's lines and padding
+        fig.set_figheight(fig.get_figheight() + room)
+        fig.text(0.5, 1.0 - 0.04 / fig.get_figheight(), text, ha="center", va="top",
+                 fontsize=8, color="darkred", bbox={"boxstyle": "round", "facecolor": "#fff0f0",
+                                                    "edgecolor": "darkred"})
+        fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - room / fig.get_figheight()))
+    else:
+        fig.tight_layout()
     return save_figure(fig, path, dpi=110)
 
 
@@ -146,9 +182,12 @@ def make_picture(target, projectile, velocity, depth, path, numerics=None, nu=No
                f"{closed['dynamic']['state']}) and {closed['quasi-static']['b'] * 1e3:.1f} mm "
                f"(quasi-static, state {closed['quasi-static']['state']}); FE wall stress "
                f"{fields['cavity_stress'] / 1e6:.1f} MPa (cavity a = {fields['a'] * 1e3:g} mm)")
+    warning = wave_speed_warning(target, velocity, fields["layers"])
+    if warning:
+        caption += "; " + warning
     try:
         plot_stresses(fields, path, f"Stresses around the cavity, V = {velocity:g} m/s, "
-                                    f"L = {depth:.3f} m")
+                                    f"L = {depth:.3f} m", warning)
     except Exception as exc:  # noqa: BLE001 - any plotting failure is reported in one line
         return None, f"stress figure not drawn ({first_line(exc)})"
     return path, caption

@@ -53,13 +53,17 @@ def margins(fig, left, right, top, bottom, **space):
                         bottom=bottom / height, **space)
 
 
-def _layer_names(ax, target):
+def _layer_names(ax, target, only=None):
     """Each layer's name at the right edge of a side view, in the middle of the part of its
-    depth range that is in view (only the layers in view)."""
+    depth range that is in view (only the layers in view); ``only``: the words of the run the
+    layers below the first belong to (a homogeneous run beside it flies through the first
+    layer's material there: "macadam (runway only)")."""
     tops = [0.0, *target.interface_depths, math.inf]
     deep, shallow = ax.get_ylim()  # the axis is inverted: ylim = (deepest, shallowest)
     for k, name in enumerate(target.layer_names()):
         low, high = max(tops[k], shallow, 0.0), min(tops[k + 1], deep)
+        if k > 0 and only:
+            name = f"{name} ({only} only)"
         if high > low:
             fit_right(ax.text(1.01, 0.5 * (low + high), name,
                               transform=ax.get_yaxis_transform(), va="center", fontsize=8,
@@ -131,11 +135,13 @@ def draw_side_view(ax, job, curves=None):
     target = job["target"]
     curves, ((x0, x1), (z0, z1)) = side_view_curves(job) if curves is None else curves
     for name, color, h, outlines in curves:
-        label = run_label(job, name)
-        ax.plot(h["cg_x_m"], h["cg_z_m"], color=color, lw=1, label=f"{label}: centre of mass")
+        label = legend_label(job, name)
+        ax.plot(h["cg_x_m"], h["cg_z_m"], color=color, lw=1.3, ls=(0, (5, 2, 1, 2)),
+                label=f"{label}: centre of mass")
         for k, (ox, oz) in enumerate(outlines):
             ax.plot(ox, oz, color=color, lw=0.8,
-                    label=f"{label}: outline at 9 equal time intervals" if k == 0 else None)
+                    label=f"{label}: outline at 9 equal time intervals" if k == 0
+                    else None)
     for depth in target.interface_depths:
         if z0 < depth < z1:
             ax.axhline(depth, color="0.5", lw=0.8, ls="--")
@@ -143,7 +149,7 @@ def draw_side_view(ax, job, curves=None):
     ax.set_xlim(x0, x1)
     ax.set_ylim(z1, z0)  # depth downward
     ax.set_aspect("equal")
-    _layer_names(ax, target)
+    _layer_names(ax, target, run_label(job, "runway") if HOMOGENEOUS in job["runs"] else None)
     ax.set_xlabel("x (m, horizontal, plane of obliquity)")
     ax.set_ylabel("z (m, depth)")
 
@@ -169,6 +175,20 @@ def side_view(job, path):
     fig.legend(*ax.get_legend_handles_labels(), fontsize=8, loc="lower center",
                bbox_to_anchor=(0.5, 0.0), frameon=False)
     return save_figure(fig, path, dpi=120)
+
+
+HOMOGENEOUS = "first layer only"  # the run of --compare-homogeneous
+
+
+def legend_label(job, name):
+    """The run's words in a figure's legend (:func:`run_label`); the homogeneous run of
+    ``--compare-homogeneous`` says that its target is the first layer throughout, so that its
+    curve drawn past an interface of the layered target is not read as flying through the next
+    layer."""
+    label = run_label(job, name)
+    if name == HOMOGENEOUS:
+        label += f" ({job['target'].layer_names()[0]} throughout)"
+    return label
 
 
 def run_label(job, name):
@@ -224,7 +244,8 @@ def draw_pitch(ax, job):
     moving = turning_runs(job)
     for k, name, result in moving:
         h = result.history
-        ax.plot(h["t_s"] * 1e3, h["pitch_deg"], color=f"C{k}", label=run_label(job, name))
+        ax.plot(h["t_s"] * 1e3, h["pitch_deg"], color=f"C{k}",
+                label=textwrap.fill(legend_label(job, name), 18))  # the right margin's width
         for ph in result.phases[:-1]:
             ax.axvline(ph["end_time_s"] * 1e3, color=f"C{k}", lw=0.6, ls=":")
     if moving:
@@ -263,14 +284,57 @@ def overloads(job, path):
     return save_figure(fig, path, dpi=120)
 
 
+#: The nose tip rising again by more than this fraction of its depth range (a ricochet): the
+#: overloads are drawn against the nose tip's path length, on which a curve does not fold back.
+TURN_BACK = 0.02
+
+
+def depth_turns_back(history):
+    """Whether the nose-tip depth falls back from its running maximum by more than
+    :data:`TURN_BACK` of its range."""
+    z = np.asarray(history["tip_z_m"])
+    return float(np.max(np.maximum.accumulate(z) - z)) > TURN_BACK * max(float(np.ptp(z)), 1e-12)
+
+
+def path_length(history):
+    """The nose tip's path length ``s_i = sum_{j <= i} |x_tip,j - x_tip,j-1|`` (m)."""
+    tip = np.stack([history[f"tip_{c}_m"] for c in "xyz"], axis=-1)
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(tip, axis=0), axis=-1))])
+
+
+def zone_spans(x, depth, zones):
+    """``[(x0, x1)]``: the stretches of ``x`` (time, depth or path length, one value a sample)
+    where the nose-tip ``depth`` lies in one of ``zones`` (``(top, bottom)`` depths, m)."""
+    spans = []
+    for top, bottom in zones:
+        inside = np.flatnonzero((depth >= top) & (depth <= bottom))
+        if inside.size:
+            runs = np.split(inside, np.flatnonzero(np.diff(inside) > 1) + 1)
+            spans += [(float(x[r[0]]), float(x[r[-1]])) for r in runs if r[-1] > r[0]]
+    return spans
+
+
+def open_zones_of(job):
+    """The layered run's zones (debonded interfaces' craters and rear zones, the entry crater;
+    none for a bonded target): ``model.zones``, ``(top, bottom)`` depths (m)."""
+    return [tuple(z) for z in getattr(job["runs"]["runway"].model, "zones", [])]
+
+
 def draw_overload_row(ax_time, ax_depth, job, key):
     """The overload ``key`` ("axial_g" or "lateral_g") of every run against time on
-    ``ax_time`` and against nose-tip depth on ``ax_depth`` (the interfaces dashed); a note
-    instead of the lateral curves where they stay below :data:`LATERAL_ROUNDOFF` of the axial
-    peak."""
+    ``ax_time`` and against nose-tip depth on ``ax_depth`` (the interfaces dashed; against the
+    nose tip's path length when the tip rises again, :func:`depth_turns_back`: against depth
+    the curve would fold back), the open zones of the layered run shaded; the lateral
+    overload as its samples (thin) and their mean over one nose length (thick,
+    :func:`~cavex.analytic.penetration.low_pass.low_pass`): the samples step where discrete
+    surface points enter and leave contact. A note instead of the lateral curves where they
+    stay below :data:`LATERAL_ROUNDOFF` of the axial peak."""
     from matplotlib.ticker import MaxNLocator
 
+    from cavex.analytic.penetration.low_pass import low_pass
+
     runs = list(job["runs"].items())
+    along_path = any(depth_turns_back(r.history) for _, r in runs)
     shown = 0
     for k, (name, result) in enumerate(runs):
         h = result.history
@@ -278,19 +342,43 @@ def draw_overload_row(ax_time, ax_depth, job, key):
         if key == "lateral_g" and np.max(np.abs(h[key])) < LATERAL_ROUNDOFF * peak:
             continue
         shown += 1
-        ax_time.plot(h["t_s"] * 1e3, h[key] / 1e3, color=f"C{k}", label=run_label(job, name))
-        ax_depth.plot(h["tip_z_m"], h[key] / 1e3, color=f"C{k}", label=run_label(job, name))
+        x = path_length(h) if along_path else h["tip_z_m"]
+        label = legend_label(job, name)
+        if key == "lateral_g":
+            mean = low_pass(h, result.model.body.nose_length)
+            for a, abscissa in ((ax_time, h["t_s"] * 1e3), (ax_depth, x)):
+                a.plot(abscissa, h[key] / 1e3, color=f"C{k}", lw=0.6, alpha=0.45)
+                a.plot(abscissa, mean / 1e3, color=f"C{k}", lw=1.6, label=label)
+        else:
+            ax_time.plot(h["t_s"] * 1e3, h[key] / 1e3, color=f"C{k}", label=label)
+            ax_depth.plot(x, h[key] / 1e3, color=f"C{k}", label=label)
     word = key.split("_")[0]
     if not shown:
         for a in (ax_time, ax_depth):
             _note(a, f"lateral overload 0\n(below {LATERAL_ROUNDOFF:g} of the axial peak: "
                   "round-off;\na shot in its plane of symmetry\nhas no lateral force)")
         return
+    zones = open_zones_of(job)
+    h = job["runs"]["runway"].history
+    x = path_length(h) if along_path else h["tip_z_m"]
+    for a, abscissa in ((ax_time, h["t_s"] * 1e3), (ax_depth, x)):
+        for x0, x1 in zone_spans(abscissa, h["tip_z_m"], zones):
+            a.axvspan(x0, x1, color="0.88", lw=0, zorder=0)
+    shaded = "; shaded: open zones" if zones else ""
     ax_time.set_ylabel(f"{word} overload (thousands of g)")
-    ax_time.set_xlabel("t (ms)")
-    ax_depth.set_xlabel("nose-tip depth (m); dashed: interfaces")
-    deepest = max(float(np.max(r.history["tip_z_m"])) for _, r in runs)
-    _interfaces(ax_depth, job["target"], vertical=False, deepest=deepest)
+    ax_time.set_xlabel("t (ms)" + shaded)
+    if along_path:
+        ax_depth.set_xlabel("nose-tip path length (m; the tip rises again)" + shaded)
+    else:
+        ax_depth.set_xlabel("nose-tip depth (m); dashed: interfaces" + shaded)
+        deepest = max(float(np.max(r.history["tip_z_m"])) for _, r in runs)
+        _interfaces(ax_depth, job["target"], vertical=False, deepest=deepest)
+    if key == "lateral_g":
+        nose = job["runs"]["runway"].model.body.nose_length
+        ax_time.text(0.0, 1.03, "thin: samples (they step as surface points enter and leave "
+                     "contact, in the model's force too); thick: mean over one nose length "
+                     f"({nose * 1e3:.3g} mm)", transform=ax_time.transAxes, fontsize=8,
+                     va="bottom")
     for a in (ax_time, ax_depth):
         a.grid(alpha=0.3)
         a.xaxis.set_major_locator(MaxNLocator(6))  # no overprinted ticks (mm depths)
@@ -303,7 +391,9 @@ VIEW_3D_SIZE_IN = (7.5, 6.5)  # the 3-D view: width, height (in)
 def block_limits(result, target, min_ratio=0.4):
     """``(x limits, y limits, depth limits)`` (m) of the 3-D view's block: around the path and
     the body (tip and centre of mass) with a margin, from above the surface (the body at the
-    strike) to below the deepest interface and the path, so that every layer is in it; each
+    strike) to below the path, so that the block is to the scale of the shot (a ricochet's
+    few centimetres are not drawn in a block of the whole target's depth; the layers below it
+    are named in the legend, :func:`draw_view_3d`); each
     horizontal extent at least ``min_ratio`` of the largest extent (no hairline axis, room for
     readable ticks); ``y`` covers the half ``y >= 0`` behind the plane of obliquity and any
     lateral motion."""
@@ -312,9 +402,8 @@ def block_limits(result, target, min_ratio=0.4):
     y = np.concatenate([h["tip_y_m"], h["cg_y_m"]])
     z = np.concatenate([h["tip_z_m"], h["cg_z_m"]])
     length = result.model.body.length
-    interfaces = target.interface_depths or (0.0,)
     top = min(float(z.min()), 0.0) - 0.5 * length
-    deepest = max(float(z.max()), interfaces[-1])
+    deepest = max(float(z.max()), 0.0)
     span = max(float(np.ptp(x)), deepest - top, length)
     margin = 0.1 * span
     bottom = deepest + margin
@@ -349,9 +438,12 @@ def view_3d(job, path):
     # is either on the block's back walls or in front of them, so no depth sorting is needed
     ax = fig.add_axes((0.0, 0.12, 1.0, 0.78), projection="3d", computed_zorder=False)
     handles = draw_view_3d(ax, job)
+    rows = math.ceil(len(handles) / 2)  # the legend's rows below the axes (0.19 in each)
+    bottom = (0.45 + 0.19 * rows) / VIEW_3D_SIZE_IN[1]  # and the x label above it
+    ax.set_position((0.0, bottom, 1.0, 0.9 - bottom))
     fig.suptitle(shot_title(job).replace("; ", "\n") + "\nx: horizontal in the plane of obliquity; "
                  "the block cut open along it", fontsize=9, y=0.985)
-    fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=min(len(handles), 3),
+    fig.legend(handles=handles, fontsize=8, loc="lower center", ncol=min(len(handles), 2),
                frameon=False, bbox_to_anchor=(0.5, 0.0))
     return save_figure(fig, path, dpi=120)
 
@@ -372,9 +464,11 @@ def draw_view_3d(ax, job):
     h = result.history
     (x0, x1), (y0, y1), (top, bottom) = block_limits(result, target)
     ax.view_init(elev=22, azim=-58)
-    planes = [0.0, *target.interface_depths, bottom]
+    planes = [0.0, *(H for H in target.interface_depths if H < bottom), bottom]
     names = target.layer_names()
-    handles = []
+    handles = [Patch(facecolor="none", edgecolor="none",
+                     label=f"below the block: {names[k + 1]} from {H:.3g} m")
+               for k, H in enumerate(target.interface_depths) if H >= bottom]
     for k in range(len(planes) - 1):
         a, b = planes[k], planes[k + 1]
         colour = LAYER_COLOURS[k % len(LAYER_COLOURS)]
@@ -384,7 +478,7 @@ def draw_view_3d(ax, job):
             walls.append([(x0, y0, b), (x1, y0, b), (x1, y1, b), (x0, y1, b)])
         ax.add_collection3d(Poly3DCollection(walls, facecolor=colour, alpha=0.45,
                                              edgecolor="none", zorder=1))
-        handles.append(Patch(facecolor=colour, alpha=0.6, label=names[k]))
+        handles.insert(k, Patch(facecolor=colour, alpha=0.6, label=names[k]))
     for k, depth in enumerate(planes[:-1]):  # the surface (solid) and the interfaces (dashed)
         ax.plot([x0, x1, x1, x0, x0], [y0, y0, y1, y1, y0], [depth] * 5, zorder=2,
                 color="k" if k == 0 else "0.35", lw=1.0 if k == 0 else 0.8,
@@ -411,5 +505,5 @@ def draw_view_3d(ax, job):
     ax.tick_params(labelsize=8, pad=1)
     ax.set_xlabel("x (m)", fontsize=8, labelpad=6)
     ax.set_ylabel("y (m)", fontsize=8, labelpad=4)
-    ax.set_zlabel("depth z (m)", fontsize=8, labelpad=6)
+    ax.set_zlabel("depth z (m)", fontsize=8, labelpad=9)
     return handles

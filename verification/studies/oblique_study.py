@@ -30,6 +30,7 @@ import sys
 import numpy as np
 
 from cavex.analytic.models import fly
+from cavex.analytic.penetration.low_pass import low_pass
 from cavex.analytic.penetration.oblique import PEAK_SPAN, Strike, overload_peaks, peaks
 from cavex.analytic.penetration.refinement import (
     PEAK_TOLERANCE,
@@ -42,6 +43,7 @@ from cavex.verification.fedata.runner import run_cases
 from cavex.verification.output.files import save_figure, write_text_atomic
 from cavex.verification.output.number_format import format_number
 from cavex.verification.output.paths import check_output_dir
+from cavex.verification.studies.study_axes import broken_axes, symlog_axis
 
 OBLIQUITIES = (0.0, 10.0, 20.0, 30.0, 45.0, 60.0)
 VELOCITIES = (400.0, 600.0, 800.0, 1000.0)
@@ -405,34 +407,7 @@ def figures(results, folder, interfaces, runs):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    written = []
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    for k, o in enumerate(sorted({r["obliquity_deg"] for r in results} - {0.0})):
-        pairs = [p for p in _pairs(results) if p[0] == o]
-        v = [p[1] for p in pairs]
-        axes[0].plot(v, [p[2]["pitch_change_deg"] for p in pairs], "o-", color=f"C{k}",
-                     label=f"{o:g} deg layered")
-        axes[0].plot(v, [p[3]["pitch_change_deg"] for p in pairs], "s--", color=f"C{k}",
-                     mfc="none", label=f"{o:g} deg concrete only")
-        for level, style in zip(LEVELS, ("o-", "s--"), strict=True):
-            added = _added(results, level)
-            rows = sorted((v, x) for (q, v), x in added.items() if q == o)
-            if rows:
-                axes[1].plot(*zip(*rows, strict=True), style, color=f"C{k}",
-                             mfc="none" if level == "refined" else None,
-                             label=f"{o:g} deg, {level}")
-    axes[0].set_ylabel("final pitch - initial pitch (deg)")
-    axes[0].set_title("whole path: layered (solid) against concrete alone (dashed)",
-                      fontsize=9)
-    axes[1].set_ylabel("added pitch change, layered - concrete (deg)")
-    axes[1].set_title(f"from {APPROACH:g} m above the first interface on (shots that get "
-                      "there): default and refined discretisation", fontsize=9)
-    for a in axes:
-        a.set_xlabel("striking velocity (m/s)")
-        a.legend(fontsize=7, ncol=2)
-        a.grid(alpha=0.3)
-    written.append(save_figure(fig, folder / "pitch_change.png", dpi=120,
-                               bbox_inches="tight"))
+    written = [pitch_change_figure(results, folder, plt)]
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     for k, (label, result) in enumerate(runs.items()):
         h = result.history
@@ -454,6 +429,54 @@ def figures(results, folder, interfaces, runs):
     return [str(p) for p in written]
 
 
+def pitch_change_figure(results, folder, plt):
+    """``pitch_change.png``: the whole path's pitch change (layered and concrete alone) and
+    the added pitch change from the approach depth on (default and refined), each against the
+    striking velocity, one colour per obliquity; a panel whose few large values (a turn-over)
+    would squash the rest gets them in a panel of their own above it
+    (:func:`~cavex.verification.studies.study_axes.broken_axes`). Returns the file."""
+    fig = plt.figure(figsize=(12, 6.2), layout="constrained")
+    cells = fig.add_gridspec(1, 2, wspace=0.08)
+    obliquities = sorted({r["obliquity_deg"] for r in results} - {0.0})
+    curves = ([], [])  # per panel: (x, y, style, colour, open marker, label)
+    for k, o in enumerate(obliquities):
+        pairs = [p for p in _pairs(results) if p[0] == o]
+        v = [p[1] for p in pairs]
+        curves[0].append((v, [p[2]["pitch_change_deg"] for p in pairs], "o-", f"C{k}", False,
+                          f"{o:g} deg layered"))
+        curves[0].append((v, [p[3]["pitch_change_deg"] for p in pairs], "s--", f"C{k}", True,
+                          f"{o:g} deg concrete only"))
+        for level, style in zip(LEVELS, ("o-", "s--"), strict=True):
+            rows = sorted((v, x) for (q, v), x in _added(results, level).items() if q == o)
+            if rows:
+                x, y = zip(*rows, strict=True)
+                curves[1].append((x, y, style, f"C{k}", level == "refined",
+                                  f"{o:g} deg, {level}"))
+    titles = ("Whole path: final - initial pitch,\nlayered (solid) against concrete alone "
+              "(dashed)",
+              f"Added pitch change (layered - concrete) from {APPROACH:g} m above the first "
+              "interface on,\nshots that get there: default (solid) and refined (dashed) "
+              "discretisation")
+    labels = ("pitch change (deg)", "added pitch change (deg)")
+    for cell, panel, title, label in zip(cells, curves, titles, labels, strict=True):
+        upper, lower = broken_axes(fig, cell, [y for c in panel for y in c[1]])
+        for ax in (upper, lower):
+            if ax is None:
+                continue
+            for x, y, style, colour, hollow, name in panel:
+                ax.plot(x, y, style, color=colour, mfc="none" if hollow else None,
+                        label=name)
+            ax.grid(alpha=0.3)
+        (upper or lower).set_title(title, fontsize=9)
+        lower.set_ylabel(label)
+        if upper is not None:
+            upper.set_ylabel("large turns\n(deg; own scale)", fontsize=8)
+        lower.set_xlabel("striking velocity (m/s)")
+        lower.legend(fontsize=7, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.16),
+                     frameon=False)
+    return save_figure(fig, folder / "pitch_change.png", dpi=120, bbox_inches="tight")
+
+
 def turn_after_interface(result, interface=1):
     """Pitch at the end of the phase after the nose tip first crosses ``interface`` minus the
     pitch at the crossing (deg); None when it does not cross."""
@@ -462,23 +485,6 @@ def turn_after_interface(result, interface=1):
     if k is None or k + 1 >= len(result.phases):
         return None
     return result.phases[k + 1]["end_pitch_deg"] - result.phases[k]["end_pitch_deg"]
-
-
-def low_pass(history, length):
-    """Lateral overload averaged over the time the body takes to travel ``length`` (the nose
-    length) around each sample (trapezoidal mean over ``[t - T/2, t + T/2]``, ``T = length /
-    speed``): the raw samples switch with the shank's contact."""
-    t, g, v = history["t_s"], history["lateral_g"], history["speed_m_s"]
-    out = np.empty_like(g)
-    for i in range(t.size):
-        half = 0.5 * length / max(v[i], 1e-9)
-        lo, hi = t[i] - half, t[i] + half
-        grid = np.concatenate([[max(lo, t[0])], t[(t > lo) & (t < hi)], [min(hi, t[-1])]])
-        values = np.interp(grid, t, g)
-        span = grid[-1] - grid[0]
-        area = float(np.sum(0.5 * (values[1:] + values[:-1]) * np.diff(grid)))
-        out[i] = area / span if span > 0 else g[i]
-    return out
 
 
 SHOT = Strike(600.0, obliquity=20.0)  # the paper's shot that reaches the first interface
@@ -600,12 +606,31 @@ def interface_figures(folder, target, projectile, numbers):
     fig.suptitle(f"{SHOT.speed:g} m/s at {SHOT.obliquity:g} deg: bonded and debonded "
                  "interfaces, and the concrete alone", fontsize=10)
     written = [save_figure(fig, folder / "interface_shot.png", dpi=120, bbox_inches="tight")]
-    fig, axes = plt.subplots(2, 2, figsize=(11, 7), layout="constrained", sharex="col")
+    written.append(sensitivity_figure(folder, numbers, plt))
+    return [str(p) for p in written]
+
+
+#: The rows of ``interface_sensitivity.png``: the answer, its axis label, its panel title.
+SENSITIVITY_ROWS = (
+    ("added", "added turn (deg)",
+     "(i) added turn at interface 1 (debonded - bonded)"),
+    ("peak", "axial peak (thousands of g)",
+     "(ii) largest axial overload peak within the window of interface 1"))
+
+
+def sensitivity_figure(folder, numbers, plt):
+    """``interface_sensitivity.png``: the answers of :func:`zone_sensitivity` (``numbers``)
+    against each zone size (columns), default and refined; the answer named in each panel's
+    title and a short axis label (the long labels of two rows overlapped), a symmetric-log
+    axis labelled on both sides of zero where the added turn spans decades, and a note
+    instead of an empty panel where no size gives an interface peak."""
+    fig, axes = plt.subplots(2, 2, figsize=(11, 7.4), layout="constrained", sharex="col")
     keys = ("rear zone (calibres)", "crater (shank radii)")
     for col, key in enumerate(keys):
         items = [(v, e) for (k, v), e in numbers.items() if k == key]
-        for row, what in enumerate(("added", "peak")):
+        for row, (what, label, title) in enumerate(SENSITIVITY_ROWS):
             a = axes[row, col]
+            drawn = []
             for level, style in ((0, "o-"), (1, "s--")):
                 xs, ys = [], []
                 for v, e in items:
@@ -615,26 +640,32 @@ def interface_figures(folder, target, projectile, numbers):
                     if y is not None:
                         xs.append(v)
                         ys.append(y)
-                a.plot(xs, ys, style, mfc="none" if level else None,
-                       label="default" if level == 0 else "refined")
+                if xs:
+                    a.plot(xs, ys, style, mfc="none" if level else None,
+                           label="default" if level == 0 else "refined")
+                drawn += ys
             default = 2.12 if col == 0 else 4.5
             a.axvline(default, color="0.6", lw=0.8, ls=":")
             a.grid(alpha=0.3)
+            a.set_title(title, fontsize=9)
+            a.set_ylabel(label)
+            if not drawn:
+                a.set_yticks([])
+                a.text(0.5, 0.5, "no axial peak within the window of interface 1 at any "
+                       f"{key.split(' (')[0]} size,\ndefault or refined (report.md)",
+                       transform=a.transAxes, ha="center", va="center", fontsize=9,
+                       color="0.25")
+                continue
             a.legend(fontsize=7)
-            if what == "added":
-                a.set_ylabel("(i) added turn at interface 1 (deg)")
-                if any(abs(e["added"][0] or 0.0) > 2.0 for _, e in items):
-                    a.set_yscale("symlog", linthresh=1.0)
-                    a.set_ylabel("(i) added turn at interface 1 (deg; symlog, linear "
-                                 "within +-1)")
-            else:
-                a.set_ylabel("(ii) axial peak at interface 1 (thousands of g; none: no point)")
-                a.set_xlabel(key + "; dotted: default")
+            if what == "added" and any(abs(y) > 2.0 for y in drawn):
+                symlog_axis(a, drawn, linthresh=1.0)
+                a.set_ylabel(label + "\n(symmetric log: linear within +-1)")
+        axes[1, col].set_xlabel(key + "; dotted: default")
+        axes[1, col].tick_params(axis="x", labelbottom=True)
     fig.suptitle(f"The answers against the uncalibrated zone sizes, {SHOT.speed:g} m/s at "
                  f"{SHOT.obliquity:g} deg, debonded", fontsize=10)
-    written.append(save_figure(fig, folder / "interface_sensitivity.png", dpi=120,
-                               bbox_inches="tight"))
-    return [str(p) for p in written]
+    return save_figure(fig, folder / "interface_sensitivity.png", dpi=120,
+                       bbox_inches="tight")
 
 
 def crossing_figure(results, folder):
@@ -649,6 +680,7 @@ def crossing_figure(results, folder):
     added, fine = _added(results, "default"), _added(results, "refined")
     speed = {(o, v): lay["crossing_speed_m_s"] for o, v, lay, _ in _pairs(results)}
     fig, ax = plt.subplots(figsize=(6.5, 4.2), layout="constrained")
+    drawn = []
     for k, o in enumerate(sorted({o for o, _ in added if 0.0 < o <= 45.0})):
         rows = sorted((speed[(q, v)], x, fine[(q, v)]) for (q, v), x in added.items()
                       if q == o and speed[(q, v)] is not None and (q, v) in fine)
@@ -656,9 +688,10 @@ def crossing_figure(results, folder):
             s_, x, refined = zip(*rows, strict=True)
             ax.plot(s_, x, "o-", color=f"C{k}", label=f"{o:g} deg, default")
             ax.plot(s_, refined, "s--", color=f"C{k}", mfc="none", label=f"{o:g} deg, refined")
-    ax.set_yscale("symlog", linthresh=1.0)
+            drawn += [*x, *refined]
+    symlog_axis(ax, drawn or [0.0], linthresh=1.0)
     ax.set_xlabel("speed at the first interface (m/s)")
-    ax.set_ylabel("added turn, layered - concrete (deg; symlog, linear within +-1)")
+    ax.set_ylabel("added turn, layered - concrete (deg)\n(symmetric log: linear within +-1)")
     ax.set_title(f"{results[0].get('interfaces', 'bonded')} interfaces: the turn from "
                  f"{APPROACH:g} m above the first interface on", fontsize=9)
     ax.grid(alpha=0.3)
