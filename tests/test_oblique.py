@@ -100,7 +100,7 @@ def _one_layer_normal(runway, boundary, method="DOP853", rtol=1e-10):
     # nose force's 8-point rule (the 3-D default is 16 since issue 30): the two models' nose
     # forces then agree to round-off, and this comparison is of the integrators
     body = build_body(projectile, QUADRATURE_POINTS, shank_rings=8)
-    start = body.nose_length + 0.5 * body.sizes.max() + 1e-4  # nose fully embedded
+    start = body.nose_length + body.axial_half_extent + 1e-4  # nose fully embedded
     law = make_law(single, projectile, "derived", boundary=boundary, free_surface=False)
     model = ObliqueModel(single, projectile, law, body=body, rtol=rtol, atol=1e-3 * rtol,
                          method=method, contact_ramp=0.0)
