@@ -65,8 +65,11 @@ class Body:
         How the element's normal and position change across it, in its two surface
         directions: ``(dn_a, dp_a, dn_b, dp_b)``, ``a`` along ``phi`` (the ogive; the axis on the
         shank) and ``b`` along ``theta``, each the derivative times the element's extent
-        (body frame); row 4 holds their half lengths ``((|dn_a| + |dn_b|)/2,
-        (|dp_a| + |dp_b|)/2, 0)``, bounds on the half extents in any frame. The force law
+        (body frame), the extent being the node's cell (for the Gauss rule in ``phi`` the
+        consecutive intervals of the weights' widths, each holding its node off centre);
+        row 4 holds ``(|dn_a| + |dn_b|, |dp_a| + |dp_b|, e)``, bounds on the changes across
+        the element in any frame and the offset ``e`` of the cell's centre from the node
+        along ``a`` per cell width (0 on the shank and in ``theta``). The force law
         reads the element's extent in depth and in normal velocity from them
         (:mod:`cavex.analytic.penetration.surface_force`, "Fractions").
     nose : ndarray of bool, shape (n,)
@@ -147,11 +150,11 @@ def uniform_mass_properties(projectile, length):
     return volume, cg, axial, transverse
 
 
-def _with_reach(spans):
-    """``spans`` (n, 4, 3) with the row of half lengths appended (:class:`Body`)."""
+def _with_reach(spans, offsets):
+    """``spans`` (n, 4, 3) with the row ``(|dn_a| + |dn_b|, |dp_a| + |dp_b|, e)`` appended
+    (:class:`Body`)."""
     length = np.linalg.norm(spans, axis=-1)
-    reach = np.stack([0.5 * (length[:, 0] + length[:, 2]), 0.5 * (length[:, 1] + length[:, 3]),
-                      np.zeros(len(spans))], -1)
+    reach = np.stack([length[:, 0] + length[:, 2], length[:, 1] + length[:, 3], offsets], -1)
     return np.ascontiguousarray(np.concatenate([spans, reach[:, None, :]], axis=1))
 
 
@@ -170,6 +173,10 @@ def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rin
         transverse = projectile.inertia
     phi, weights, jacobian = angle_rule(float(R), float(r), nose_points)
     dphi = weights * jacobian
+    # the nodes' cells: consecutive intervals of the weights' widths from phi_0 to pi/2 (each
+    # node lies in its own, not at its centre: the centre's offset from the node per width)
+    lower = math.asin((R - r) / R) + np.concatenate([[0.0], np.cumsum(dphi)[:-1]])
+    offset = (lower + 0.5 * dphi - phi) / dphi
     k = np.arange(azimuths)
     half = (k + 0.5 < 0.5 * azimuths)
     theta = np.where(half, (k + 0.5) * 2.0 * math.pi / azimuths,
@@ -191,6 +198,7 @@ def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rin
                     -1) * dtheta
     dp_b = np.stack([np.zeros_like(P), -rho * np.sin(T), rho * np.cos(T)], -1) * dtheta
     nose_spans = np.stack([dn_a, R * dn_a, dn_b, dp_b], -2).reshape(-1, 4, 3)
+    nose_offsets = np.broadcast_to(offset[:, None], P.shape).ravel()
     dx = (length - ln) / shank_rings
     xs = ln + (np.arange(shank_rings) + 0.5) * dx
     X, T2 = np.meshgrid(xs, theta, indexing="ij")
@@ -209,7 +217,8 @@ def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rin
         points=np.concatenate([nose_pts, shank_pts]),
         normals=np.concatenate([nose_nrm, shank_nrm]),
         areas=np.concatenate([nose_area, shank_area]),
-        spans=_with_reach(np.concatenate([nose_spans, shank_spans])),
+        spans=_with_reach(np.concatenate([nose_spans, shank_spans]),
+                          np.concatenate([nose_offsets, np.zeros(len(shank_spans))])),
         nose=np.concatenate([np.ones(nose_area.size, bool), np.zeros(shank_area.size, bool)]),
         partners=np.concatenate([(ring * azimuths + mirror[None, :]).ravel()
                                  for ring in (np.arange(nose_points)[:, None],

@@ -35,7 +35,8 @@ size at a fixed state (docs/oblique.md "Convergence"). With ``G(x) = wetted_frac
   ``clip(V_n/V_r, 0, 1)`` for an element over which ``V_n`` hardly varies and the element's
   part in contact otherwise; with OFPM's tangency attenuation ``tangency = sin psi`` > 0,
   ``V_r = max(contact_ramp, |u| sin psi)`` (the load falls linearly within ``psi`` of
-  tangency). ``V_n`` within ``10^-9 (|v| + L |omega|)`` of zero counts as zero (round-off).
+  tangency). ``V_n`` within ``10^-9 (|v| + L |omega|)`` of zero counts as zero, and so does
+  its change across an element (round-off).
 
 An element with ``w c > 0`` carries the load ``P = A_i w c sigma_n(z, n_3, max(V_n, 0))``,
 force
@@ -186,18 +187,19 @@ def _near_edge(z, reach, bottom, open_zones, interfaces):
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _depth_spread(i, rot, spans):
-    """``(wide, narrow)``: the larger and the smaller change of the depth ``z`` across element
-    ``i`` in its two surface directions (``|(R dp) . e_3|``, module docstring, "Fractions")."""
-    first = abs(rot[2, 0] * spans[i, 1, 0] + rot[2, 1] * spans[i, 1, 1]
-                + rot[2, 2] * spans[i, 1, 2])
+    """``(shift, wide, narrow)``: the depth of element ``i``'s centre less its node's,
+    ``e dz_a``, and the larger and the smaller change of the depth across it in its two
+    surface directions, ``|dz| = |(R dp) . e_3|`` (module docstring, "Fractions")."""
+    first = (rot[2, 0] * spans[i, 1, 0] + rot[2, 1] * spans[i, 1, 1]
+             + rot[2, 2] * spans[i, 1, 2])
     second = abs(rot[2, 0] * spans[i, 3, 0] + rot[2, 1] * spans[i, 3, 1]
                  + rot[2, 2] * spans[i, 3, 2])
-    return max(first, second), min(first, second)
+    return spans[i, 4, 2] * first, max(abs(first), second), min(abs(first), second)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _span_change(i, k, rot, omega, u0, u1, u2, n0, n1, n2, spans):
-    """``|u . (R dn) + ((R omega) x (R dp)) . n|`` for the spans ``dn = spans[i, k]``,
+    """``u . (R dn) + ((R omega) x (R dp)) . n`` for the spans ``dn = spans[i, k]``,
     ``dp = spans[i, k + 1]`` (``omega`` already in the target frame)."""
     a0, a1, a2 = spans[i, k, 0], spans[i, k, 1], spans[i, k, 2]
     b0, b1, b2 = spans[i, k + 1, 0], spans[i, k + 1, 1], spans[i, k + 1, 2]
@@ -210,30 +212,32 @@ def _span_change(i, k, rot, omega, u0, u1, u2, n0, n1, n2, spans):
     c0 = omega[1] * dp2 - omega[2] * dp1
     c1 = omega[2] * dp0 - omega[0] * dp2
     c2 = omega[0] * dp1 - omega[1] * dp0
-    return abs((u0 * dn0 + u1 * dn1 + u2 * dn2) + (c0 * n0 + c1 * n1 + c2 * n2))
+    return (u0 * dn0 + u1 * dn1 + u2 * dn2) + (c0 * n0 + c1 * n1 + c2 * n2)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
 def _velocity_spread(i, rot, omega, u0, u1, u2, n0, n1, n2, spans):
-    """``(wide, narrow)``: the larger and the smaller change of the normal velocity across
-    element ``i`` in its two surface directions, ``|u . dn + (omega x dp) . n|`` with the
+    """``(shift, wide, narrow)``: the normal velocity at element ``i``'s centre less its
+    node's, ``e dV_a``, and the larger and the smaller change of the normal velocity across
+    it in its two surface directions, ``|dV| = |u . dn + (omega x dp) . n|`` with the
     element's ``spans`` turned to the target frame (module docstring, "Fractions")."""
     first = _span_change(i, 0, rot, omega, u0, u1, u2, n0, n1, n2, spans)
-    second = _span_change(i, 2, rot, omega, u0, u1, u2, n0, n1, n2, spans)
-    return max(first, second), min(first, second)
+    second = abs(_span_change(i, 2, rot, omega, u0, u1, u2, n0, n1, n2, spans))
+    return spans[i, 4, 2] * first, max(abs(first), second), min(abs(first), second)
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _split_stress(kind, scalars, values, tables, counts, depths, z, wide, narrow, nz, vn, radii,
-                  zones):
-    """``(sigma_n, status)`` of an element whose depths span ``z`` plus the sum of two
-    uniform offsets of widths ``wide >= narrow``: where the element straddles an interface
-    ``H`` (a jump of the law), the fractions below and above it, each at the element's depth
-    clamped to its side (module docstring, "Fractions"); else the law at ``z``."""
+def _split_stress(kind, scalars, values, tables, counts, depths, z, middle, wide, narrow, nz, vn,
+                  radii, zones):
+    """``(sigma_n, status)`` of an element with its node at depth ``z`` whose depths span
+    ``middle`` plus the sum of two uniform offsets of widths ``wide >= narrow``: where the
+    element straddles an interface ``H`` (a jump of the law), the parts below and above it,
+    each at the node's depth clamped to its side (module docstring, "Fractions"); else the
+    law at ``z``."""
     for j in range(depths.shape[0]):
         H = depths[j]
-        if abs(z - H) < 0.5 * (wide + narrow):
-            below = wetted_fraction(z - H, wide, narrow)[0]
+        if abs(middle - H) < 0.5 * (wide + narrow):
+            below = wetted_fraction(middle - H, wide, narrow)[0]
             low, status = element_stress(kind, scalars, values, tables, counts, depths,
                                          max(z, H), nz, vn, radii, zones)
             if status == WALK_FAILED or below >= 1.0:
@@ -264,20 +268,21 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, spans, mu, co
     p1 = rot[1, 0] * points[i, 0] + rot[1, 1] * points[i, 1] + rot[1, 2] * points[i, 2]
     p2 = rot[2, 0] * points[i, 0] + rot[2, 1] * points[i, 1] + rot[2, 2] * points[i, 2]
     z = y[2] + p2
-    z_wide = z_narrow = 0.0  # far from every edge the fractions are steps: exact
+    middle, z_wide, z_narrow = z, 0.0, 0.0  # far from every edge: steps, exact
     if _near_edge(z, spans[i, 4, 1], bottom, open_zones if not nose[i] else _NO_ZONES,
                   law[5]):
-        z_wide, z_narrow = _depth_spread(i, rot, spans)
-    frac = wetted_fraction(z, z_wide, z_narrow)[0]  # the part below the free surface
+        shift, z_wide, z_narrow = _depth_spread(i, rot, spans)
+        middle = z + shift
+    frac = wetted_fraction(middle, z_wide, z_narrow)[0]  # the part below the free surface
     if bottom < np.inf:  # and above the bottom
-        frac = max(frac - (1.0 - wetted_fraction(bottom - z, z_wide, z_narrow)[0]), 0.0)
+        frac = max(frac - (1.0 - wetted_fraction(bottom - middle, z_wide, z_narrow)[0]), 0.0)
     if not nose[i] and open_zones.shape[0] > 0:  # the shank carries no load in an open
         # zone (crater, scabbed rear zone); the zones are disjoint (merged where they touch),
         # so the element's part inside their union is the sum of its parts in each
         inside = 0.0
         for k in range(open_zones.shape[0]):
-            inside += (wetted_fraction(open_zones[k, 1] - z, z_wide, z_narrow)[0]
-                       - wetted_fraction(open_zones[k, 0] - z, z_wide, z_narrow)[0])
+            inside += (wetted_fraction(open_zones[k, 1] - middle, z_wide, z_narrow)[0]
+                       - wetted_fraction(open_zones[k, 0] - middle, z_wide, z_narrow)[0])
         frac = max(frac - inside, 0.0)
     if not nose[i] and walls.shape[0] > 0:  # the tunnel-wall factor of the element's layer
         frac *= walls[np.searchsorted(wall_depths, z, side="right")]
@@ -291,24 +296,26 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, spans, mu, co
     u2 = y[9] + omega[0] * p1 - omega[1] * p0
     vn = u0 * n0 + u1 * n1 + u2 * n2
     if hold > 0.0:
-        return _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, z_wide,
-                          z_narrow, scale, areas, mu, hold, hold_time, law, radii, zones, out,
-                          damping, extra)
+        return _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, middle,
+                          z_wide, z_narrow, scale, areas, mu, hold, hold_time, law, radii,
+                          zones, out, damping, extra)
     if abs(vn) <= scale:
         vn = 0.0
     ramp = contact_ramp
     if tangency > 0.0:  # OFPM's attenuation: load x angle / psi within psi of tangency
         ramp = max(ramp, tangency * math.sqrt(u0 * u0 + u1 * u1 + u2 * u2))
-    wide = narrow = 0.0
+    shift = wide = narrow = 0.0
     speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
     turning = math.sqrt(omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2])
     if abs(vn - 0.5 * ramp) < 0.5 * ramp + speed * spans[i, 4, 0] + turning * spans[i, 4, 1]:
-        wide, narrow = _velocity_spread(i, rot, omega, u0, u1, u2, n0, n1, n2, spans)
-    wetted, slope = wetted_fraction(vn - 0.5 * ramp, max(wide, ramp), narrow)
+        shift, wide, narrow = _velocity_spread(i, rot, omega, u0, u1, u2, n0, n1, n2, spans)
+        if wide <= scale:  # round-off: V_n does not vary across the element
+            shift = wide = narrow = 0.0
+    wetted, slope = wetted_fraction(vn + shift - 0.5 * ramp, max(wide, ramp), narrow)
     if wetted <= 0.0:
         return OK, vn
-    sigma, status = _split_stress(kind, scalars, values, tables, counts, depths, z, z_wide,
-                                  z_narrow, n2, max(vn, 0.0), radii, zones)
+    sigma, status = _split_stress(kind, scalars, values, tables, counts, depths, z, middle,
+                                  z_wide, z_narrow, n2, max(vn, 0.0), radii, zones)
     if status == WALK_FAILED:
         return status, vn
     capacity = sigma * areas[i] * frac
@@ -337,8 +344,8 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, spans, mu, co
     return status, vn
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, z_wide, z_narrow, scale,
-               areas, mu, hold, hold_time, law, radii, zones, out, damping, extra):
+def _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, middle, z_wide, z_narrow,
+               scale, areas, mu, hold, hold_time, law, radii, zones, out, damping, extra):
     """Element ``i`` under the held contact (module docstring, "Held contact"). Its elastic
     fraction ``phi = y[14 + i]`` moves at ``V_n / hold`` within ``[0, 1]`` (not at all where
     ``V_n`` pushes out of them; ``|V_n|`` less the round-off guard ``scale``): an elastic
@@ -361,8 +368,8 @@ def _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, z_wide, z_
     if frac <= 0.0 or not (fraction > 0.0 or elastic):
         return OK, 0.0
     kind, scalars, values, tables, counts, depths = law
-    sigma, status = _split_stress(kind, scalars, values, tables, counts, depths, z, z_wide,
-                                  z_narrow, n2, max(vn, 0.0), radii, zones)
+    sigma, status = _split_stress(kind, scalars, values, tables, counts, depths, z, middle,
+                                  z_wide, z_narrow, n2, max(vn, 0.0), radii, zones)
     if status == WALK_FAILED:
         return status, vn
     capacity = sigma * areas[i] * frac
