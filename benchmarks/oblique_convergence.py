@@ -38,7 +38,7 @@ RTOL, RAMP = 1e-3, 0.01  # the defaults (oblique.RTOL, oblique.CONTACT_RAMP)
 DEFAULT = {"nose_points": NOSE_POINTS, "azimuths": AZIMUTHS, "shank_rings": SHANK_RINGS,
            "rtol": RTOL, "contact_ramp": RAMP}
 SERIES = {
-    "nose_points": (16, 24, 32, 48, 64),
+    "nose_points": (8, 16, 24, 32, 48, 64),
     "azimuths": (8, 16, 32),
     "shank_rings": (8, 16, 32),
     "rtol": (3e-3, 1e-3, 3e-4),
@@ -280,12 +280,17 @@ def main(argv=None):
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", default="results/oblique/convergence.json")
     parser.add_argument("--table", help="print the tables of a written file")
+    parser.add_argument("--reuse", help="a written file whose runs of the same settings (same "
+                        "code) are kept instead of being run again")
     args = parser.parse_args(argv)
     if args.table:
         print(tables(json.loads(Path(args.table).read_text())["runs"]))
         return 0
-    work = tasks()
-    runs = []
+    old = json.loads(Path(args.reuse).read_text()) if args.reuse else {"runs": [], "settings": {}}
+    names = settings_list()
+    runs = [r for r in old["runs"] if old["settings"].get(r["setting"]) == names.get(r["setting"])]
+    done = {(r["setting"], r["interfaces"], r["speed_m_s"], r["obliquity_deg"]) for r in runs}
+    work = [t for t in tasks() if (t[0], *t[2]) not in done]
     with Pool(args.workers) as pool:
         for k, run in enumerate(pool.imap_unordered(run_one, work), 1):
             runs.append(run)

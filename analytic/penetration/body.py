@@ -42,7 +42,7 @@ from scipy.integrate import quad
 from cavex.analytic.penetration.nose import angle_rule
 from cavex.errors import require
 
-NOSE_POINTS = 32  # Gauss points in phi; convergence: docs/oblique.md "Convergence"
+NOSE_POINTS = 16  # Gauss points in phi; convergence: docs/oblique.md "Convergence"
 AZIMUTHS = 16
 SHANK_RINGS = 16
 
