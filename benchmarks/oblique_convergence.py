@@ -38,12 +38,14 @@ RTOL, RAMP = 1e-3, 0.01  # the defaults (oblique.RTOL, oblique.CONTACT_RAMP)
 DEFAULT = {"nose_points": NOSE_POINTS, "azimuths": AZIMUTHS, "shank_rings": SHANK_RINGS,
            "rtol": RTOL, "contact_ramp": RAMP}
 SERIES = {
-    "nose_points": (8, 12, 16, 24, 32, 48),
+    "nose_points": (8, 16, 24, 32, 48, 64),
     "azimuths": (8, 16, 32),
     "shank_rings": (8, 16, 32),
     "rtol": (3e-3, 1e-3, 3e-4),
     "contact_ramp": (0.03, 0.01, 0.003),
 }
+# the surface rule refined as a whole: nose points, azimuths and shank rings times each factor
+UNIFORM = (1.0, 1.5, 2.0)
 HOLD = 1e-6  # m, the held contact (600 m/s shots only: its runs are the slowest)
 # the first interface of the default runway and the window of "a peak at it" (oblique_study)
 INTERFACE, WINDOW = 0.65, (0.1, 0.166)
@@ -56,6 +58,10 @@ def settings_list():
         for level in levels:
             options = {**DEFAULT, key: level}
             out[_name(options)] = options
+    for factor in UNIFORM[1:]:
+        options = {**DEFAULT, **{k: int(round(factor * DEFAULT[k]))
+                                 for k in ("nose_points", "azimuths", "shank_rings")}}
+        out[_name(options)] = options
     out["hold"] = {**DEFAULT, "contact_hold": HOLD}
     out["refined"] = {"nose_points": 2 * NOSE_POINTS, "azimuths": 2 * AZIMUTHS,
                       "shank_rings": 2 * SHANK_RINGS, "rtol": RTOL / 3.0,
@@ -171,6 +177,38 @@ def _rate(levels, errors):
     return float(np.polyfit(x, e, 1)[0])
 
 
+DEPTH_TOL, PITCH_TOL_DEG, PITCH_TOL_REL = 1e-3, 0.01, 0.03  # the issue's tolerances
+
+
+def shot_table(runs, uniform):
+    """Per shot: the default's depth and pitch, and their changes against the finest level of
+    each series, the refined rerun and the uniformly refined rule; whether every change is
+    within the tolerances (depth 0.1 %, pitch max(0.01 deg, 3 %))."""
+    index = {(r["setting"], r["interfaces"], r["speed_m_s"], r["obliquity_deg"]): r
+             for r in runs}
+    default = _name(DEFAULT)
+    finest = [_name({**DEFAULT, key: (levels[-1] if key not in ("rtol", "contact_ramp")
+                                      else min(levels))}) for key, levels in SERIES.items()]
+    against = [*finest, "refined", uniform]
+    lines = ["", "per shot, the default against the finest level of each series ("
+             + ", ".join(against) + "):", "",
+             "| shot | depth (m) | pitch (deg) | depth changes (%) | pitch changes (deg) | "
+             "within tolerance |", "|---|---|---|---|---|---|"]
+    for shot in sorted({k[1:] for k in index if k[0] == default}):
+        a = index[(default, *shot)]
+        depth = [100 * (a["tip_depth_m"] / index[(n, *shot)]["tip_depth_m"] - 1.0)
+                 for n in against if (n, *shot) in index]
+        pitch = [a["pitch_deg"] - index[(n, *shot)]["pitch_deg"]
+                 for n in against if (n, *shot) in index]
+        ok = (max(map(abs, depth)) <= 100 * DEPTH_TOL and max(map(abs, pitch)) <= max(
+            PITCH_TOL_DEG, PITCH_TOL_REL * abs(a["pitch_deg"])))
+        lines.append(f"| {shot[0]} {shot[1]:g} m/s {shot[2]:g} deg | {a['tip_depth_m']:.3f} | "
+                     f"{a['pitch_deg']:.2f} | " + " / ".join(f"{d:+.3f}" for d in depth)
+                     + " | " + " / ".join(f"{p:+.3f}" for p in pitch)
+                     + f" | {'yes' if ok else 'no'} |")
+    return lines
+
+
 def tables(runs):
     """The tables (text, markdown)."""
     names = settings_list()
@@ -203,6 +241,21 @@ def tables(runs):
         lines.append("| fitted rate | " + " | ".join(
             f"{rates[q]:.2f}" for q in ("depth_rel", "pitch_deg", "phase_deg", "added_deg",
                                         "axial_rel")) + " | | | |")
+    uniform = [_name({**DEFAULT, **{k: int(round(f * DEFAULT[k]))
+                                    for k in ("nose_points", "azimuths", "shank_rings")}})
+               for f in UNIFORM]
+    lines += ["", f"surface rule refined as a whole (nose points, azimuths, shank rings x "
+              f"{', '.join(f'{f:g}' for f in UNIFORM)}; against x {UNIFORM[-1]:g}):", "",
+              header.format("factor"), "|---|---|---|---|---|---|---|---|---|"]
+    for factor, name in zip(UNIFORM, uniform, strict=True):
+        c = changes(runs, name, uniform[-1])
+        peak = c["interface_peak"][0] if c["interface_peak"] else None
+        lines.append(f"| {factor:g}{' (default)' if factor == 1.0 else ''} | "
+                     f"{100 * c['depth_rel']:.3f} | {c['pitch_deg']:.4f} | "
+                     f"{c['phase_deg']:.4f} | {c['added_deg']:.4f} | "
+                     f"{100 * c['axial_rel']:.2f} | {c['peaks_differ']} | "
+                     f"{'-' if peak is None else f'{peak:.0f}'} | {c['wall_s']:.2f} |")
+    lines += shot_table(runs, uniform[-1])
     default = _name(DEFAULT)
     lines += ["", "default against the refined rerun (--estimate) and against the held contact:",
               "", header.format("setting"), "|---|---|---|---|---|---|---|---|---|"]
@@ -227,12 +280,17 @@ def main(argv=None):
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", default="results/oblique/convergence.json")
     parser.add_argument("--table", help="print the tables of a written file")
+    parser.add_argument("--reuse", help="a written file whose runs of the same settings (same "
+                        "code) are kept instead of being run again")
     args = parser.parse_args(argv)
     if args.table:
         print(tables(json.loads(Path(args.table).read_text())["runs"]))
         return 0
-    work = tasks()
-    runs = []
+    old = json.loads(Path(args.reuse).read_text()) if args.reuse else {"runs": [], "settings": {}}
+    names = settings_list()
+    runs = [r for r in old["runs"] if old["settings"].get(r["setting"]) == names.get(r["setting"])]
+    done = {(r["setting"], r["interfaces"], r["speed_m_s"], r["obliquity_deg"]) for r in runs}
+    work = [t for t in tasks() if (t[0], *t[2]) not in done]
     with Pool(args.workers) as pool:
         for k, run in enumerate(pool.imap_unordered(run_one, work), 1):
             runs.append(run)

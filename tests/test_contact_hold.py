@@ -140,7 +140,7 @@ def test_held_normal_incidence_one_layer_is_the_1d_tunnel(default):
     target, projectile = default
     single = target.single(0)
     body = build_body(projectile, shank_rings=8)
-    start = body.nose_length + 0.5 * body.sizes.max() + 1e-4
+    start = body.nose_length + body.axial_half_extent + 1e-4
     law = make_law(single, projectile, "derived", boundary="dynamic", free_surface=False)
     model = ObliqueModel(single, projectile, law, body=body, rtol=1e-6, atol=1e-9,
                          contact_hold=1e-6)

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.integrate import quad
 
 from cavex.analytic.models import fly
 from cavex.analytic.penetration.oblique import Strike
@@ -54,26 +55,43 @@ def test_entry_zone_is_the_one_crater_definition(default):
 def _element_forces(y, surface, count):
     """Force and moment of every element alone (the compiled surface_loads on one-element
     slices of the body's arrays)."""
-    points, normals, areas, sizes, partners, length = surface[:6]
+    points, normals, areas, spans, partners, length = surface[:6]
     nose = surface[9]
     out = np.empty((count, 6))
     for i in range(count):
         one = i + 1
         force, moment, _, status, _, _, _ = surface_loads(
-            y, points[i:one], normals[i:one], areas[i:one], sizes[i:one],
+            y, points[i:one], normals[i:one], areas[i:one], spans[i:one],
             np.zeros_like(partners[:1]), length, *surface[6:9], nose[i:one], *surface[10:])
         assert status == 0
         out[i, :3], out[i, 3:] = force, moment
     return out
 
 
+def _below(x, wide, narrow):
+    """Part of a parallelogram element whose depth is ``z + s wide + t narrow`` (``|s|, |t|
+    <= 1/2``) with ``z + ... < z + x``: the trapezoid's integral, written here apart from the
+    kernel (numpy, by cases of the overlap length)."""
+    if wide <= 0.0:
+        return float(x > 0.0)
+    if narrow <= 0.0:
+        return min(max(0.5 + x / wide, 0.0), 1.0)
+    # the mean over t of the part of s in [-1/2, 1/2] with s wide < x - t narrow (adaptive
+    # quadrature, told where the part reaches 0 and 1)
+    kinks = [k for k in ((x - 0.5 * wide) / narrow, (x + 0.5 * wide) / narrow) if abs(k) < 0.5]
+    return quad(lambda t: min(max(0.5 + (x - t * narrow) / wide, 0.0), 1.0), -0.5, 0.5,
+                points=kinks or None, epsabs=1e-15, epsrel=1e-13)[0]
+
+
 def test_shank_carries_no_load_inside_the_entry_crater(shots):
     """Element by element, at the state where the nose tip is 0.17 m deep (the shank spans the
     crater's bottom, L_c = 0.116 m): a shank element wholly inside ``[0, L_c]`` carries
-    nothing, one across its bottom the fraction ``1 - overlap / h`` of its load without the
-    zone, one below it and every nose element their full load. The expected fractions are
-    computed here from the element's depth, independently of the kernel's arithmetic; the
-    load is linear in the fraction, so they agree to round-off (1e-12 relative)."""
+    nothing, one across its bottom the part of it below ``L_c`` of its load without the zone,
+    one below it and every nose element their full load. The expected parts are computed
+    here from the element's depth and its extent in depth (its spans turned by the body's
+    rotation), independently of the kernel's arithmetic (scipy's
+    adaptive quadrature over one direction); the load is linear in the part, so they agree to
+    round-off (1e-12 relative)."""
     result = shots[True, 0.01]
     model = result.model
     lc = model.zones[0][1]
@@ -85,23 +103,26 @@ def test_shank_carries_no_load_inside_the_entry_crater(shots):
     body = model.body
     n = body.areas.size
     with_zone, without = _element_forces(y, opened, n), _element_forces(y, closed, n)
-    z = y[2] + (body.points @ rotation_matrix(y[3:7]).T)[:, 2]
+    rot = rotation_matrix(y[3:7])
+    z = y[2] + (body.points @ rot.T)[:, 2]
+    extent = np.abs(body.spans[:, [1, 3]] @ rot[2])  # depth change across, both directions
     counts = {"inside": 0, "across": 0, "below": 0, "nose": 0}
     for i in range(n):
         if not np.any(without[i]):
             continue  # not loaded anyway (moving away from the wall, out of the target)
-        half = 0.5 * body.sizes[i]
-        wet = min(max(0.5 + z[i] / body.sizes[i], 0.0), 1.0)
-        overlap = max(min(z[i] + half, lc) - max(z[i] - half, 0.0), 0.0)
+        wide, narrow = extent[i].max(), extent[i].min()
+        half = 0.5 * (wide + narrow)
+        wet = 1.0 - _below(-z[i], wide, narrow)
+        overlap = _below(lc - z[i], wide, narrow) - _below(-z[i], wide, narrow)
         if body.nose[i]:
             counts["nose"] += 1
             assert np.array_equal(with_zone[i], without[i])  # the same code path
             continue
-        expected = min(wet, 1.0 - overlap / body.sizes[i]) / wet
+        expected = max(wet - overlap, 0.0) / wet
         inside, below = z[i] - half >= 0.0 and z[i] + half <= lc, z[i] - half >= lc
         counts["inside" if inside else "below" if below else "across"] += 1
-        if inside:  # nothing but round-off of 1 - overlap / h
-            assert expected < 1e-12
+        if inside:
+            assert expected == 0.0
         if below:
             assert expected == 1.0
         scale = np.abs(without[i]).max()

@@ -22,8 +22,10 @@ docs/oblique.md "Convergence"), the midpoint rule in ``theta``
 and in the shank's axial coordinate. The azimuths are placed in mirror pairs
 ``theta_k = (k + 1/2) 2 pi / n`` and ``-theta_k`` (computed as the negative, so that the pair's
 coordinates are exact mirrors); ``partners`` maps each element to its mirror image. Each
-element carries its centroid, normal, area and a size ``h = sqrt(area)`` (the depth band
-over which it is counted as partly embedded, see :mod:`cavex.analytic.penetration.surface_force`).
+element carries its centroid, normal and area, and its spans: how its normal and position
+change across it in ``phi`` (or the shank's axial coordinate) and in ``theta``, from which
+the force law reads the element's extent in depth and in normal velocity
+(:mod:`cavex.analytic.penetration.surface_force`, "Fractions").
 
 Mass properties: ``m`` is given; ``cg`` (from the tip) and the transverse inertia ``I_t``
 about the centre of mass are taken from the projectile when given, else computed for a solid
@@ -58,7 +60,18 @@ class Body:
         Moments of inertia about the centre of mass (kg m^2).
     points, normals : ndarray, shape (n, 3)
         Element centroids relative to the centre of mass and outward unit normals.
-    areas, sizes : ndarray, shape (n,)
+    areas : ndarray, shape (n,)
+    spans : ndarray, shape (n, 5, 3)
+        How the element's normal and position change across it, in its two surface
+        directions: ``(dn_a, dp_a, dn_b, dp_b)``, ``a`` along ``phi`` (the ogive; the axis on the
+        shank) and ``b`` along ``theta``, each the derivative times the element's extent
+        (body frame), the extent being the node's cell (for the Gauss rule in ``phi`` the
+        consecutive intervals of the weights' widths, each holding its node off centre);
+        row 4 holds ``(|dn_a| + |dn_b|, |dp_a| + |dp_b|, e)``, bounds on the changes across
+        the element in any frame and the offset ``e`` of the cell's centre from the node
+        along ``a`` per cell width (0 on the shank and in ``theta``). The force law
+        reads the element's extent in depth and in normal velocity from them
+        (:mod:`cavex.analytic.penetration.surface_force`, "Fractions").
     nose : ndarray of bool, shape (n,)
         True for the ogive's elements.
     partners : ndarray of int, shape (n,)
@@ -78,7 +91,7 @@ class Body:
     points: np.ndarray
     normals: np.ndarray
     areas: np.ndarray
-    sizes: np.ndarray
+    spans: np.ndarray
     nose: np.ndarray
     partners: np.ndarray
     outline: np.ndarray
@@ -94,6 +107,13 @@ class Body:
     def tip(self):
         """Nose tip in the body frame."""
         return np.array([self.cg, 0.0, 0.0])
+
+    @property
+    def axial_half_extent(self):
+        """Half the largest extent (m) of an element along the axis: a nose tip deeper than
+        ``nose_length`` plus this below a face has the whole nose below it at normal
+        incidence."""
+        return 0.5 * float(np.max(np.abs(self.spans[:, 1, 0]) + np.abs(self.spans[:, 3, 0])))
 
     @property
     def elements(self):
@@ -130,6 +150,14 @@ def uniform_mass_properties(projectile, length):
     return volume, cg, axial, transverse
 
 
+def _with_reach(spans, offsets):
+    """``spans`` (n, 4, 3) with the row ``(|dn_a| + |dn_b|, |dp_a| + |dp_b|, e)`` appended
+    (:class:`Body`)."""
+    length = np.linalg.norm(spans, axis=-1)
+    reach = np.stack([length[:, 0] + length[:, 2], length[:, 1] + length[:, 3], offsets], -1)
+    return np.ascontiguousarray(np.concatenate([spans, reach[:, None, :]], axis=1))
+
+
 def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rings=SHANK_RINGS):
     """The :class:`Body` of ``projectile`` with ``nose_points`` Gauss points in ``phi``,
     ``azimuths`` in ``theta`` and ``shank_rings`` rings along the shank."""
@@ -145,6 +173,10 @@ def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rin
         transverse = projectile.inertia
     phi, weights, jacobian = angle_rule(float(R), float(r), nose_points)
     dphi = weights * jacobian
+    # the nodes' cells: consecutive intervals of the weights' widths from phi_0 to pi/2 (each
+    # node lies in its own, not at its centre: the centre's offset from the node per width)
+    lower = math.asin((R - r) / R) + np.concatenate([[0.0], np.cumsum(dphi)[:-1]])
+    offset = (lower + 0.5 * dphi - phi) / dphi
     k = np.arange(azimuths)
     half = (k + 0.5 < 0.5 * azimuths)
     theta = np.where(half, (k + 0.5) * 2.0 * math.pi / azimuths,
@@ -159,15 +191,24 @@ def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rin
     nose_nrm = np.stack([np.cos(P), np.sin(P) * np.cos(T), np.sin(P) * np.sin(T)],
                         -1).reshape(-1, 3)
     nose_area = (R * rho * DP * dtheta).ravel()
-    # element size: arc length in phi times arc length in theta
-    nose_size = np.sqrt((R * DP * rho * dtheta).ravel())
+    # the element's extent: d n / d phi dphi, d p / d phi = R d n / d phi, d n / d theta dtheta,
+    # d p / d theta dtheta
+    dn_a = np.stack([-np.sin(P), np.cos(P) * np.cos(T), np.cos(P) * np.sin(T)], -1) * DP[..., None]
+    dn_b = np.stack([np.zeros_like(P), -np.sin(P) * np.sin(T), np.sin(P) * np.cos(T)],
+                    -1) * dtheta
+    dp_b = np.stack([np.zeros_like(P), -rho * np.sin(T), rho * np.cos(T)], -1) * dtheta
+    nose_spans = np.stack([dn_a, R * dn_a, dn_b, dp_b], -2).reshape(-1, 4, 3)
+    nose_offsets = np.broadcast_to(offset[:, None], P.shape).ravel()
     dx = (length - ln) / shank_rings
     xs = ln + (np.arange(shank_rings) + 0.5) * dx
     X, T2 = np.meshgrid(xs, theta, indexing="ij")
     shank_pts = np.stack([cg - X, r * np.cos(T2), r * np.sin(T2)], -1).reshape(-1, 3)
     shank_nrm = np.stack([np.zeros_like(X), np.cos(T2), np.sin(T2)], -1).reshape(-1, 3)
     shank_area = np.full(X.size, r * dtheta * dx)
-    shank_size = np.sqrt(shank_area)
+    around = np.stack([np.zeros_like(X), -np.sin(T2), np.cos(T2)], -1) * dtheta
+    along = np.broadcast_to(np.array([-dx, 0.0, 0.0]), around.shape)
+    shank_spans = np.stack([np.zeros_like(around), along, around, r * around],
+                           -2).reshape(-1, 4, 3)
     xi_line = np.concatenate([np.linspace(0.0, ln, 40), [length]])
     outline = np.stack([cg - xi_line, profile_radius(projectile, xi_line)], -1)
     return Body(
@@ -176,7 +217,8 @@ def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rin
         points=np.concatenate([nose_pts, shank_pts]),
         normals=np.concatenate([nose_nrm, shank_nrm]),
         areas=np.concatenate([nose_area, shank_area]),
-        sizes=np.concatenate([nose_size, shank_size]),
+        spans=_with_reach(np.concatenate([nose_spans, shank_spans]),
+                          np.concatenate([nose_offsets, np.zeros(len(shank_spans))])),
         nose=np.concatenate([np.ones(nose_area.size, bool), np.zeros(shank_area.size, bool)]),
         partners=np.concatenate([(ring * azimuths + mirror[None, :]).ravel()
                                  for ring in (np.arange(nose_points)[:, None],

@@ -32,7 +32,7 @@ from cavex.analytic.penetration.rosenbrock import (
     initial_step,
     integrate,
 )
-from cavex.analytic.penetration.stress_laws import OK, raise_for
+from cavex.analytic.penetration.stress_laws import OK, TABLE, raise_for
 from cavex.analytic.penetration.strike import Strike  # noqa: F401 (re-exported)
 from cavex.analytic.penetration.surface_force import (
     derivative,
@@ -227,7 +227,7 @@ class ObliqueModel:
             z[0] == depth and depth > 0.0) or (k == 0 and self.entry_crater)],
             dtype=float).reshape(-1, 2)
         walls = np.array(union(self.opened.tolist()), dtype=float).reshape(-1, 2)
-        self._surface = (b.points, b.normals, b.areas, b.sizes, b.partners, b.length, self.mu,
+        self._surface = (b.points, b.normals, b.areas, b.spans, b.partners, b.length, self.mu,
                          self.contact_ramp, np.inf if self.bottom is None else float(self.bottom),
                          b.nose, walls, self._walls, self._wall_depths, self.tangency,
                          self.contact_hold, self.hold_time, *self.law.data)
@@ -446,16 +446,32 @@ class ObliqueModel:
                 "work_J": float(y[13])}
 
     def _history(self, sols, surfaces):
+        """The sampled history at the accepted steps. The compiled integrator's phases carry
+        each step's derivative: the force is ``m dv/dt`` and the body moment
+        ``I d omega/dt + omega x I omega`` (the equations of motion read backwards, equal to
+        round-off); a table law's states are summed again instead (:meth:`loads`), which
+        refuses a normal velocity beyond the table."""
         t = np.concatenate([s.t if i == 0 else s.t[1:] for i, s in enumerate(sols)])
         Y = np.concatenate([s.y if i == 0 else s.y[:, 1:] for i, s in enumerate(sols)], axis=1)
         phase_of = np.concatenate([np.full(s.t.size - (i > 0), i) for i, s in enumerate(sols)])
+        rates = None
+        if self.law.data[0] != TABLE and all(isinstance(s, Segment) for s in sols):
+            rates = np.concatenate([s.f if i == 0 else s.f[:, 1:] for i, s in enumerate(sols)],
+                                   axis=1)
         n = t.size
         out = {k: np.empty(n) for k in (
             "pitch_deg", "yaw_deg", "axial_g", "lateral_g")}
         tips, forces, moments, omegas = (np.empty((n, 3)) for _ in range(4))
+        inertia = self._inertia
         for i in range(n):
             y = Y[:, i]
-            force, moment, _, rot = self.loads(y, surfaces[phase_of[i]])
+            if rates is None:
+                force, moment, _, rot = self.loads(y, surfaces[phase_of[i]])
+            else:
+                rot = rotation_matrix(y[3:7])
+                w = y[10:13]
+                force = self.body.mass * rates[7:10, i]
+                moment = inertia * rates[10:13, i] + np.cross(w, inertia * w)
             axis = rot[:, 0]
             tips[i] = y[0:3] + rot @ self._tip
             forces[i], moments[i] = force, rot @ moment

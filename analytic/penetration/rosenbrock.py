@@ -21,7 +21,9 @@ Heun's method.
 Step control: the embedded first-order solution ``y_n + h k_1`` gives the estimate
 ``e = h (k_1 + k_2) / 2``; a step is accepted when
 ``||e_i / (atol + rtol max(|y_n,i|, |y_n+1,i|))||_rms <= 1`` and the next step is
-``h min(5, max(0.2, 0.9 err^(-1/2)))`` (at most ``h`` after a rejection).
+``h min(5, max(0.2, 0.9 err^(-1/2)))`` (at most ``h`` after a rejection). A step whose
+stage state has non-finite equations of motion (a stiff contact overshot by too long a step)
+is rejected with the largest shrink, not fatal.
 
 Events: the functions of :func:`event_values` (nose tip at each interface, deepest and
 shallowest point of the body, the axis's ``z`` component, transverse kinetic energy) are
@@ -44,11 +46,12 @@ import math
 import numpy as np
 from numba import njit
 
-from cavex.analytic.penetration.stress_laws import OK
+from cavex.analytic.penetration.stress_laws import NOT_FINITE, OK
 from cavex.analytic.penetration.surface_force import derivative, rotation_matrix
 
 GAMMA = 1.0 + 1.0 / math.sqrt(2.0)
 SAFETY, SHRINK, GROW = 0.9, 0.2, 5.0
+REJECTED = 1e6  # the scaled error of a step whose stage is not finite: shrinks it by SHRINK
 EPS = 2.220446049250313e-16
 # statuses of integrate() beside the stress-law statuses (OK, WALK_FAILED, ..., NOT_FINITE)
 RUNNING, EVENT, END_TIME, STEP_TOO_SMALL = 10, 11, 12, 13
@@ -244,6 +247,8 @@ def ros2_step(y, f, jac, h, rtol, atol, mass, inertia, surface, y1):
     for k in range(14):
         stage[k] = y[k] + h * k1[k]
     fstage, _, status, vn = derivative(stage, mass, inertia, *surface)
+    if status == NOT_FINITE:  # the stage overshot: a rejected step (the largest shrink)
+        return REJECTED, OK, vn
     if status != OK:
         return np.inf, status, vn
     for k in range(14):

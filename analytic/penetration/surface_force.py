@@ -3,23 +3,43 @@ r"""Differential-area force law and the rigid body's equations of motion (compil
 State ``y`` (14): centre of mass ``x`` (target frame), unit quaternion ``q = (w, x, y, z)``
 (body to target), velocity ``v``, body-frame angular velocity ``omega``, work ``W`` of the
 surface forces. For surface element ``i`` (body-frame centroid ``p_i``, outward normal
-``n_i``, area ``A_i``, size ``h_i``) with ``R = R(q)``:
+``n_i``, area ``A_i``, spans ``(dn_a, dp_a, dn_b, dp_b)``: the changes of the normal and the
+position across the element in its two surface directions) with ``R = R(q)``:
 
 .. math::
     \mathbf p = R \mathbf p_i, \quad \mathbf n = R \mathbf n_i, \quad
     \mathbf u = \mathbf v + (R \boldsymbol\omega) \times \mathbf p, \quad
-    V_n = \mathbf u \cdot \mathbf n, \quad z = x_3 + p_3,
+    V_n = \mathbf u \cdot \mathbf n, \quad z = x_3 + p_3.
 
-embedded fraction ``w = clip(1/2 + z/h_i, 0, 1)`` (and ``clip(1/2 + (z_b - z)/h_i, 0, 1)`` at
-a finite bottom ``z_b``; for a shank element and each open zone ``[z_t, z_b]``
-(:func:`cavex.analytic.penetration.zones.open_zones`, opened by the integrator's events) at
-most ``1 - |[z - h_i/2, z + h_i/2] ∩ [z_t, z_b]| / h_i``: no tunnel wall in a crater or a
-scabbed rear zone; times the tunnel-wall factor ``walls[k]`` of its layer ``k``, none: 1).
-A wetted element (``w > 0`` and ``V_n > 10^-9 (|v| + L |omega|)``,
-the round-off guard) carries the load ``P = A_i w sigma_n(z, n_3, V_n) min(V_n / V_r, 1)``
-(contact regularisation over ``0 < V_n < V_r``, ``V_r`` = ``contact_ramp``; 0: none; with
-OFPM's tangency attenuation ``tangency = sin psi`` > 0, ``V_r = max(contact_ramp, |u| sin psi)``:
-the load falls linearly within ``psi`` of tangency), force
+Fractions. An element is a small parallelogram over which ``z`` and ``V_n`` vary linearly:
+``z + s dz_a + t dz_b`` and ``V_n + s dV_a + t dV_b`` with ``|s|, |t| <= 1/2``,
+``dz = (R dp) . e_3`` and ``dV = u . (R dn) + ((R omega) x (R dp)) . n``. The part of it on
+which a linear function ``x + s w_1 + t w_2`` is positive is the distribution function of the
+sum of two uniform variables of widths ``w_1 >= w_2`` (:func:`wetted_fraction`; a trapezoid's
+integral, exact for the linear function), so every step of the force law across the surface
+(the free surface, a finite bottom, an open zone's edges, an interface where the stress law
+jumps, the line where the contact opens) is integrated over the element's area instead of
+switching at its centroid; the surface rule then converges at second order in the element
+size at a fixed state (docs/oblique.md "Convergence"). With ``G(x) = wetted_fraction(x, dz)``:
+
+- embedded fraction ``w = G(z)`` (the part below ``z = 0``), at a finite bottom ``z_b`` less
+  ``1 - G(z_b - z)``; for a shank element less its part ``G(z_b - z) - G(z_t - z)`` in each
+  open zone ``[z_t, z_b]`` (:func:`cavex.analytic.penetration.zones.open_zones`, opened by the
+  integrator's events: no tunnel wall in a crater or a scabbed rear zone); times the
+  tunnel-wall factor ``walls[k]`` of its layer ``k`` (none: 1);
+- an element straddling an interface ``H`` carries ``G(z - H) sigma_n(max(z, H)) +
+  (1 - G(z - H)) sigma_n(min(z, H^-))``, each side's stress at the centroid's depth clamped
+  to that side (:func:`_split_stress`);
+- wetted fraction ``c = wetted_fraction(V_n - V_r/2, max(w_1, V_r), w_2)`` of the normal
+  velocity's widths: the contact regularisation ``V_r`` = ``contact_ramp`` (0: none) is a ramp
+  ``clip(V_n/V_r, 0, 1)`` for an element over which ``V_n`` hardly varies and the element's
+  part in contact otherwise; with OFPM's tangency attenuation ``tangency = sin psi`` > 0,
+  ``V_r = max(contact_ramp, |u| sin psi)`` (the load falls linearly within ``psi`` of
+  tangency). ``V_n`` within ``10^-9 (|v| + L |omega|)`` of zero counts as zero, and so does
+  its change across an element (round-off).
+
+An element with ``w c > 0`` carries the load ``P = A_i w c sigma_n(z, n_3, max(V_n, 0))``,
+force
 
 .. math:: \mathbf f = -P (\mathbf n + \mu \mathbf t), \quad
           \mathbf t = \mathbf u_t / |\mathbf u_t|, \quad
@@ -28,9 +48,9 @@ the load falls linearly within ``psi`` of tangency), force
 Sums: ``F = sum f``, ``M = R^T sum p x f`` (body frame), power ``sum f . u``.
 
 Contact damping (the stiff part of the Jacobian, for the linearly implicit integrator of
-:mod:`cavex.analytic.penetration.rosenbrock`): on the ramp ``0 < V_n < V_r`` the load grows as
-``kappa V_n`` with ``kappa = A_i w sigma_n / V_r`` (large for a small ramp: a sliding shank is
-a stiff damper). With ``u = v - [p]_x omega_t`` its contribution to
+:mod:`cavex.analytic.penetration.rosenbrock`): the load grows with ``V_n`` at the rate
+``kappa = A_i w sigma_n dc/dV_n`` (at most ``A_i w sigma_n / V_r``: large for a small ramp,
+a sliding shank is a stiff damper). With ``u = v - [p]_x omega_t`` its contribution to
 ``d(F, sum p x f)/d(v, omega_t)`` is ``-kappa b a^T``, ``a = (n, p x n)``,
 ``b = (d, p x d)``, ``d = n + mu t``; the kernel returns
 ``D = d(dv/dt, d omega/dt)/d(v, omega)`` in the state's frames (body-frame ``omega``),
@@ -74,6 +94,7 @@ from cavex.analytic.penetration.stress_laws import (
 )
 
 ROUND_OFF = 1e-9  # normal velocities below this x the body's velocity scale count as zero
+_NO_ZONES = np.empty((0, 2))
 
 
 @njit(cache=True, error_model="numpy")
@@ -128,32 +149,141 @@ def mirror_state(y, partners=None):
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, contact_ramp, bottom,
-                  nose, open_zones, walls, wall_depths, tangency, hold, hold_time, kind,
-                  scalars, values, tables, counts, depths, radii, zones, out, damping, extra):
+def wetted_fraction(x, wide, narrow):
+    """``(fraction, d fraction / dx)`` of the unit square ``|s|, |t| <= 1/2`` on which
+    ``x + wide s + narrow t > 0`` (``wide >= narrow >= 0``; "Wetted fraction" in the module
+    docstring): the distribution function of the sum of two uniform variables of widths
+    ``wide`` and ``narrow`` at ``x``, a trapezoid's integral. ``wide = 0``: the step at 0."""
+    if wide <= 0.0:
+        return (1.0 if x > 0.0 else 0.0), 0.0
+    outer = 0.5 * (wide + narrow)
+    inner = 0.5 * (wide - narrow)
+    if x <= -outer:
+        return 0.0, 0.0
+    if x >= outer:
+        return 1.0, 0.0
+    if x < -inner:
+        return (x + outer) ** 2 / (2.0 * wide * narrow), (x + outer) / (wide * narrow)
+    if x > inner:
+        return 1.0 - (outer - x) ** 2 / (2.0 * wide * narrow), (outer - x) / (wide * narrow)
+    return 0.5 + x / wide, 1.0 / wide
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _near_edge(z, reach, bottom, open_zones, interfaces):
+    """Whether an edge of the force law (the free surface, the bottom, an open zone's top or
+    bottom, an interface) lies within ``reach`` (the element's largest half extent) of the
+    depth ``z``: only then do the element's fractions need its spans."""
+    if abs(z) < reach or abs(bottom - z) < reach:
+        return True
+    for k in range(open_zones.shape[0]):
+        if abs(open_zones[k, 0] - z) < reach or abs(open_zones[k, 1] - z) < reach:
+            return True
+    for k in range(interfaces.shape[0]):
+        if abs(interfaces[k] - z) < reach:
+            return True
+    return False
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _depth_spread(i, rot, spans):
+    """``(shift, wide, narrow)``: the depth of element ``i``'s centre less its node's,
+    ``e dz_a``, and the larger and the smaller change of the depth across it in its two
+    surface directions, ``|dz| = |(R dp) . e_3|`` (module docstring, "Fractions")."""
+    first = (rot[2, 0] * spans[i, 1, 0] + rot[2, 1] * spans[i, 1, 1]
+             + rot[2, 2] * spans[i, 1, 2])
+    second = abs(rot[2, 0] * spans[i, 3, 0] + rot[2, 1] * spans[i, 3, 1]
+                 + rot[2, 2] * spans[i, 3, 2])
+    return spans[i, 4, 2] * first, max(abs(first), second), min(abs(first), second)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _span_change(i, k, rot, omega, u0, u1, u2, n0, n1, n2, spans):
+    """``u . (R dn) + ((R omega) x (R dp)) . n`` for the spans ``dn = spans[i, k]``,
+    ``dp = spans[i, k + 1]`` (``omega`` already in the target frame)."""
+    a0, a1, a2 = spans[i, k, 0], spans[i, k, 1], spans[i, k, 2]
+    b0, b1, b2 = spans[i, k + 1, 0], spans[i, k + 1, 1], spans[i, k + 1, 2]
+    dn0 = rot[0, 0] * a0 + rot[0, 1] * a1 + rot[0, 2] * a2
+    dn1 = rot[1, 0] * a0 + rot[1, 1] * a1 + rot[1, 2] * a2
+    dn2 = rot[2, 0] * a0 + rot[2, 1] * a1 + rot[2, 2] * a2
+    dp0 = rot[0, 0] * b0 + rot[0, 1] * b1 + rot[0, 2] * b2
+    dp1 = rot[1, 0] * b0 + rot[1, 1] * b1 + rot[1, 2] * b2
+    dp2 = rot[2, 0] * b0 + rot[2, 1] * b1 + rot[2, 2] * b2
+    c0 = omega[1] * dp2 - omega[2] * dp1
+    c1 = omega[2] * dp0 - omega[0] * dp2
+    c2 = omega[0] * dp1 - omega[1] * dp0
+    return (u0 * dn0 + u1 * dn1 + u2 * dn2) + (c0 * n0 + c1 * n1 + c2 * n2)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _velocity_spread(i, rot, omega, u0, u1, u2, n0, n1, n2, spans):
+    """``(shift, wide, narrow)``: the normal velocity at element ``i``'s centre less its
+    node's, ``e dV_a``, and the larger and the smaller change of the normal velocity across
+    it in its two surface directions, ``|dV| = |u . dn + (omega x dp) . n|`` with the
+    element's ``spans`` turned to the target frame (module docstring, "Fractions")."""
+    first = _span_change(i, 0, rot, omega, u0, u1, u2, n0, n1, n2, spans)
+    second = abs(_span_change(i, 2, rot, omega, u0, u1, u2, n0, n1, n2, spans))
+    return spans[i, 4, 2] * first, max(abs(first), second), min(abs(first), second)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _split_stress(kind, scalars, values, tables, counts, depths, z, middle, wide, narrow, nz, vn,
+                  radii, zones):
+    """``(sigma_n, status)`` of an element with its node at depth ``z`` whose depths span
+    ``middle`` plus the sum of two uniform offsets of widths ``wide >= narrow``: where the
+    element straddles an interface ``H`` (a jump of the law), the parts below and above it,
+    each at the node's depth clamped to its side (module docstring, "Fractions"); else the
+    law at ``z``."""
+    for j in range(depths.shape[0]):
+        H = depths[j]
+        if abs(middle - H) < 0.5 * (wide + narrow):
+            below = wetted_fraction(middle - H, wide, narrow)[0]
+            low, status = element_stress(kind, scalars, values, tables, counts, depths,
+                                         max(z, H), nz, vn, radii, zones)
+            if status == WALK_FAILED or below >= 1.0:
+                return low, status
+            high, other = element_stress(kind, scalars, values, tables, counts, depths,
+                                         max(min(z, np.nextafter(H, -np.inf)), 1e-12), nz, vn,
+                                         radii, zones)
+            if other == WALK_FAILED:
+                return high, other
+            return below * low + (1.0 - below) * high, max(status, other)
+    return element_stress(kind, scalars, values, tables, counts, depths, max(z, 1e-12), nz, vn,
+                          radii, zones)
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _element_load(i, y, rot, omega, scale, points, normals, areas, spans, mu, contact_ramp, bottom,
+                  nose, open_zones, walls, wall_depths, tangency, hold, hold_time, law,
+                  radii, zones, out, damping, extra):
     """Force, moment about the centre of mass (target frame) and power of element ``i``
     into ``out[0:7]``, its contact damping ``kappa b a^T`` (module docstring, target frame)
     into ``damping``; returns ``(status, V_n)``. With the held contact (``hold`` > 0)
-    :func:`_held_load` instead (``extra``: its rate and Jacobian rows)."""
+    :func:`_held_load` instead (``extra``: its rate and Jacobian rows). ``law``: the stress
+    law's ``(kind, scalars, values, tables, counts, depths)``."""
+    kind, scalars, values, tables, counts, depths = law
     out[:] = 0.0
     damping[:, :] = 0.0
     p0 = rot[0, 0] * points[i, 0] + rot[0, 1] * points[i, 1] + rot[0, 2] * points[i, 2]
     p1 = rot[1, 0] * points[i, 0] + rot[1, 1] * points[i, 1] + rot[1, 2] * points[i, 2]
     p2 = rot[2, 0] * points[i, 0] + rot[2, 1] * points[i, 1] + rot[2, 2] * points[i, 2]
     z = y[2] + p2
-    frac = min(max(0.5 + z / sizes[i], 0.0), 1.0)
-    if bottom < np.inf:
-        frac = min(frac, min(max(0.5 + (bottom - z) / sizes[i], 0.0), 1.0))
+    middle, z_wide, z_narrow = z, 0.0, 0.0  # far from every edge: steps, exact
+    if _near_edge(z, spans[i, 4, 1], bottom, open_zones if not nose[i] else _NO_ZONES,
+                  law[5]):
+        shift, z_wide, z_narrow = _depth_spread(i, rot, spans)
+        middle = z + shift
+    frac = wetted_fraction(middle, z_wide, z_narrow)[0]  # the part below the free surface
+    if bottom < np.inf:  # and above the bottom
+        frac = max(frac - (1.0 - wetted_fraction(bottom - middle, z_wide, z_narrow)[0]), 0.0)
     if not nose[i] and open_zones.shape[0] > 0:  # the shank carries no load in an open
         # zone (crater, scabbed rear zone); the zones are disjoint (merged where they touch),
-        # so the element's length inside their union is the sum of its overlaps
-        half = 0.5 * sizes[i]
+        # so the element's part inside their union is the sum of its parts in each
         inside = 0.0
         for k in range(open_zones.shape[0]):
-            inside += max(min(z + half, open_zones[k, 1]) - max(z - half, open_zones[k, 0]),
-                          0.0)
-        if inside > 0.0:
-            frac = min(frac, max(1.0 - inside / sizes[i], 0.0))
+            inside += (wetted_fraction(open_zones[k, 1] - middle, z_wide, z_narrow)[0]
+                       - wetted_fraction(open_zones[k, 0] - middle, z_wide, z_narrow)[0])
+        frac = max(frac - inside, 0.0)
     if not nose[i] and walls.shape[0] > 0:  # the tunnel-wall factor of the element's layer
         frac *= walls[np.searchsorted(wall_depths, z, side="right")]
     if frac <= 0.0 and hold <= 0.0:  # (a held element's fraction moves outside too)
@@ -166,21 +296,30 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
     u2 = y[9] + omega[0] * p1 - omega[1] * p0
     vn = u0 * n0 + u1 * n1 + u2 * n2
     if hold > 0.0:
-        return _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, scale, areas,
-                          mu, hold, hold_time, kind, scalars, values, tables, counts, depths,
-                          radii, zones, out, damping, extra)
-    if vn <= scale:
-        return OK, 0.0
-    sigma, status = element_stress(kind, scalars, values, tables, counts, depths,
-                                   max(z, 1e-12), n2, vn, radii, zones)
-    if status == WALK_FAILED:
-        return status, vn
-    load = sigma * areas[i] * frac
+        return _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, middle,
+                          z_wide, z_narrow, scale, areas, mu, hold, hold_time, law, radii,
+                          zones, out, damping, extra)
+    if abs(vn) <= scale:
+        vn = 0.0
     ramp = contact_ramp
     if tangency > 0.0:  # OFPM's attenuation: load x angle / psi within psi of tangency
         ramp = max(ramp, tangency * math.sqrt(u0 * u0 + u1 * u1 + u2 * u2))
-    if ramp > 0.0:
-        load *= min(vn / ramp, 1.0)
+    shift = wide = narrow = 0.0
+    speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    turning = math.sqrt(omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2])
+    if abs(vn - 0.5 * ramp) < 0.5 * ramp + speed * spans[i, 4, 0] + turning * spans[i, 4, 1]:
+        shift, wide, narrow = _velocity_spread(i, rot, omega, u0, u1, u2, n0, n1, n2, spans)
+        if wide <= scale:  # round-off: V_n does not vary across the element
+            shift = wide = narrow = 0.0
+    wetted, slope = wetted_fraction(vn + shift - 0.5 * ramp, max(wide, ramp), narrow)
+    if wetted <= 0.0:
+        return OK, vn
+    sigma, status = _split_stress(kind, scalars, values, tables, counts, depths, z, middle,
+                                  z_wide, z_narrow, n2, max(vn, 0.0), radii, zones)
+    if status == WALK_FAILED:
+        return status, vn
+    capacity = sigma * areas[i] * frac
+    load = capacity * wetted
     f0, f1, f2 = -load * n0, -load * n1, -load * n2
     if mu > 0.0:
         t0, t1, t2 = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
@@ -193,8 +332,8 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
     out[4] = p2 * f0 - p0 * f2
     out[5] = p0 * f1 - p1 * f0
     out[6] = f0 * u0 + f1 * u1 + f2 * u2
-    if ramp > 0.0 and vn < ramp and load > 0.0:
-        kappa = load / vn  # = A_i w sigma_n / V_r on the ramp
+    if slope > 0.0 and load > 0.0:
+        kappa = capacity * slope  # d load / d V_n = A_i w sigma_n d(wetted)/dV_n
         a = (n0, n1, n2, p1 * n2 - p2 * n1, p2 * n0 - p0 * n2, p0 * n1 - p1 * n0)
         b = (-f0 / load, -f1 / load, -f2 / load, -out[3] / load, -out[4] / load,
              -out[5] / load)
@@ -205,9 +344,8 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, sizes, mu, co
     return status, vn
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, scale, areas, mu, hold,
-               hold_time, kind, scalars, values, tables, counts, depths, radii, zones, out,
-               damping, extra):
+def _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, middle, z_wide, z_narrow,
+               scale, areas, mu, hold, hold_time, law, radii, zones, out, damping, extra):
     """Element ``i`` under the held contact (module docstring, "Held contact"). Its elastic
     fraction ``phi = y[14 + i]`` moves at ``V_n / hold`` within ``[0, 1]`` (not at all where
     ``V_n`` pushes out of them; ``|V_n|`` less the round-off guard ``scale``): an elastic
@@ -229,8 +367,9 @@ def _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, scale, are
     elastic = rate != 0.0 and 0.0 < raw < 1.0
     if frac <= 0.0 or not (fraction > 0.0 or elastic):
         return OK, 0.0
-    sigma, status = element_stress(kind, scalars, values, tables, counts, depths,
-                                   max(z, 1e-12), n2, max(vn, 0.0), radii, zones)
+    kind, scalars, values, tables, counts, depths = law
+    sigma, status = _split_stress(kind, scalars, values, tables, counts, depths, z, middle,
+                                  z_wide, z_narrow, n2, max(vn, 0.0), radii, zones)
     if status == WALK_FAILED:
         return status, vn
     capacity = sigma * areas[i] * frac
@@ -262,7 +401,7 @@ def _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, scale, are
 
 
 @njit(cache=True, error_model="numpy")
-def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
+def surface_loads(y, points, normals, areas, spans, partners, length, mu, contact_ramp, bottom,
                   nose, open_zones, walls, wall_depths, tangency, hold, hold_time, kind, scalars,
                   values, tables, counts, depths):
     """``(F (3, target frame), M (3, body frame), power, status, V_n of a failed element,
@@ -292,19 +431,19 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contac
     held = np.zeros((areas.shape[0] if hold > 0.0 else 0, 14))
     extra = np.empty(14)
     beyond = 0.0  # largest normal velocity beyond a table's range (0: none)
+    law = (kind, scalars, values, tables, counts, depths)
     for i in range(areas.shape[0]):
         j = partners[i]
         if j < i:
             continue
         for second in range(2 if j != i else 1):
             k = j if second else i
-            status, vn = _element_load(k, y, rot, omega, scale, points,
-                                       normals, areas, sizes, mu, contact_ramp, bottom, nose,
-                                       open_zones, walls, wall_depths, tangency, hold,
-                                       hold_time, kind, scalars, values, tables, counts,
-                                       depths, radii, zones,
-                                       other if second else one,
-                                       other_damping if second else one_damping, extra)
+            result = other if second else one
+            result_damping = other_damping if second else one_damping
+            status, vn = _element_load(k, y, rot, omega, scale, points, normals, areas, spans,
+                                       mu, contact_ramp, bottom, nose, open_zones, walls,
+                                       wall_depths, tangency, hold, hold_time, law, radii,
+                                       zones, result, result_damping, extra)
             if hold > 0.0:  # the rate and the Jacobian rows, turned to the state's frames
                 held[k, 0:7] = extra[0:7]
                 held[k, 7:10] = extra[7:10]
@@ -342,16 +481,16 @@ def surface_loads(y, points, normals, areas, sizes, partners, length, mu, contac
 
 
 @njit(cache=True, error_model="numpy")
-def derivative(y, mass, inertia, points, normals, areas, sizes, partners, length, mu, contact_ramp,
-               bottom, nose, open_zones, walls, wall_depths, tangency, hold, hold_time, kind,
-               scalars, values, tables, counts, depths):
+def derivative(y, mass, inertia, points, normals, areas, spans, partners, length, mu,
+               contact_ramp, bottom, nose, open_zones, walls, wall_depths, tangency, hold,
+               hold_time, kind, scalars, values, tables, counts, depths):
     """``(dy/dt, D, status, V_n of a failed element)`` (module docstring; ``D`` the 6 x 6
     contact damping block of the Jacobian; with the held contact, ``hold`` > 0, ``D`` is
     ``(6 + 2 N) x 6``: rows 0-5 the product ``S = B C`` of the two blocks, rows ``6 + i``
     the column ``B_i = d(dv/dt, d omega/dt)/d phi_i``, rows ``6 + N + i`` the row
     ``C_i = d(dphi_i/dt)/d(v, omega)``)."""
     force, moment, power, status, vn, damping, held = surface_loads(
-        y, points, normals, areas, sizes, partners, length, mu, contact_ramp, bottom,
+        y, points, normals, areas, spans, partners, length, mu, contact_ramp, bottom,
         nose, open_zones, walls, wall_depths, tangency, hold, hold_time, kind, scalars, values,
         tables, counts, depths)
     size = y.shape[0]
