@@ -39,22 +39,27 @@ def test_tunnel_wall_key_and_option(default, capsys, tmp_path):
         assert not (tmp_path / "o").exists()
 
 
-def _state(default, **model_options):
-    """A model and a state with the shank sliding in its tunnel (600 m/s, 20 deg, mid-run)."""
+@pytest.fixture(scope="module")
+def paper_shot(default):
+    """The paper's shot at the defaults (600 m/s, 20 deg, bonded runway, ramp 0.01 m/s), flown
+    once for the module: the state of :func:`_state` and the bonded run at ramp 0.01 of the
+    ramp refinement (the tests only read it)."""
     target, projectile = default
-    law = make_law(target, projectile)
-    model = ObliqueModel(target, projectile, law, **model_options)
-    result = model.run(Strike(600.0, 20.0))
-    last = result.solutions[-1]  # in the macadam, the shank in its tunnel
-    return model, last.y[:, last.t.size // 2]
+    return fly(target, projectile, Strike(600.0, 20.0))
 
 
-def test_wall_factor_scales_the_shank_load_only(default):
+def _state(paper_shot):
+    """A model and a state with the shank sliding in its tunnel (600 m/s, 20 deg, mid-run)."""
+    last = paper_shot.solutions[-1]  # in the macadam, the shank in its tunnel
+    return paper_shot.model, last.y[:, last.t.size // 2]
+
+
+def test_wall_factor_scales_the_shank_load_only(default, paper_shot):
     """``F(f) = F_nose + f (F - F_nose)`` for force, moment and power, with ``F_nose`` from
     the same state with the shank's areas set to zero (linear in the load: bound 1e-12 of the
     total)."""
     target, projectile = default
-    model, y = _state(default)
+    model, y = _state(paper_shot)
     surface = list(model._surface)
     full = np.concatenate([np.ravel(v) for v in surface_loads(y, *surface)[:3]])
     nose_only = list(surface)
@@ -70,12 +75,12 @@ def test_wall_factor_scales_the_shank_load_only(default):
                                atol=1e-12 * np.abs(full[part]).max()), (factor, part)
 
 
-def test_tangency_attenuation_is_a_relative_ramp(default):
+def test_tangency_attenuation_is_a_relative_ramp(default, paper_shot):
     """OFPM scales an element's load by angle/psi within psi of tangency; for a body that
     only translates every element's speed is |v|, so the attenuation is the contact ramp
     ``V_r = |v| sin psi`` (bound 1e-12 of the force)."""
     target, projectile = default
-    model, y = _state(default)
+    model, y = _state(paper_shot)
     y = y.copy()
     y[10:13] = 0.0  # translation only
     speed = float(np.linalg.norm(y[7:10]))
@@ -109,7 +114,7 @@ def _turn_after(result, interface=1):
     return result.phases[k + 1]["end_pitch_deg"] - result.phases[k]["end_pitch_deg"]
 
 
-def test_added_turn_refinement_in_the_contact_ramp(default):
+def test_added_turn_refinement_in_the_contact_ramp(default, paper_shot):
     """Issue 30, with every step of the force law integrated over the element (docs/oblique.md
     "Convergence"): the added turn at the first debonded interface (600 m/s, 20 deg; debonded
     minus bonded, pitch at the stop minus at the crossing) at ramps 0.03, 0.01, 0.003, 0.001
@@ -120,11 +125,12 @@ def test_added_turn_refinement_in_the_contact_ramp(default):
     target, projectile = default
     debonded = target.with_interfaces("debonded")
     added = {}
+    assert paper_shot.model.contact_ramp == 0.01
     for ramp in (0.03, 0.01, 0.003, 0.001):
+        bonded = (paper_shot if ramp == 0.01  # the default ramp: the module's run
+                  else fly(target, projectile, Strike(600.0, 20.0), contact_ramp=ramp))
         added[ramp] = (_turn_after(fly(debonded, projectile, Strike(600.0, 20.0),
-                                       contact_ramp=ramp))
-                       - _turn_after(fly(target, projectile, Strike(600.0, 20.0),
-                                         contact_ramp=ramp)))
+                                       contact_ramp=ramp)) - _turn_after(bonded))
     print("added turn (deg) by ramp:", added)
     gaps = np.abs(np.diff(list(added.values())))
     assert np.all(np.diff(gaps) < 0.0)  # the gaps shrink
@@ -170,7 +176,7 @@ def test_low_pass_lateral_overload():
     assert np.all(np.abs(mean[inner] - 1.0) <= 2.0 / 30)
 
 
-def test_open_zones_are_merged_where_they_meet(default):
+def test_open_zones_are_merged_where_they_meet(default, paper_shot):
     """The rear zone and the crater meet at the interface plane; a shank element straddling
     it has no wall on either side (before the merge each zone's overlap was taken alone and
     the element kept the larger partial load). ``zones.union`` merges touching and overlapping
@@ -184,7 +190,7 @@ def test_open_zones_are_merged_where_they_meet(default):
     assert union([]) == []
     target, projectile = default
     debonded = target.with_interfaces("debonded")
-    model, y = _state(default)  # the shank in its tunnel around the first interface
+    model, y = _state(paper_shot)  # the shank in its tunnel around the first interface
     law = make_law(debonded, projectile)
     deb = ObliqueModel(debonded, projectile, law)
     H = debonded.interface_depths[0]
