@@ -272,9 +272,8 @@ def test_surface_discretisation_converges(runway, contact_ramp):
         force, moment = model.loads(y)[:2]
         loads.append(np.concatenate([force, moment]))
     loads = np.array(loads)
-    errors = {part: np.linalg.norm(loads[:-1, part] - loads[-1, part], axis=1)
-              / np.linalg.norm(loads[-1, part]) for part in (slice(0, 3), slice(3, 6))}
-    force, moment = errors.values()
+    force, moment = (np.linalg.norm(loads[:-1, part] - loads[-1, part], axis=1)
+                     / np.linalg.norm(loads[-1, part]) for part in (slice(0, 3), slice(3, 6)))
     rate = np.polyfit(np.log(1.0 / np.array(levels[:-1])), np.log(moment), 1)[0]
     print("force errors", force, "moment errors", moment, "moment's fitted order", rate)
     assert rate > 1.9
