@@ -265,18 +265,14 @@ def _tunnel(target, projectile, resistance, start, columns, phases, crater, rtol
         phases.append(replace(phase, stage=stage))
         if phase.end_reason == stop_reason:
             stage = ahead.pop(0)[2]
-            if stage == "crater" and erosion is not None:
-                start, mass = _eroding_interface_crater(target, projectile, resistance, start,
-                                                        columns, phases, crater, erosion,
-                                                        mass, masses)
-                stage = "tunnel"
-                ahead = [stop for stop in ahead if stop[0] > start[1]]
-                if start[2] > 0.0:
-                    label = resistance.label(start[1], start[2])
-                continue
             if stage == "crater":
-                start = _interface_crater(target, projectile, resistance, start, columns,
-                                          phases, crater)
+                if erosion is not None:
+                    start, mass = _eroding_interface_crater(target, projectile, resistance,
+                                                            start, columns, phases, crater,
+                                                            erosion, mass, masses)
+                else:
+                    start = _interface_crater(target, projectile, resistance, start, columns,
+                                              phases, crater)
                 stage = "tunnel"
                 ahead = [stop for stop in ahead if stop[0] > start[1]]
                 if start[2] > 0.0:
