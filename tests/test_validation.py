@@ -593,7 +593,7 @@ def test_a_shot_id_of_any_characters_is_one_markdown_table_cell():
 def test_recommended_split_holds_with_each_reference_left_out():
     """The recommended model's two choices (Li and Chen at f_c <= 100 MPa, the concrete model
     above) were made on the development shots: refitted with each of the 21 references left
-    out, both choices stay the same (so its LORO scores are its in-sample ones: 0.436 all,
+    out, both choices stay the same (so its LORO scores are its in-sample ones: 0.433 all,
     0.356 normal strength, docs/validation.md), and the split beats both of its parts over all
     shots and at every threshold from 60 to 120 MPa."""
     import csv
@@ -615,7 +615,7 @@ def test_recommended_split_holds_with_each_reference_left_out():
         assert logs["concrete"][rest & high].mean() < logs["li-chen-2003"][rest & high].mean()
     split = np.where(high, logs["concrete"], logs["li-chen-2003"])
     assert np.allclose(split, logs["li-chen-concrete"], rtol=1e-5, atol=1e-6)
-    assert split.mean() == pytest.approx(0.436, abs=5e-4)
+    assert split.mean() == pytest.approx(0.433, abs=5e-4)
     for threshold in (60e6, 80e6, 100e6, 120e6):
         other = np.where(fc > threshold, logs["concrete"], logs["li-chen-2003"]).mean()
         assert other < min(logs["concrete"].mean(), logs["li-chen-2003"].mean()) - 0.03
