@@ -22,7 +22,7 @@ from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.config import default_config_text, load_config
 from cavex.verification.cli import main
-from cavex.verification.output.number_format import TRAJECTORY_QUANTA
+from cavex.verification.output.number_format import TRAJECTORY_QUANTA, Decimals
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 TRAJECTORY_COLUMNS = ["t_s", "depth_m", "velocity_m_s", "deceleration_m_s2", "phase"]
@@ -88,13 +88,17 @@ def test_penetrate_json_outputs_and_files(capsys, tmp_path, default):
         assert data[:8] == PNG_SIGNATURE and len(data) > 1000
     header, rows = _read_csv(out_dir / "trajectory_runway.csv")
     assert header == TRAJECTORY_COLUMNS
-    assert len(rows) == len(trajectory.t)
+    written = trajectory.rows()  # equal intervals of time within each phase
+    assert len(rows) == len(written["t_s"])
     columns = list(zip(*rows, strict=True))
     for name, column in zip(header, columns, strict=True):
-        quantum = TRAJECTORY_QUANTA.get(name)  # the coarser of 6 digits and this (number_format)
+        rule = TRAJECTORY_QUANTA.get(name)  # number_format: a Decimals quantum or digits
+        quantum = rule if isinstance(rule, Decimals) else None
         half = 0.0 if quantum is None else 0.5 * 10.0 ** -int(quantum) * (1 + 1e-6)
-        assert [float(v) for v in column] == pytest.approx(
-            list(trajectory.as_columns()[name]), rel=CSV_ROUNDING, abs=half)
+        rel = CSV_ROUNDING if quantum is not None or rule is None else (
+            0.5 * 10.0 ** (1 - rule) * (1 + 1e-6))
+        assert [float(v) for v in column] == pytest.approx(list(written[name]), rel=rel,
+                                                           abs=half)
     header, rows = _read_csv(out_dir / "trajectory_first_layer_only.csv")
     assert header == TRAJECTORY_COLUMNS and len(rows) > 10
     assert float(rows[-1][2]) == 0.0  # velocity at the stop

@@ -272,14 +272,17 @@ def test_trajectory_user_target_is_a_layered_target_with_its_names(trajectory_jo
     assert any(label.startswith("layered target: ") for label in
                (t.get_text() for t in side.legends[0].get_texts()))
     renderer = side.canvas.get_renderer()
-    names = {t.get_text().replace("\n", " "): t for t in side.axes[0].texts}
+    names = {t.get_text().replace("\n", " ").removesuffix(" (layered target only)"): t
+             for t in side.axes[0].texts}  # the layers below the first: the layered run's
     assert set(USER_NAMES) <= set(names)
     for name in USER_NAMES:  # inside the figure: not cropped at its right edge
         assert names[name].get_window_extent(renderer).x1 <= side.bbox.x1, name
     assert "\n" in names["crushed stone base"].get_text()  # wrapped to fit
-    legend_3d = [t.get_text() for t in kept_trajectory_figures["path_3d.png"].legends[0]
-                 .get_texts()]
-    assert set(USER_NAMES) <= set(legend_3d)
+    legend_3d = [t.get_text().replace("\n", " ") for t in
+                 kept_trajectory_figures["path_3d.png"].legends[0].get_texts()]
+    for name in USER_NAMES:  # a layer in the block, or named below it ("below the block: ...")
+        assert any(label == name or label.startswith(f"below the block: {name} ")
+                   for label in legend_3d), (name, legend_3d)
 
 
 # --- 4. help ------------------------------------------------------------------------------------
