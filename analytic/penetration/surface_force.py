@@ -253,14 +253,15 @@ def _split_stress(kind, scalars, values, tables, counts, depths, z, middle, wide
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _element_load(i, y, rot, omega, scale, points, normals, areas, spans, mu, contact_ramp, bottom,
-                  nose, open_zones, walls, wall_depths, tangency, hold, hold_time, law,
-                  radii, zones, out, damping, extra):
+def _element_load(i, y, rot, omega, turning, scale, points, normals, areas, spans, mu,
+                  contact_ramp, bottom, nose, open_zones, walls, wall_depths, tangency, hold,
+                  hold_time, law, radii, zones, out, damping, extra):
     """Force, moment about the centre of mass (target frame) and power of element ``i``
     into ``out[0:7]``, its contact damping ``kappa b a^T`` (module docstring, target frame)
     into ``damping``; returns ``(status, V_n)``. With the held contact (``hold`` > 0)
     :func:`_held_load` instead (``extra``: its rate and Jacobian rows). ``law``: the stress
-    law's ``(kind, scalars, values, tables, counts, depths)``."""
+    law's ``(kind, scalars, values, tables, counts, depths)``; ``turning`` the body's ``|omega|``
+    (the state's, one for every element)."""
     kind, scalars, values, tables, counts, depths = law
     out[:] = 0.0
     damping[:, :] = 0.0
@@ -270,7 +271,7 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, spans, mu, co
     z = y[2] + p2
     middle, z_wide, z_narrow = z, 0.0, 0.0  # far from every edge: steps, exact
     if _near_edge(z, spans[i, 4, 1], bottom, open_zones if not nose[i] else _NO_ZONES,
-                  law[5]):
+                  depths):
         shift, z_wide, z_narrow = _depth_spread(i, rot, spans)
         middle = z + shift
     frac = wetted_fraction(middle, z_wide, z_narrow)[0]  # the part below the free surface
@@ -306,7 +307,6 @@ def _element_load(i, y, rot, omega, scale, points, normals, areas, spans, mu, co
         ramp = max(ramp, tangency * math.sqrt(u0 * u0 + u1 * u1 + u2 * u2))
     shift = wide = narrow = 0.0
     speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-    turning = math.sqrt(omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2])
     if abs(vn - 0.5 * ramp) < 0.5 * ramp + speed * spans[i, 4, 0] + turning * spans[i, 4, 1]:
         shift, wide, narrow = _velocity_spread(i, rot, omega, u0, u1, u2, n0, n1, n2, spans)
         if wide <= scale:  # round-off: V_n does not vary across the element
@@ -420,6 +420,7 @@ def surface_loads(y, points, normals, areas, spans, partners, length, mu, contac
         omega[r] = rot[r, 0] * y[10] + rot[r, 1] * y[11] + rot[r, 2] * y[12]
     speed = math.sqrt(y[7] * y[7] + y[8] * y[8] + y[9] * y[9])
     scale = ROUND_OFF * (speed + length * math.sqrt(omega @ omega))
+    turning = math.sqrt(omega[0] * omega[0] + omega[1] * omega[1] + omega[2] * omega[2])
     total = np.zeros(7)  # force, moment (target frame), power
     radii = np.empty((1, max(depths.shape[0], 1)))
     zones = np.empty((0, 1, 2))
@@ -440,7 +441,8 @@ def surface_loads(y, points, normals, areas, spans, partners, length, mu, contac
             k = j if second else i
             result = other if second else one
             result_damping = other_damping if second else one_damping
-            status, vn = _element_load(k, y, rot, omega, scale, points, normals, areas, spans,
+            status, vn = _element_load(k, y, rot, omega, turning, scale, points, normals, areas,
+                                       spans,
                                        mu, contact_ramp, bottom, nose, open_zones, walls,
                                        wall_depths, tangency, hold, hold_time, law, radii,
                                        zones, result, result_damping, extra)
