@@ -190,6 +190,34 @@ def test_erosion_through_the_layered_runway_and_its_interfaces():
                                                              rel=1e-9)
 
 
+def test_eroding_rows_are_equal_time_intervals_with_the_mass():
+    """With erosion the written rows are, as without it, ROWS_PER_PHASE equal intervals of
+    time in each integrated phase (not the integrator's steps), and carry the mass: the dense
+    output's third state, the phase's end mass at its end, never growing along the path."""
+    from cavex.analytic.models import make_resistance
+    from cavex.analytic.penetration.integrator import ROWS_PER_PHASE
+
+    target, p = load_config()
+    layered = target.with_interfaces("debonded")
+    resistance = make_resistance(layered, p, "derived", None, "quasi-static", None)
+    flight = penetrate(layered, p, resistance, erosion=ErodingNose(SILLING_FORRESTAL, p))
+    rows = flight.rows()
+    assert set(rows) == {"t_s", "depth_m", "velocity_m_s", "deceleration_m_s2", "phase",
+                         "mass_kg"}
+    assert len({len(column) for column in rows.values()}) == 1
+    assert np.all(np.diff(rows["mass_kg"]) <= 0.0)
+    assert rows["mass_kg"][0] == flight.mass[0] and rows["mass_kg"][-1] == flight.mass[-1]
+    for index, phase in enumerate(flight.phases):
+        in_phase = rows["phase"] == index
+        assert rows["mass_kg"][in_phase][-1] == phase.end_mass
+        if phase.stage != "crater":  # an integrated phase: equal intervals of time
+            t = rows["t_s"][in_phase]
+            assert len(t) == ROWS_PER_PHASE + 1
+            assert np.diff(t) == pytest.approx(np.full(ROWS_PER_PHASE, np.diff(t).mean()),
+                                               rel=1e-9)
+    assert rows["depth_m"][-1] == flight.depth[-1]
+
+
 def test_bad_erosion_values_are_refused_in_one_line(capsys):
     for argv in (["penetrate", "--erosion", "silling"],
                  ["validate", "--shots", "x.csv", "--erosion", "Silling-Forrestal"]):

@@ -86,9 +86,9 @@ class Trajectory:
         time within each integrated phase (its start and end included; the crater stages'
         closed-form samples as they are), on the integrator's dense output with the force
         evaluated at each row, instead of at the integrator's steps, whose places move with
-        the last bits of the force (another CPU would write other rows). With erosion: the
-        steps (:meth:`as_columns`)."""
-        if self.sampled is None or self.mass is not None:
+        the last bits of the force (another CPU would write other rows). With erosion the
+        rows carry the mass too (``mass_kg``, the dense output's third state)."""
+        if self.sampled is None:
             return self.as_columns()
         return dict(self.sampled)
 
@@ -199,6 +199,7 @@ def _eroding_penetrate(target, projectile, resistance, crater, rtol, atol, erosi
         _append(columns, *samples, 0)
         depth0 = samples[1][-1]
         masses.append(np.full(len(samples[0]), mass))
+        columns[5][-1].append(masses[-1])  # the crater's rows are its samples: one mass array
         mass -= erosion.crater_loss(projectile, 0.5 * mass * (projectile.V0 ** 2 - v0 ** 2))
         masses[-1][-1] = mass
         phases.append(Phase("crater", depth0, v0, t0,
@@ -296,6 +297,7 @@ def _eroding_interface_crater(target, projectile, resistance, start, columns, ph
         return end, mass
     mass = float(mass - erosion.crater_loss(projectile, 0.5 * mass * (start[2] ** 2 - end[2] ** 2)))
     masses.append(np.full(len(columns[0][-1]), mass))
+    columns[5][-1].append(masses[-1])  # the crater's rows are its samples: one mass array
     phases[-1] = replace(phases[-1], end_mass=mass)
     return end, mass
 
@@ -477,16 +479,19 @@ def _append_solution(columns, sol, phase_end, resistance, mass, phase, erosion=N
             deceleration = np.array([erosion.forces(resistance, x, max(v, 0.0), m)[0] / m
                                      for x, v, m in zip(depth, y[1], y[2], strict=True)])
         if rows:
-            columns[5].append([t, y[0], np.maximum(y[1], 0.0), deceleration,
-                               np.full(len(t), float(phase))])
+            block = [t, y[0], np.maximum(y[1], 0.0), deceleration, np.full(len(t), float(phase))]
+            if erosion is not None:  # the mass at the rows, the phase's end mass at its end
+                block.append(np.append(y[2][:-1], phase_end.end_mass))
+            columns[5].append(block)
         else:
             _append(columns, t, y[0], np.maximum(y[1], 0.0), deceleration, phase, rows=False)
 
 
 def _trajectory(columns, phases):
     t, depth, velocity, deceleration, phase = (np.concatenate(c) for c in columns[:5])
-    sampled = dict(zip(("t_s", "depth_m", "velocity_m_s", "deceleration_m_s2", "phase"),
-                       (np.concatenate(c) for c in zip(*columns[5], strict=True)), strict=True))
+    names = ("t_s", "depth_m", "velocity_m_s", "deceleration_m_s2", "phase", "mass_kg")
+    blocks = list(zip(*columns[5], strict=True))  # a mass column with erosion only
+    sampled = {name: np.concatenate(c) for name, c in zip(names, blocks, strict=False)}
     sampled["phase"] = sampled["phase"].astype(int)
     return Trajectory(t, depth, velocity, deceleration, phase.astype(int), tuple(phases),
                       sampled=sampled)
