@@ -25,7 +25,8 @@ from pathlib import Path
 from mkdocs.plugins import event_priority
 
 NOTEBOOKS_SECTION = "Notebooks"
-MATHJAX_FILES = ("tex-chtml.js", "output/chtml/fonts/woff-v2", "input/tex/extensions")
+# the SVG output: its glyphs are paths in the page, so no web font has to load
+MATHJAX_FILES = ("tex-svg.js", "input/tex/extensions")
 
 
 def notebook_pages(docs_dir):
