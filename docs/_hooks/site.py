@@ -7,11 +7,12 @@
   laid out when installed: the checkout has no ``cavex/`` folder (``core/`` is ``cavex``,
   ``analytic/`` is ``cavex.analytic``..., pyproject.toml's ``package-dir``), so a folder of
   symbolic links in a temporary directory, put first in ``sys.path``, makes that layout from
-  the checkout's own files, whether cavex is installed, installed editable, or not at all.
+  the checkout's own files, the same for an installed and an editable cavex.
   It also takes the scripts folder (``bin/``) out of ``sys.path``: run as the ``mkdocs``
   program, Python puts it first, and griffe would find the ``cavex`` console script there.
 - ``on_post_build``: MathJax (the ``django-static-mathjax`` package, a docs dependency) copied
-  into ``site/assets/mathjax``: the site renders its equations offline, with no CDN.
+  into ``site/assets/mathjax``, its SVG output: the site renders its equations offline, with
+  no CDN and no web font to load.
 """
 
 import os
