@@ -21,6 +21,7 @@ MATH = re.compile(r"^(\s*)\.\. math::\s?(.*)$")
 def plain_reference(match):
     """The role's target as a Markdown code span (its last dotted part after ``~``)."""
     shorten, target = match.groups()
+    target = "".join(target.split())  # a target broken over two lines of the docstring
     shown = target.lstrip(".").rsplit(".", 1)[-1] if shorten else target
     return f"`{shown}`"
 
