@@ -13,7 +13,9 @@ Floors, bottom to top (README "Where things are"):
   production), then ``validation/`` (which uses ``fedata/``), then ``report/`` (the reports'
   words and figures, which may use ``validation/``: the validation's figures and markdown) and
   ``studies/`` (which may use ``validation/``: a study of the validation data), which do not
-  use each other, then ``commands/`` (one module per command), then ``cli``.
+  use each other, then ``commands/`` (one module per command), then ``cli``;
+- on top, beside ``cli``: ``cavex.api`` (``core/api.py``, the Python API in xarray and pandas
+  over the commands' job functions and figure panels), which nothing in cavex imports.
 """
 
 import ast
@@ -52,6 +54,9 @@ ALLOWED = {
     V + "commands": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
                             V + "report", V + "validation", V + "studies", V + "commands"),
     V + "cli": ("cavex",),
+    # the Python API: the commands' jobs and the reports' panels, on the top floor with cli
+    "cavex.api": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
+                         V + "report", V + "validation", V + "studies", V + "commands"),
     "cavex.__main__": (V + "cli",),  # `python -m cavex`: the command line, nothing else
     "cavex": CORE,
 }
