@@ -49,8 +49,10 @@ def shot():
 
 
 @pytest.fixture(scope="module")
-def validation():
-    return api.validate(SHOTS, models=CHEAP_MODELS)
+def validation(tmp_path_factory):
+    with pytest.MonkeyPatch.context() as patch:  # this module's own FE-table cache
+        patch.setenv("CAVEX_CACHE_DIR", str(tmp_path_factory.mktemp("cache")))
+        return api.validate(SHOTS, models=CHEAP_MODELS)
 
 
 def test_table_is_a_dataset_with_its_grid(table):
@@ -238,3 +240,24 @@ def test_plot_table_takes_a_quantified_table(table):
     ax = _axes()
     api.plot_table(table.pint.quantify(), ax)
     assert len(ax.lines) == table.sizes["depth"]
+
+
+def test_the_readme_example_runs(monkeypatch):
+    """README "Python API": its code block runs as printed (from the repository root) and
+    gives the types it names."""
+    pytest.importorskip("pint_xarray")
+    import matplotlib
+    import pandas as pd
+    import xarray as xr
+
+    matplotlib.use("Agg")
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    block = text.split("## Python API", 1)[1].split("```python", 1)[1].split("```", 1)[0]
+    monkeypatch.chdir(ROOT)
+    scope = {}
+    exec(compile(block, "README.md", "exec"), scope)
+    assert isinstance(scope["ds"], xr.Dataset)
+    assert isinstance(scope["shot"].phases, pd.DataFrame)
+    assert isinstance(scope["oblique"].history, pd.DataFrame)
+    assert isinstance(scope["check"].predictions, pd.DataFrame)
+    assert scope["ax"].lines
