@@ -121,6 +121,13 @@ def test_no_import_runs_upward(module, path):
     assert not upward, f"{module} imports {upward}"
 
 
+def test_nothing_imports_the_api():
+    """``cavex.api`` is the top floor: no module of the package imports it."""
+    importers = sorted(module for module, path in MODULES
+                       if module != "cavex.api" and "cavex.api" in cavex_imports(module, path))
+    assert importers == []
+
+
 def test_the_rule_catches_an_upward_import(tmp_path):
     """The checker itself: a core module that reaches into verification is caught."""
     bad = tmp_path / "bad.py"

@@ -30,17 +30,33 @@ def test_notebook_is_committed_without_outputs(path):
             assert cell["outputs"] == [] and cell["execution_count"] is None, path.name
 
 
+def this_interpreter_kernel(folder):
+    """A kernelspec ``cavex-test`` under ``folder`` (put first on ``JUPYTER_PATH``) that runs
+    this interpreter: a ``python3`` kernelspec installed for the user could run another."""
+    spec = folder / "kernels" / KERNEL
+    spec.mkdir(parents=True)
+    (spec / "kernel.json").write_text(json.dumps({
+        "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
+        "display_name": "cavex test", "language": "python"}))
+    return folder
+
+
+KERNEL = "cavex-test"
+
+
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_notebook_runs(path, tmp_path, monkeypatch):
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")
     pytest.importorskip("ipykernel")
+    monkeypatch.setenv("JUPYTER_PATH", str(this_interpreter_kernel(tmp_path / "jupyter")))
     monkeypatch.setenv("MPLBACKEND", "module://matplotlib_inline.backend_inline")
+    work = tmp_path / "work"
+    work.mkdir()
     notebook = nbformat.read(path, as_version=4)
-    client = nbclient.NotebookClient(notebook, timeout=CELL_TIMEOUT_S, kernel_name="python3",
-                                     resources={"metadata": {"path": str(tmp_path)}})
+    client = nbclient.NotebookClient(notebook, timeout=CELL_TIMEOUT_S, kernel_name=KERNEL,
+                                     resources={"metadata": {"path": str(work)}})
     client.execute()  # raises CellExecutionError on the first cell that fails
     figures = [output for cell in notebook.cells if cell.cell_type == "code"
                for output in cell.outputs if "image/png" in output.get("data", {})]
     assert figures, f"{path.name} drew no figure"
-    assert sys.executable  # the kernel: ipykernel's own spec runs this interpreter
