@@ -446,7 +446,15 @@ def plot_table(ds, ax):
 def plot_velocity(result, ax):
     """Velocity against time of a :class:`Penetration`, the target beside its first layer
     alone (``velocity_time.png``; :func:`cavex.verification.report.penetration_figures.
-    draw_velocity`)."""
+    draw_velocity`).
+
+    Parameters
+    ----------
+    result : Penetration
+        From :func:`penetrate`.
+    ax : matplotlib.axes.Axes
+        Of a figure with a renderer (pyplot's, or an Agg canvas), as every ``plot_*`` here.
+    """
     from cavex.verification.report.penetration_figures import draw_velocity
 
     draw_velocity(ax, result.job)
@@ -455,7 +463,14 @@ def plot_velocity(result, ax):
 def plot_deceleration(result, ax):
     """Deceleration against nose-tip depth of a :class:`Penetration`, the interfaces dotted
     and the layers named (``deceleration_depth.png``;
-    :func:`cavex.verification.report.penetration_figures.draw_deceleration`)."""
+    :func:`cavex.verification.report.penetration_figures.draw_deceleration`).
+
+    Parameters
+    ----------
+    result : Penetration
+        From :func:`penetrate`.
+    ax : matplotlib.axes.Axes
+    """
     from cavex.verification.report.penetration_figures import draw_deceleration
 
     draw_deceleration(ax, result.job)
@@ -464,7 +479,15 @@ def plot_deceleration(result, ax):
 def plot_trajectory(shot, ax):
     """The side view of a :class:`Shot` to scale: centre-of-mass path and the body's outline
     at 9 equal time intervals, the interfaces and layers (``path_side.png``;
-    :func:`cavex.verification.report.trajectory_figures.draw_side_view`)."""
+    :func:`cavex.verification.report.trajectory_figures.draw_side_view`).
+
+    Parameters
+    ----------
+    shot : Shot
+        From :func:`fly`.
+    ax : matplotlib.axes.Axes
+        Set to equal aspect (the view is to scale).
+    """
     from cavex.verification.report.trajectory_figures import draw_side_view
 
     draw_side_view(ax, shot.job)
@@ -472,7 +495,14 @@ def plot_trajectory(shot, ax):
 
 def plot_pitch(shot, ax):
     """Pitch against time of a :class:`Shot`, phase ends dotted (``pitch_time.png``;
-    :func:`cavex.verification.report.trajectory_figures.draw_pitch`)."""
+    :func:`cavex.verification.report.trajectory_figures.draw_pitch`).
+
+    Parameters
+    ----------
+    shot : Shot
+        From :func:`fly`.
+    ax : matplotlib.axes.Axes
+    """
     from cavex.verification.report.trajectory_figures import draw_pitch
 
     draw_pitch(ax, shot.job)
@@ -503,7 +533,18 @@ def plot_validation(validation, ax, models=None, predicted=True):
     ``predicted`` False the ratio predicted / measured against the striking velocity, of
     ``models`` (default: every model that ran) of a :class:`Validation`
     (``predicted_vs_measured.png``, ``ratio_vs_velocity.png``;
-    :func:`cavex.verification.report.validation_figures.draw_models`)."""
+    :func:`cavex.verification.report.validation_figures.draw_models`).
+
+    Parameters
+    ----------
+    validation : Validation
+        From :func:`validate`.
+    ax : matplotlib.axes.Axes
+    models : sequence of str, optional
+        Model labels among ``validation.result["models"]``.
+    predicted : bool, default True
+        Predicted against measured; False: the ratio against the striking velocity.
+    """
     from cavex.verification.report.validation_figures import draw_models
 
     draw_models(ax, validation.result, list(models or validation.result["models"]),
@@ -514,7 +555,17 @@ def plot_residuals(validation, ax, models=None, against="velocity"):
     """``ln(predicted / measured)`` against the striking velocity (``against="velocity"``)
     or ``f_c`` (``"strength"``) of ``models`` (default: every model that ran) of a
     :class:`Validation` (``residuals.png``;
-    :func:`cavex.verification.report.validation_figures.draw_residuals`)."""
+    :func:`cavex.verification.report.validation_figures.draw_residuals`).
+
+    Parameters
+    ----------
+    validation : Validation
+        From :func:`validate`.
+    ax : matplotlib.axes.Axes
+    models : sequence of str, optional
+        Model labels among ``validation.result["models"]``.
+    against : {"velocity", "strength"}, default "velocity"
+    """
     from cavex.verification.report.validation_figures import draw_residuals
 
     draw_residuals(ax, validation.result, list(models or validation.result["models"]),
