@@ -123,7 +123,7 @@ def build_table(velocities, depths, target=None, projectile=None, *, nu=None, nu
 
 # --- 1-D penetration --------------------------------------------------------------------------
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Penetration:
     """The rigid projectile through the target and through its first layer alone: the job of
     ``cavex penetrate`` (:func:`penetrate`).
@@ -167,6 +167,11 @@ class Penetration:
     def final_depth(self):
         """The target's final nose-tip depth (m)."""
         return float(self.job["runs"]["runway"].depth[-1])
+
+    def __repr__(self):
+        phases = len(self.job["runs"]["runway"].phases)
+        return (f"Penetration({self.job['model']}, {self.job['target_label']}: "
+                f"{phases} phases, final depth {self.final_depth:.4g} m)")
 
     @property
     def summary(self):
@@ -230,7 +235,7 @@ def penetrate(target=None, projectile=None, *, resistance="derived", boundary=No
 
 # --- 3-D oblique shot -------------------------------------------------------------------------
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Shot:
     """One oblique shot of the rigid body in 3-D: the job of ``cavex trajectory``
     (:func:`fly`).
@@ -271,6 +276,12 @@ class Shot:
         from cavex.verification.commands.trajectory import summary
 
         return summary(self.job)
+
+    def __repr__(self):
+        settings, end = self.job["settings"], self.end
+        return (f"Shot({settings['speed_m_s']:g} m/s at {settings['obliquity_deg']:g} deg, "
+                f"{settings['resistance']}: {end['state']}, nose tip at z = "
+                f"{end['nose_tip_m'][2]:.4g} m, pitch {end['pitch_deg']:.4g} deg)")
 
 
 def fly(target=None, projectile=None, *, velocity=None, obliquity=0.0, attack=0.0,
@@ -317,7 +328,7 @@ def fly(target=None, projectile=None, *, velocity=None, obliquity=0.0, attack=0.
 
 # --- validation -------------------------------------------------------------------------------
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Validation:
     """Predicted against measured penetration depths: the result of ``cavex validate``
     (:func:`validate`).
@@ -368,6 +379,10 @@ class Validation:
         from cavex.verification.commands.validate import summary
 
         return summary(self.result)
+
+    def __repr__(self):
+        return (f"Validation({len(self.result['shots'])} shots, models "
+                f"{', '.join(self.result['models'])})")
 
 
 def _number(value):

@@ -261,3 +261,12 @@ def test_the_readme_example_runs(monkeypatch):
     assert isinstance(scope["oblique"].history, pd.DataFrame)
     assert isinstance(scope["check"].predictions, pd.DataFrame)
     assert scope["ax"].lines
+
+
+def test_results_print_in_one_line(penetration, shot, validation):
+    """A result's repr is one line of what it is (a notebook prints it), not its arrays."""
+    assert repr(penetration) == (f"Penetration(derived-dynamic, runway (the paper's Table 1): "
+                                 f"{len(penetration.phases)} phases, final depth "
+                                 f"{penetration.final_depth:.4g} m)")
+    assert repr(shot).startswith("Shot(1000 m/s at 20 deg, derived: stopped")
+    assert repr(validation) == "Validation(17 shots, models forrestal-1994, li-chen-2003)"
