@@ -269,4 +269,6 @@ def test_results_print_in_one_line(penetration, shot, validation):
                                  f"{len(penetration.phases)} phases, final depth "
                                  f"{penetration.final_depth:.4g} m)")
     assert repr(shot).startswith("Shot(1000 m/s at 20 deg, derived: stopped")
-    assert repr(validation) == "Validation(17 shots, models forrestal-1994, li-chen-2003)"
+    assert repr(validation) == ("Validation(17 shots, models "
+                                + ", ".join(validation.result["models"]) + ")")
+    assert set(validation.result["models"]) == set(CHEAP_MODELS)  # in the registry's order
