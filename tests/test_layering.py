@@ -13,7 +13,9 @@ Floors, bottom to top (README "Where things are"):
   production), then ``validation/`` (which uses ``fedata/``), then ``report/`` (the reports'
   words and figures, which may use ``validation/``: the validation's figures and markdown) and
   ``studies/`` (which may use ``validation/``: a study of the validation data), which do not
-  use each other, then ``commands/`` (one module per command), then ``cli``.
+  use each other, then ``commands/`` (one module per command), then ``cli``;
+- on top, beside ``cli``: ``cavex.api`` (``core/api.py``, the Python API in xarray and pandas
+  over the commands' job functions and figure panels), which nothing in cavex imports.
 """
 
 import ast
@@ -52,6 +54,9 @@ ALLOWED = {
     V + "commands": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
                             V + "report", V + "validation", V + "studies", V + "commands"),
     V + "cli": ("cavex",),
+    # the Python API: the commands' jobs and the reports' panels, on the top floor with cli
+    "cavex.api": CORE + ("cavex.analytic", "cavex.fem", V + "output", V + "fedata",
+                         V + "report", V + "validation", V + "studies", V + "commands"),
     "cavex.__main__": (V + "cli",),  # `python -m cavex`: the command line, nothing else
     "cavex": CORE,
 }
@@ -114,6 +119,13 @@ def test_no_import_runs_upward(module, path):
     prefixes = ALLOWED[rule(module)]
     upward = sorted(t for t in cavex_imports(module, path) if not permitted(t, prefixes))
     assert not upward, f"{module} imports {upward}"
+
+
+def test_nothing_imports_the_api():
+    """``cavex.api`` is the top floor: no module of the package imports it."""
+    importers = sorted(module for module, path in MODULES
+                       if module != "cavex.api" and "cavex.api" in cavex_imports(module, path))
+    assert importers == []
 
 
 def test_the_rule_catches_an_upward_import(tmp_path):

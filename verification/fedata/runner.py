@@ -531,7 +531,10 @@ class Progress:
     nothing when disabled."""
 
     def __init__(self, total, done, enabled, unit="case"):
-        from tqdm.auto import tqdm
+        if enabled:
+            from tqdm.auto import tqdm
+        else:  # draws nothing: the plain class (tqdm.auto warns in a notebook without widgets)
+            from tqdm import tqdm
 
         tqdm.monitor_interval = 0  # no monitor thread: a pool forked later stays a plain fork
         self.bar = tqdm(total=total, initial=done, disable=not enabled, file=sys.stderr,

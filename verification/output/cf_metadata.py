@@ -3,6 +3,9 @@
 - the global attribute ``Conventions`` (:data:`CONVENTIONS`);
 - units in UDUNITS spelling, one spelling per quantity (:data:`UNITS`: ``m s-1``, not ``m/s``),
   so that ``cf_xarray``'s unit registry, and with it ``pint-xarray``, reads every file;
+- :func:`pint_readable`: a dataset's units respelled where pint's default registry reads the
+  UDUNITS spelling otherwise (``m s-1`` as ``m/s``, ``kg m-3`` as ``kg/m^3``: both spellings are
+  UDUNITS, so the dataset stays CF), for the Python API (:mod:`cavex.api`);
 - coded variables (booleans stored as ``int8``, validity codes, response states, the wall
   layer) carry ``flag_values`` and ``flag_meanings`` (:func:`flag_attrs`).
 """
@@ -16,6 +19,23 @@ CONVENTIONS = "CF-1.10"
 # UDUNITS spellings of every unit the netCDF files use
 UNITS = {"velocity": "m s-1", "length": "m", "stress": "Pa", "density": "kg m-3",
          "time": "s", "angle": "degree", "dimensionless": "1"}
+
+
+#: UDUNITS spellings of :data:`UNITS` that pint's default registry misreads (it parses
+#: ``s-1`` as ``s - 1``), each with the UDUNITS spelling it reads as the same unit
+PINT_SPELLINGS = {"m s-1": "m/s", "kg m-3": "kg/m^3"}
+
+
+def pint_readable(ds):
+    """A shallow copy of the :class:`xarray.Dataset` ``ds`` whose ``units`` attributes pint's
+    default registry reads: :data:`PINT_SPELLINGS` respelled, the others as they are (so that
+    ``ds.pint.quantify()`` needs no unit registry of its own)."""
+    out = ds.copy()
+    for variable in out.variables.values():
+        units = variable.attrs.get("units")
+        if units in PINT_SPELLINGS:
+            variable.attrs = {**variable.attrs, "units": PINT_SPELLINGS[units]}
+    return out
 
 
 def flag_word(text):
