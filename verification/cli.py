@@ -19,7 +19,7 @@ from cavex.verification.output.json_document import json_text
 #: The commands, in the order ``cavex --help`` lists them; each is the module
 #: ``cavex.verification.commands.<name>``.
 COMMANDS = ("penetrate", "stress", "fem", "table", "verify", "batch", "calibrate", "validate",
-            "trajectory", "config")
+            "trajectory", "view", "config")
 
 
 class _Help(argparse.ArgumentDefaultsHelpFormatter):
