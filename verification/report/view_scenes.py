@@ -31,9 +31,9 @@ STRESSES = {"radial": ("sigma_r", "sigma_r (MPa, compression +)"),
             "hoop": ("sigma_theta", "sigma_theta (MPa, compression +)"),
             "deviator": ("deviator", "von Mises stress abs(sigma_r - sigma_theta) (MPa)")}
 FIELDS_WINDOW = (1400, 700)  # px: the two views side by side
-SHOT_WINDOW = (1100, 850)  # px
+SHOT_WINDOW = (1200, 850)  # px
 BODY_INSTANTS = 6  # the body drawn at this many equal time intervals, as path_3d.png
-LAYER_COLOURS = ("#bbbbbb", "#c8a27a", "#9cbf5a", "#8c8c8c")  # as trajectory's 3-D view
+LAYER_COLOURS = ("#8a8a8a", "#b07a3e", "#6f9a2e", "#5a5a5a")  # top down; readable legend text
 
 
 def zone_codes(sigma_theta, plastic_strain, layer, tensile_strengths):
@@ -218,9 +218,10 @@ def shot_picture(job, path):
     """Render the oblique shot (``job``: :func:`cavex.verification.commands.trajectory.
     trajectory_job`) to the PNG ``path``; returns ``{"width_px", "height_px",
     "render_window"}``. The block and its limits are those of ``path_3d.png``
-    (:func:`cavex.verification.report.trajectory_figures.block_limits`): the half ``y >= 0``
-    behind the plane of obliquity, from above the surface to below the path; the layers in
-    it as translucent slabs, a layer below the block named in the legend with its depth."""
+    (:func:`cavex.verification.report.trajectory_figures.block_limits`, its ``y`` range
+    taken on the side ``y <= 0``: the half behind the plane of obliquity as the camera sees
+    it, with x to the right), from above the surface to below the path; the layers in it as
+    translucent slabs, a layer below the block named in the legend with its depth."""
     from cavex.verification.report.trajectory_figures import block_limits, shot_title
 
     pv = _pyvista()
@@ -233,7 +234,7 @@ def shot_picture(job, path):
     legend = []
     for k in range(len(planes) - 1):
         colour = LAYER_COLOURS[k % len(LAYER_COLOURS)]
-        slab = pv.Box(bounds=(x0, x1, -y1, -y0, -planes[k + 1], -planes[k]))
+        slab = pv.Box(bounds=(x0, x1, y0, y1, -planes[k + 1], -planes[k]))
         plotter.add_mesh(slab, color=colour, opacity=0.35, show_edges=True,
                          edge_color="#555555", line_width=1)
         legend.append([names[k], colour])
@@ -248,14 +249,16 @@ def shot_picture(job, path):
         surface = pv.StructuredGrid(*display(*revolved_body(model_body, result.state(t))))
         plotter.add_mesh(surface, color="navy", smooth_shading=True)
     legend.insert(1, [f"body at {BODY_INSTANTS} equal time intervals", "navy"])
-    _legend(plotter, legend, 0.42)
+    _legend(plotter, legend, 0.34)
     _title(plotter, shot_title(job).replace("; ", "\n") + "\nthe block cut open along the "
            "plane of obliquity (x horizontal in it, depth down)")
     plotter.show_bounds(xtitle="x (m)", ytitle="-y (m)", ztitle="-depth (m)", color="black",
-                        font_size=10, location="outer", ticks="outside")
+                        font_size=10, location="outer", ticks="outside", n_xlabels=4,
+                        n_ylabels=2, n_zlabels=4, fmt="%.2g")
     span = max(x1 - x0, bottom - top)
-    focus = (0.5 * (x0 + x1), -0.5 * (y0 + y1), -0.5 * (top + bottom))
-    plotter.camera_position = [(focus[0] - 0.9 * span, focus[1] + 2.4 * span,
-                                focus[2] + 0.9 * span), focus, (0.0, 0.0, 1.0)]
-    plotter.camera.zoom(1.15)
+    # the focus right of the block's centre: the block left of the legend
+    focus = (0.5 * (x0 + x1) + 0.3 * span, 0.5 * (y0 + y1), -0.5 * (top + bottom))
+    plotter.camera_position = [(focus[0] - 1.0 * span, focus[1] - 2.6 * span,
+                                focus[2] + 0.8 * span), focus, (0.0, 0.0, 1.0)]
+    plotter.camera.zoom(1.1)
     return _save(plotter, path)
