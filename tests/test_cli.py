@@ -298,7 +298,7 @@ def test_every_command_module_has_the_one_shape():
     commands = build_parser()._subparsers._group_actions[0]  # argparse keeps them only here
     assert list(commands.choices) == list(COMMANDS)
     helps = {action.dest: action.help for action in commands._choices_actions}
-    writes = {"penetrate", "trajectory", "validate", "table", "calibrate"}
+    writes = {"penetrate", "trajectory", "validate", "table", "calibrate", "view"}
     for name in COMMANDS:
         module = command_module(name)
         assert helps[name] == module.HELP, name

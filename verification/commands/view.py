@@ -228,7 +228,7 @@ def summary(result):
                     "fe_plastic_radius_m": fe["fe_plastic_radius_m"],
                     "fe_sigma_r_Pa": fe["fe_sigma_r_Pa"],
                     "radius_shown_m": result["radius_shown_m"],
-                    "elements_shown": len(result["zone_codes"]),
+                    "shown_cells": len(result["zone_codes"]),
                     "zones": result["zones"], "zones_present": result["zones_present"],
                     "interfaces_in_view_m": result["interfaces_in_view_m"],
                     "beyond_view": result["beyond_view"], "warnings": fe["warnings"]}
