@@ -234,3 +234,22 @@ def test_shot_picture_normal_incidence_one_layer(capsys, tmp_path, rendering):
     image = pixels(out / "shot.png")
     assert 0.05 < drawn_share(image) < 0.8
     assert blue_share(image) > 0.002
+
+
+def test_bodies_drawn_apart_along_the_path():
+    """The shot's bodies: at most 6, at least 2, equally spaced along the path and at least
+    1.15 body lengths apart when fewer than 6 fit (a straight normal shot)."""
+    from cavex.verification.report.view_scenes import body_instants
+
+    t = np.linspace(0.0, 1e-3, 201)
+    depth = 0.4 * (1.0 - (1.0 - t / t[-1]) ** 2)  # decelerating, 0.4 m in all
+    history = {"t_s": t, "cg_x_m": 0 * t, "cg_y_m": 0 * t, "cg_z_m": depth}
+    for length, count in ((0.1, 4), (0.01, 6), (1.0, 2)):
+        instants = body_instants(history, length)
+        assert len(instants) == count
+        positions = np.interp(instants, t, depth)
+        assert positions[0] == 0.0 and positions[-1] == pytest.approx(0.4, rel=1e-12)
+        gaps = np.diff(positions)
+        assert np.allclose(gaps, gaps[0], rtol=1e-3)  # equal along the path (interpolated)
+        if count < 6 and count > 2:
+            assert gaps.min() >= 1.15 * length

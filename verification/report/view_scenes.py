@@ -6,8 +6,8 @@
   layer interfaces as rings on the cut faces;
 - :func:`shot_picture`: the oblique shot (``cavex trajectory``'s run) in the layered block cut
   open along the plane of obliquity, each layer a coloured translucent slab named in the
-  legend, the centre of mass's path and the body (the outline revolved about its axis) at 6
-  equal time intervals.
+  legend, the centre of mass's path and the body (the outline revolved about its axis) at up
+  to 6 points equally spaced along the path, not overlapping (:func:`body_instants`).
 
 The geometry is plain numpy (:func:`sphere_cut_grid`, :func:`revolved_body`); pyvista is
 imported inside the functions that render (``pip install "cavex[view]"``): no other module of
@@ -32,7 +32,7 @@ STRESSES = {"radial": ("sigma_r", "sigma_r (MPa, compression +)"),
             "deviator": ("deviator", "von Mises stress abs(sigma_r - sigma_theta) (MPa)")}
 FIELDS_WINDOW = (1400, 700)  # px: the two views side by side
 SHOT_WINDOW = (1200, 850)  # px
-BODY_INSTANTS = 6  # the body drawn at this many equal time intervals, as path_3d.png
+BODY_INSTANTS = 6  # the body drawn at most this many times along the path
 LAYER_COLOURS = ("#8a8a8a", "#b07a3e", "#6f9a2e", "#5a5a5a")  # top down; readable legend text
 
 
@@ -102,6 +102,17 @@ def revolved_body(body, y, around=24):
                       radius[:, None] * np.sin(phi)], -1)
     world = np.asarray(y[0:3]) + local @ rotation_matrix(y[3:7]).T
     return world[..., 0], world[..., 1], world[..., 2]
+
+
+def body_instants(history, length, most=BODY_INSTANTS, gap=1.15):
+    """Times (s) at which the body is drawn: equally spaced along the centre of mass's path
+    (its length from the ``history`` samples), from the strike to the end, at most ``most``
+    and at least 2, spaced at least ``gap`` body lengths apart where the path allows (at
+    normal incidence bodies drawn at equal times lie on each other)."""
+    points = np.column_stack([history["cg_x_m"], history["cg_y_m"], history["cg_z_m"]])
+    along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))])
+    count = int(min(most, max(2, 1 + along[-1] // (gap * length))))
+    return np.interp(np.linspace(0.0, along[-1], count), along, history["t_s"])
 
 
 def display(x, y, z):
@@ -245,10 +256,11 @@ def shot_picture(job, path):
     tube = pv.lines_from_points(path_points).tube(radius=0.15 * model_body.radius)
     plotter.add_mesh(tube, color="red")
     legend.insert(0, ["centre of mass", "red"])
-    for t in np.linspace(0.0, h["t_s"][-1], BODY_INSTANTS):
+    instants = body_instants(h, model_body.length)
+    for t in instants:
         surface = pv.StructuredGrid(*display(*revolved_body(model_body, result.state(t))))
         plotter.add_mesh(surface, color="navy", smooth_shading=True)
-    legend.insert(1, [f"body at {BODY_INSTANTS} equal time intervals", "navy"])
+    legend.insert(1, [f"body at {len(instants)} points equally spaced on the path", "navy"])
     _legend(plotter, legend, 0.34)
     _title(plotter, shot_title(job).replace("; ", "\n") + "\nthe block cut open along the "
            "plane of obliquity (x horizontal in it, depth down)")
