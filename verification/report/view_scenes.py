@@ -249,7 +249,7 @@ def shot_picture(job, path):
         plotter.add_mesh(slab, color=colour, opacity=0.35, show_edges=True,
                          edge_color="#555555", line_width=1)
         legend.append([names[k], colour])
-    legend += [[f"below the block: {names[k + 1]} from {H:.3g} m", "white"]
+    legend += [[f"below the block: {names[k + 1]} from {H:.3g} m", "#444444"]
                for k, H in enumerate(target.interface_depths) if H >= bottom]
     path_points = np.column_stack(display(h["cg_x_m"], h["cg_y_m"], h["cg_z_m"]))
     model_body = result.model.body
