@@ -173,10 +173,11 @@ def fields_picture(fields, path):
                 plotter.add_mesh(grid, scalars=title, cmap="viridis", log_scale=log,
                                  clim=(float(values.min()), float(values.max())),
                                  show_scalar_bar=k == 0, ambient=0.45,
-                                 scalar_bar_args={"title": title + (", log scale" if log else ""),
+                                 scalar_bar_args={"title": "MPa" + (", log scale" if log else ""),
                                                   "vertical": False, "title_font_size": 15,
                                                   "label_font_size": 13, "fmt": "%.3g",
-                                                  "position_x": 0.12, "position_y": 0.05,
+                                                  "position_x": 0.12, "position_y": 0.03,
+                                                  "height": 0.12,
                                                   "width": 0.76, "color": "black"})
             else:
                 plotter.add_mesh(grid, scalars="zone", cmap=list(ZONE_COLOURS), ambient=0.45,
@@ -190,7 +191,7 @@ def fields_picture(fields, path):
             plotter.add_mesh(_rings(pv, radius), color="black", line_width=3)
         for radius in interfaces:
             plotter.add_mesh(_rings(pv, radius), color="#666666", line_width=3)
-        _title(plotter, fields["titles"][column])
+        _title(plotter, fields["titles"][column] + (f"\ncolour: {title}" if column == 0 else ""))
         plotter.camera_position = [(1.0, 1.25, 0.8), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)]
         plotter.reset_camera()
         plotter.camera.zoom(1.05)
