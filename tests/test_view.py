@@ -110,6 +110,28 @@ def test_without_pyvista_the_command_names_the_extra(capsys, tmp_path, monkeypat
         assert "pyvista" in line
 
 
+@needs_rendering
+def test_without_an_offscreen_context_one_line(tmp_path):
+    """VTK made to take OSMesa (``VTK_DEFAULT_OPENGL_WINDOW``) where its library is not found
+    (the names patched to none that exists): one line, exit 2, nothing written, where
+    rendering would end the process with a segmentation fault (seen)."""
+    import os
+
+    out = tmp_path / "v"
+    probe = ("import sys; from cavex.verification.commands import view; "
+             "view.OSMESA_LIBRARIES = ('libcavex-no-such-osmesa.so',); "
+             "from cavex.verification.cli import main; "
+             f"print(main(['view', 'fields', '--velocity', '300', '--depth', '0.3', '--out', "
+             f"{str(out)!r}]))")
+    env = {**os.environ, "VTK_DEFAULT_OPENGL_WINDOW": "vtkOSOpenGLRenderWindow"}
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          timeout=120, env=env)
+    assert done.returncode == 0 and done.stdout.splitlines() == ["2"], done
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("cavex: error: no off-screen OpenGL"), lines
+    assert not out.exists()
+
+
 def test_the_command_module_loads_no_3d_engine():
     """``cavex --help`` builds every command's parser, so the view module's import must not
     load pyvista or VTK (the other commands stay fast, issue 33)."""

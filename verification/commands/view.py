@@ -87,21 +87,45 @@ def require_pyvista():
         raise CavexInputError(INSTALL)
 
 
+#: the OSMesa libraries VTK's vtkOSOpenGLRenderWindow loads (Mesa's sonames)
+OSMESA_LIBRARIES = ("libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so")
+NO_CONTEXT = ("no off-screen OpenGL context for VTK: it needs a display, EGL or OSMesa (e.g. "
+              "Debian's libegl1 with libegl-mesa0 and libgl1-mesa-dri, or libosmesa6)")
+
+
+def loadable(names):
+    """Whether one of the shared libraries ``names`` loads (``ctypes``)."""
+    import ctypes
+
+    for name in names:
+        try:
+            ctypes.CDLL(name)
+            return True
+        except OSError:
+            continue
+    return False
+
+
 def require_offscreen():
-    """Refuse (one line, exit 2) where VTK finds no off-screen OpenGL context. Without a
-    display VTK >= 9.4 tries EGL, then OSMesa (docs/fem.md "cavex view"); its complaint that
-    there is no X server is dropped (no display is what off-screen rendering is for)."""
+    """Refuse (one line, exit 2) where VTK has no off-screen OpenGL context; returns the
+    render window class VTK chose. Without a display VTK >= 9.4 takes EGL where it
+    initialises, else OSMesa (docs/fem.md "cavex view"); it does not check that OSMesa's
+    library is there (its window then claims OpenGL support and rendering ends the process
+    with a segmentation fault, seen with ``VTK_DEFAULT_OPENGL_WINDOW=vtkOSOpenGLRenderWindow``
+    on a machine without libOSMesa), so that is checked here. Its complaint that there is no
+    X server is dropped (no display is what off-screen rendering is for)."""
     import vtk
 
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_ERROR)
     window = vtk.vtkRenderWindow()
     window.SetOffScreenRendering(True)
+    name = window.GetClassName()
+    if name == "vtkOSOpenGLRenderWindow" and not loadable(OSMESA_LIBRARIES):
+        raise CavexInputError(NO_CONTEXT)
     if not window.SupportsOpenGL():
-        raise CavexInputError("no off-screen OpenGL context for VTK (it needs a display, EGL "
-                              "or OSMesa: e.g. Debian's libegl1 and libgl1-mesa-dri, or "
-                              "libosmesa6)")
-    return window.GetClassName()
+        raise CavexInputError(NO_CONTEXT)
+    return name
 
 
 def run(args, target, projectile):
