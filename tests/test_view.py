@@ -278,3 +278,16 @@ def test_bodies_drawn_apart_along_the_path():
         assert np.allclose(gaps, gaps[0], rtol=1e-3)  # equal along the path (interpolated)
         if count < 6 and count > 2:
             assert gaps.min() >= 1.15 * length
+
+
+def test_bad_input_loads_no_numerical_library():
+    """A refused ``cavex view`` loads none of the numerical or drawing libraries (the import
+    rule of commands/__init__.py): bad input answers at once."""
+    probe = ("import sys; from cavex.verification.cli import main; "
+             "codes = [main(['view', 'fields', '--velocity', '300']), "
+             "main(['view', 'shot', '--velocity', '-3'])]; "
+             "print(codes, sorted(m for m in ('numba', 'scipy', 'matplotlib', 'pyvista', 'vtk', "
+             "'xarray', 'skfem', 'dask', 'pandas') if m in sys.modules))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          timeout=120, check=True)
+    assert done.stdout.splitlines()[-1] == "[2, 2] []"
