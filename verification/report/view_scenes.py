@@ -9,7 +9,7 @@
   legend, the centre of mass's path and the body (the outline revolved about its axis) at up
   to 6 points equally spaced along the path, not overlapping (:func:`body_instants`).
 
-The geometry is plain numpy (:func:`sphere_cut_grid`, :func:`revolved_body`); pyvista is
+The geometry is plain numpy (:func:`sphere_grid`, :func:`revolved_body`); pyvista is
 imported inside the functions that render (``pip install "cavex[view]"``): no other module of
 cavex imports it. Display coordinates are the target's ``(x, -y, -z)`` (a half turn about x,
 so that depth ``z`` points down and the picture is not mirrored).
