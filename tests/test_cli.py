@@ -21,7 +21,7 @@ from cavex.analytic.paper_model import paper_coefficients
 from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.resistance import ClosedFormResistance
 from cavex.config import default_config_text, load_config
-from cavex.verification.cli import main
+from cavex.verification.cli import COMPILING, main
 from cavex.verification.output.number_format import TRAJECTORY_QUANTA, Decimals
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -298,7 +298,7 @@ def test_every_command_module_has_the_one_shape():
     commands = build_parser()._subparsers._group_actions[0]  # argparse keeps them only here
     assert list(commands.choices) == list(COMMANDS)
     helps = {action.dest: action.help for action in commands._choices_actions}
-    writes = {"penetrate", "trajectory", "validate", "table", "calibrate"}
+    writes = {"penetrate", "trajectory", "validate", "table", "calibrate", "view"}
     for name in COMMANDS:
         module = command_module(name)
         assert helps[name] == module.HELP, name
@@ -396,5 +396,7 @@ def test_console_script_exit_codes(tmp_path):
         "cavex: error: parameter 'velocity' must be in [0, 10000] m/s (got -1.0)"]
     good = subprocess.run([str(script), "stress", "--velocity", "500", "--depth", "0.3",
                            "--json"], capture_output=True, text=True, timeout=120, check=False)
-    assert (good.returncode, good.stderr) == (0, "")
+    # the program says it compiles (a cold numba cache, also where stderr is no terminal)
+    assert good.returncode == 0
+    assert [line for line in good.stderr.splitlines() if line != COMPILING] == []
     assert json.loads(good.stdout)["response_state"] == "a"

@@ -26,7 +26,7 @@ DIMENSIONLESS = (
     "lam", "nu", "ratio", "factor",  # material constants, ratios (mean_ratio, outer_ratio, ...)
     "error_estimate", "relative_difference",  # relative errors
     "n", "phase", "equation", "cases", "cells", "failed", "run", "loaded", "sizes",  # counts
-    "refinements", "evaluations",
+    "refinements", "evaluations", "px",  # pixels (the pictures of cavex view)
     # FE numerics (cavex.fem.Numerics; docs/fem.md)
     "degree", "per_decade", "per_step", "rho_inf", "tol", "cutbacks", "snapshots", "ramp",
 )

@@ -6,6 +6,8 @@ command: ``run(args, target, projectile)`` returns the result, printed as ``summ
 import argparse
 import gc
 import importlib
+import importlib.abc
+import importlib.util
 import os
 import re
 import signal
@@ -19,7 +21,7 @@ from cavex.verification.output.json_document import json_text
 #: The commands, in the order ``cavex --help`` lists them; each is the module
 #: ``cavex.verification.commands.<name>``.
 COMMANDS = ("penetrate", "stress", "fem", "table", "verify", "batch", "calibrate", "validate",
-            "trajectory", "config")
+            "trajectory", "view", "config")
 
 
 class _Help(argparse.ArgumentDefaultsHelpFormatter):
@@ -127,6 +129,56 @@ def announce_compiling(stream):
 _ANNOUNCED = []  # the listener of this process, once registered
 
 
+class _AfterImport(importlib.abc.MetaPathFinder):
+    """Calls ``then()`` once the module ``name`` has been imported (a post-import hook): the
+    first import of ``name`` is found by the other finders and run by their loader, then
+    ``then`` runs. The finder removes itself at that first import."""
+
+    def __init__(self, name, then):
+        self.name, self.then = name, then
+
+    def find_spec(self, fullname, path=None, target=None):
+        if fullname != self.name:
+            return None
+        sys.meta_path.remove(self)
+        spec = importlib.util.find_spec(fullname)
+        if spec is None or spec.loader is None:
+            return spec
+        loader, then = spec.loader, self.then
+
+        class Loader(importlib.abc.Loader):
+            def create_module(self, spec):
+                return loader.create_module(spec)
+
+            def exec_module(self, module):
+                loader.exec_module(module)
+                then()
+
+        spec.loader = Loader()
+        return spec
+
+
+def announce_in_the_program(argv, stream=None):
+    """The installed program (:func:`console`) says that it compiles on ``stream`` (stderr)
+    also where it is no terminal (a pipe, a log, CI: the first ``trajectory`` compiled for
+    about 2 min in silence there, issue 33). The listener is registered once numba is
+    imported, by the command's computation (a hook on numba's import): a refused input
+    still loads no numerical library (``commands/__init__.py``). ``main`` called from Python
+    (the tests, the API) says it on a terminal only (:func:`_announce_on_terminal`)."""
+    command = named_command(argv)
+    if command in (None, "config") or _ANNOUNCED:
+        return
+
+    def register():
+        if not _ANNOUNCED:
+            _ANNOUNCED.append(announce_compiling(stream or sys.stderr))
+
+    if "numba" in sys.modules:
+        register()
+    else:
+        sys.meta_path.insert(0, _AfterImport("numba", register))
+
+
 def _announce_on_terminal(command):
     """The compile notice on stderr when it is a terminal (as the progress bars), once per
     process; ``cavex config`` compiles nothing."""
@@ -215,6 +267,7 @@ def console():
     process ends at once (``os._exit``) once the command has cleaned up; the tests call
     :func:`main`, which leaves the collector as it is."""
     gc.set_threshold(*GC_THRESHOLDS)
+    announce_in_the_program(sys.argv[1:])
     try:
         code = main()
     except KeyboardInterrupt:  # raised again after main's report: reported once
