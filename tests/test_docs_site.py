@@ -33,11 +33,18 @@ def mkdocs_build(config, site, cwd):
     return done.returncode, done.stdout + done.stderr
 
 
+def docs_files():
+    return {p for p in DOCS.rglob("*") if p.is_file()}
+
+
 @pytest.fixture(scope="module")
 def site(tmp_path_factory):
     folder = tmp_path_factory.mktemp("docs-site")
+    before = docs_files()
     code, log = mkdocs_build(ROOT / "mkdocs.yml", folder / "site", cwd=folder)
     assert code == 0 and not MKDOCS_WARNING.search(log), log
+    # the notebooks run in docs/notebooks/: what they write goes to scratch folders, not there
+    assert docs_files() == before, sorted(map(str, docs_files() - before))
     return folder / "site"
 
 
