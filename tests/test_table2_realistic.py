@@ -172,3 +172,42 @@ def test_docs_show_the_committed_table():
     text = (ROOT / "docs" / "table2.md").read_text()
     table = (RESULTS / "table2.md").read_text()
     assert table in text
+
+
+def test_penetrate_command_flies_the_committed_table(capsys, tmp_path):
+    from cavex.verification.cli import main
+
+    code = main(["penetrate", "--resistance", "table", "--table",
+                 str(RESULTS / "table_realistic.nc"), "--config", str(EXAMPLE), "--out",
+                 str(tmp_path), "--no-figures", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0
+    committed = committed_convergence()[("realistic", "fine")]
+    assert out["phases"][-1]["end_depth_m"] == pytest.approx(float(committed["final_depth_m"]),
+                                                             abs=QUANTUM["depth_m"])
+    # the first layer alone is the derived closed form, without the concrete's FE-only keys
+    assert any("ignores the FE-only keys of concrete" in note for note in out["notes"])
+
+
+def test_trajectory_command_takes_the_example_and_its_table(capsys, tmp_path):
+    from cavex.verification.cli import main
+
+    code = main(["trajectory", "--resistance", "table", "--table",
+                 str(RESULTS / "table_realistic.nc"), "--config", str(EXAMPLE), "--velocity",
+                 "300", "--out", str(tmp_path), "--no-figures", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0 and out["end"]["state"] == "stopped"
+    assert 0.116 < out["end"]["nose_tip_m"][2] < 0.65  # past the crater, in the concrete
+
+
+def test_the_targets_differ_only_while_the_cavity_is_in_the_concrete(tables, realistic):
+    # docs/table2.md: below the concrete-macadam switch depth both spherical problems are the
+    # same macadam and soil, so the two tables' cells there are the same FE runs
+    from cavex.analytic.geometry import switch_depths
+
+    target, projectile = realistic
+    depths = np.asarray(tables["realistic"]["fine"]["depth"], dtype=float)
+    below = depths > switch_depths(target, projectile)[0] + 1e-6
+    a, b = (np.asarray(tables[name]["fine"]["sigma_r"])[:, below] for name in study.TARGETS)
+    estimate = np.asarray(tables["realistic"]["fine"]["error_estimate"])[:, below]
+    assert np.all(np.abs(a / b - 1.0) <= np.maximum(estimate, 1e-6))

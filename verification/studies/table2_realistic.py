@@ -6,14 +6,20 @@ item 5).
 
 - ``rows.csv``: per column (the paper's Table 2, the closed forms of the Mohr-Coulomb runway,
   the FE table of the Mohr-Coulomb runway, the FE table of the realistic concrete) and Table 2
-  row: ``L``, ``V``, ``t`` and, for the FE tables, the estimate of each;
+  row: ``L``, ``V``, ``t`` and, for the FE tables, the estimate of each. Rows 1, 3, 4 are the
+  flight's events (:func:`~cavex.verification.studies.table2.table2_rows`); row 2, the end of
+  the closed forms' state ``a``, is for a table the point where the FE's elastic-plastic
+  boundary reaches the concrete-macadam interface (:func:`state_a_end`);
 - ``convergence.csv``: every flight of the refinement (per target: the table, the table with
   every other node in ``V`` and in ``L``, the FE mesh at the default and at twice the
   resolution on the coarse grid) and its rows;
 - ``table2.md``: the one table of docs/table2.md "The realistic concrete";
 - ``trajectories.png``: velocity against depth and time, both FE tables beside Table 2;
 - ``table_realistic.nc``, ``table_realistic_mesh.nc`` (and ``_mohr_coulomb``): the FE tables
-  flown (netCDF-3, as the FE-table cache stores them), which the tests fly again.
+  flown (netCDF-3, as the FE-table cache stores them), which the tests fly again; the first
+  drives ``cavex penetrate --resistance table --table results/table2_realistic/
+  table_realistic.nc --config examples/runway_realistic_concrete.toml`` (and ``cavex
+  trajectory`` with the same options).
 
 The targets. *Mohr-Coulomb*: the paper's Table 1 (``core/data/runway.toml``). *Realistic*:
 ``examples/runway_realistic_concrete.toml``, the same runway with the concrete layer the
@@ -24,9 +30,11 @@ covers a layered target of that concrete (the concrete cavity model is one semi-
 medium), so its column is the FE's alone.
 
 The tables (:func:`cached_table`, through the FE-table cache
-:mod:`cavex.verification.fedata.table_cache`): velocities :data:`VELOCITIES` (the ogive's nose
-sees at most ``0.543 V``: 543 m/s at ``V0`` = 1000 m/s, so 600 m/s covers the shot), depths
-:data:`DEPTHS` (``cavex table``'s default, with the switch depths and their refinement added).
+:mod:`cavex.verification.fedata.table_cache`): velocities :data:`VELOCITIES`, 0 to 750 m/s
+every 25 (the ogive's nose sees at most ``0.543 V``, 543 m/s at ``V0`` = 1000 m/s; row 2 reads
+the plastic front at the projectile's own ``V``, reached below 700 m/s), depths :data:`DEPTHS`
+(``cavex table``'s default, 0.10 to 1.30 m every 0.04, with the switch depths and their
+refinement added). Built, they take about 10 min on two loaded cores; cached, seconds.
 
 The estimate of a number ``q`` (a row's ``L``, ``V`` or ``t``) of a table's flight is
 
@@ -314,7 +322,7 @@ def markdown(cols):
         for name, rows, est in cols:
             row, e = rows[i], (est[i] if est else None)
             if row is None:
-                cells.append("- (no response state in a table)")
+                cells.append("- (not reached)")
                 continue
             if name.startswith("She"):
                 cells.append(f"{row['depth_m']:.2f} m, {row['velocity_m_s']:.1f} m/s, "
