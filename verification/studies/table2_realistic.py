@@ -79,7 +79,7 @@ TARGETS = ("mohr_coulomb", "realistic")
 TARGET_WORDS = {"mohr_coulomb": "Mohr-Coulomb layers (Table 1), FE table",
                 "realistic": "realistic concrete, FE table"}
 ROW_NAMES = ("crater", "end of state a", "nose at H1", "rest")
-#: the closed forms of the Mohr-Coulomb runway: (column, penetration_job options)
+#: the closed forms of the Mohr-Coulomb runway: (column, make_resistance options)
 CLOSED_FORMS = (("paper model, cylindrical-sigma_c",
                  {"resistance": "paper", "epsilon": "cylindrical-sigma_c"}),
                 ("derived, dynamic", {"resistance": "derived"}))
@@ -266,13 +266,19 @@ def estimates(flights):
 
 
 def closed_form_runs():
-    """The closed forms of the Mohr-Coulomb runway (the commands' runs,
-    :func:`cavex.verification.commands.penetrate.penetration_job`): ``{column: trajectory}``."""
-    from cavex.verification.commands.penetrate import penetration_job
+    """The closed forms of the Mohr-Coulomb runway, flown as ``cavex penetrate`` flies them
+    (:func:`cavex.analytic.models.make_resistance` with each model's default boundary, crater
+    from the nose base): ``{column: trajectory}``."""
+    from cavex.analytic.models import get, make_resistance
+    from cavex.analytic.penetration.integrator import penetrate
 
     target, projectile = target_of("mohr_coulomb")
-    return {column: penetration_job(target, projectile, **options)["runs"]["runway"]
-            for column, options in CLOSED_FORMS}
+    runs = {}
+    for column, options in CLOSED_FORMS:
+        boundary = get(options["resistance"]).boundary(None)
+        resistance = make_resistance(target, projectile, boundary=boundary, **options)
+        runs[column] = penetrate(target, projectile, resistance, crater="nose-base")
+    return runs
 
 
 def decimals_of(estimate, unit=1.0, floor=0.0):
