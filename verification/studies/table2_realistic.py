@@ -59,6 +59,7 @@ import numpy as np
 
 from cavex.config import load_config
 from cavex.verification.output.files import save_figure, write_text_atomic
+from cavex.verification.output.number_format import Decimals, format_number
 from cavex.verification.output.paths import check_output_dir
 from cavex.verification.studies.table2 import PAPER_TABLE2, ROW_KEYS, table2_rows
 
@@ -84,6 +85,12 @@ CLOSED_FORMS = (("paper model, cylindrical-sigma_c",
                  {"resistance": "paper", "epsilon": "cylindrical-sigma_c"}),
                 ("derived, dynamic", {"resistance": "derived"}))
 UNITS = {"depth_m": 1.0, "velocity_m_s": 1.0, "time_s": 1e3}  # t written in ms
+#: the CSVs' quanta (SI): 1e-6 m, 0.01 m/s, 1e-7 s, 10 or more of the spreads a 1-ulp change
+#: of the force makes in a flight (cavex.verification.output.number_format,
+#: TRAJECTORY_QUANTA: 5e-8 m, 9.3e-4 m/s, 5.8e-9 s), so that another CPU writes the same text
+CSV_QUANTA = {"depth_m": Decimals(6), "velocity_m_s": Decimals(2), "time_s": Decimals(7)}
+CSV_DIGITS = 9  # significant digits, where the quantum is finer
+ESTIMATE_DIGITS = 3
 
 
 def target_of(name):
@@ -347,6 +354,11 @@ def markdown(cols):
     return "\n".join(lines) + "\n"
 
 
+def csv_value(value, key):
+    """A row's ``value`` of ``key`` (SI) as the CSVs write it (:data:`CSV_QUANTA`)."""
+    return format_number(value, CSV_DIGITS, CSV_QUANTA[key])
+
+
 def rows_csv(cols):
     """One line per column and row: the values (SI) and estimates (empty where none)."""
     out = io.StringIO()
@@ -355,8 +367,9 @@ def rows_csv(cols):
     for name, rows, est in cols:
         for i, row in enumerate(rows):
             e = est[i] if est else None
-            values = ["" if row is None else f"{row[k]:.9g}" for k in ROW_KEYS]
-            errs = ["" if e is None else f"{e[k]:.3g}" for k in ROW_KEYS]
+            values = ["" if row is None else csv_value(row[k], k) for k in ROW_KEYS]
+            errs = ["" if e is None else format_number(e[k], ESTIMATE_DIGITS, CSV_QUANTA[k])
+                    for k in ROW_KEYS]
             writer.writerow([name, i + 1, ROW_NAMES[i], *values, *errs])
     return out.getvalue()
 
@@ -369,9 +382,9 @@ def convergence_csv(results):
                      *(f"row{i + 1}_{k}" for i in range(4) for k in ROW_KEYS)])
     for name in TARGETS:
         for flight, f in results[name].items():
-            values = [("" if row is None else f"{row[k]:.9g}")
+            values = [("" if row is None else csv_value(row[k], k))
                       for row in f["rows"] for k in ROW_KEYS]
-            writer.writerow([name, flight, f"{f['final_depth_m']:.9g}", *values])
+            writer.writerow([name, flight, csv_value(f["final_depth_m"], "depth_m"), *values])
     return out.getvalue()
 
 
