@@ -10,11 +10,13 @@ item 5).
   flight's events (:func:`~cavex.verification.studies.table2.table2_rows`); row 2, the end of
   the closed forms' state ``a``, is for a table the point where the FE's elastic-plastic
   boundary reaches the concrete-macadam interface (:func:`state_a_end`);
-- ``convergence.csv``: every flight of the refinement (per target: the table, the table with
-  every other node in ``V`` and in ``L``, the FE mesh at the default and at twice the
-  resolution on the coarse grid) and its rows;
-- ``table2.md``: the one table of docs/table2.md "The realistic concrete";
-- ``trajectories.png``: velocity against depth and time, both FE tables beside Table 2;
+- ``convergence.csv``: every flight of the refinement (per target: the table; the table with
+  every other node in ``V`` once, twice, three times and in ``L`` once, twice; the FE mesh at
+  the default and at twice the resolution on the coarse grid) and its rows;
+- ``table2.md``: the one table of docs/table2.md ("Table 2 under the Mohr-Coulomb layers and
+  under the realistic concrete");
+- ``trajectories.png``: velocity against depth and time, both FE tables and the paper model's
+  closed form beside Table 2's points;
 - ``table_realistic.nc``, ``table_realistic_mesh.nc`` (and ``_mohr_coulomb``): the FE tables
   flown (netCDF-3, as the FE-table cache stores them), which the tests fly again; the first
   drives ``cavex penetrate --resistance table --table results/table2_realistic/
