@@ -211,3 +211,22 @@ def test_the_targets_differ_only_while_the_cavity_is_in_the_concrete(tables, rea
     a, b = (np.asarray(tables[name]["fine"]["sigma_r"])[:, below] for name in study.TARGETS)
     estimate = np.asarray(tables["realistic"]["fine"]["error_estimate"])[:, below]
     assert np.all(np.abs(a / b - 1.0) <= np.maximum(estimate, 1e-6))
+
+
+def test_state_a_end_finds_where_the_front_reaches_the_interface(realistic):
+    # a front b(V, L) = 0.05 + 0.1 (0.7 - L) (linear in L: the bilinear interpolation and the
+    # crossing between trajectory points are exact) meets the interface radius H1 + l - L where
+    # 0.05 + 0.07 - 0.1 L = 0.71 - L, at L = 0.59 / 0.9; a front that never reaches it gives None
+    from types import SimpleNamespace
+
+    target, projectile = realistic
+    velocities, depths = np.array([0.0, 400.0, 800.0]), np.linspace(0.1, 1.3, 13)
+    front = np.broadcast_to(0.05 + 0.1 * (0.7 - depths), (3, 13))
+    run = SimpleNamespace(depth=np.linspace(0.0, 1.0, 101), velocity=np.linspace(700, 200, 101),
+                          t=np.linspace(0.0, 1e-3, 101))
+    row = study.state_a_end(run, (velocities, depths, front), target, projectile)
+    expected = 0.59 / 0.9
+    assert row["depth_m"] == pytest.approx(expected, abs=1e-12)
+    assert row["velocity_m_s"] == pytest.approx(700 - 500 * expected, abs=1e-9)
+    assert row["time_s"] == pytest.approx(1e-3 * expected, abs=1e-15)
+    assert study.state_a_end(run, (velocities, depths, 0.0 * front), target, projectile) is None

@@ -175,8 +175,11 @@ def state_a_end(run, front, target, projectile):
     velocities, depths, b = front
     boundary = RegularGridInterpolator((velocities, depths), b, method="linear")
     L, V, t = (np.asarray(x, dtype=float) for x in (run.depth, run.velocity, run.t))
-    inside = (L >= depths[0]) & (L <= depths[-1]) & (V <= velocities[-1])
     interface = target.interface_depths[0] + projectile.l - L
+    # while the concrete surrounds the cavity (up to the switch depth, where the interface's
+    # radius is the cavity's r <= b: the state has ended there at the latest)
+    inside = ((L >= depths[0]) & (L <= depths[-1]) & (V <= velocities[-1])
+              & (interface >= projectile.r))
     gap = np.full(L.shape, -np.inf)
     gap[inside] = boundary(np.column_stack([V[inside], L[inside]])) - interface[inside]
     reached = np.flatnonzero(gap >= 0.0)
