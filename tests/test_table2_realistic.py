@@ -141,10 +141,12 @@ def test_refinement_claims(realistic):
                                                        ("velocity_x4", "velocity"),
                                                        ("velocity", "fine"))]
     assert v_changes[0] > v_changes[1] > v_changes[2]
-    l_changes = [abs(depth["depth_x4"] - depth["depth"]), abs(depth["depth"] - depth["fine"])]
-    assert l_changes[0] > l_changes[1]
+    l_changes = [abs(depth[a] - depth[b]) for a, b in (("depth_x8", "depth_x4"),
+                                                       ("depth_x4", "depth"),
+                                                       ("depth", "fine"))]
+    assert l_changes[0] > l_changes[1] > l_changes[2]
     mesh = abs(depth["mesh_refined"] - depth["mesh_base"])
-    assert mesh < v_changes[2] + l_changes[1]
+    assert mesh < v_changes[2] + l_changes[2]
 
 
 @pytest.mark.parametrize(("velocity", "depth"), [(0.0, 0.3), (200.0, 0.9)])

@@ -35,8 +35,8 @@ The tables (:func:`cached_table`, through the FE-table cache
 :mod:`cavex.verification.fedata.table_cache`): velocities :data:`VELOCITIES`, 0 to 750 m/s
 every 25 (the ogive's nose sees at most ``0.543 V``, 543 m/s at ``V0`` = 1000 m/s; row 2 reads
 the plastic front at the projectile's own ``V``, reached below 700 m/s), depths :data:`DEPTHS`
-(``cavex table``'s default, 0.10 to 1.30 m every 0.04, with the switch depths and their
-refinement added). Built from an empty cache the study took 4.5 min wall (106 s of CPU) on
+(0.10 to 1.30 m every 0.02, twice ``cavex table``'s default density, with the switch depths
+and their refinement added). Built from an empty cache the study took 4.5 min wall (106 s of CPU) on
 two cores shared with other jobs, about 10 min when they were busier; cached, about 25 s.
 
 The estimate of a number ``q`` (a row's ``L``, ``V`` or ``t``) of a table's flight is
@@ -72,11 +72,12 @@ REALISTIC_FILE = ROOT / "examples" / "runway_realistic_concrete.toml"
 #: m/s: 0, 25, ..., 750 (the nose sees at most 0.543 V0 = 543 m/s; row 2 reads the plastic
 #: front at the projectile's own V, below 750 m/s where it is reached)
 VELOCITIES = tuple(float(v) for v in np.linspace(0.0, 750.0, 31))
-#: nose depths (m): ``cavex table``'s default (the switch depths are added)
-DEPTHS = tuple(float(d) for d in np.round(np.linspace(0.10, 1.30, 31), 6))
+#: nose depths (m): 0.10 ... 1.30 every 0.02, twice ``cavex table``'s default density (the
+#: switch depths are added)
+DEPTHS = tuple(float(d) for d in np.round(np.linspace(0.10, 1.30, 61), 6))
 #: the coarse grid of the FE-mesh check: a subset of the table's
 MESH_VELOCITIES = (0.0, 250.0, 500.0, 750.0)
-MESH_DEPTHS = DEPTHS[::2]
+MESH_DEPTHS = DEPTHS[::4]
 #: twice the default space and time resolution (cavex.fem.Numerics: 30 per decade, 0.03)
 MESH_NUMERICS = {"elements_per_decade": 60.0, "growth_per_step": 0.015}
 TARGETS = ("mohr_coulomb", "realistic")
@@ -206,8 +207,8 @@ def flight_rows(target, projectile, table, front=None):
 
 
 #: how often each axis is coarsened for the refinement series (every other node each time):
-#: V spacing 25, 50, 100, 200 m/s; L spacing 0.04, 0.08, 0.16 m
-COARSENINGS = (("velocity", 3), ("depth", 2))
+#: V spacing 25, 50, 100, 200 m/s; L spacing 0.02, 0.04, 0.08, 0.16 m
+COARSENINGS = (("velocity", 3), ("depth", 3))
 
 
 def variants(fine, target, projectile):
