@@ -36,8 +36,8 @@ The tables (:func:`cached_table`, through the FE-table cache
 every 25 (the ogive's nose sees at most ``0.543 V``, 543 m/s at ``V0`` = 1000 m/s; row 2 reads
 the plastic front at the projectile's own ``V``, reached below 700 m/s), depths :data:`DEPTHS`
 (0.10 to 1.30 m every 0.02, twice ``cavex table``'s default density, with the switch depths
-and their refinement added). Built from an empty cache the study took 4.5 min wall (106 s of CPU) on
-two cores shared with other jobs, about 10 min when they were busier; cached, about 25 s.
+and their refinement added). Built from an empty cache the study took 7.3 min wall (180 s of CPU) on
+two cores shared with other jobs; cached, about 25 s.
 
 The estimate of a number ``q`` (a row's ``L``, ``V`` or ``t``) of a table's flight is
 
