@@ -111,9 +111,10 @@ def concrete_layer(table, where="", name=None, material=()):
     path, e.g. ``"layers[0]."``): :meth:`cavex.concrete.Concrete.layer`, a concrete of strength
     ``fc`` (Pa) and density ``rho`` (kg/m^3) with ``E``, ``nu``, ``lam`` and ``tau`` from the
     published correlations (:mod:`cavex.concrete`); with ``capped = true``
-    :meth:`~cavex.concrete.Concrete.fe_layer` (the cap ``tau_max = 7 f_c`` and the tension
-    cut-off that the FE carries). Named ``name`` (default ``"concrete"``). The layer's own
-    material keys (``material``) are refused: the concrete is its material."""
+    :meth:`~cavex.concrete.Concrete.fe_layer` (the cap ``tau_max = 7 f_c``, the tension
+    cut-off and HJC's compaction hydrostat that the FE carries). Named ``name`` (default
+    ``"concrete"``). The layer's own material keys (``material``) are refused: the concrete is
+    its material."""
     if material:
         raise CavexInputError("must be absent with concrete (the layer's material is the "
                               "concrete's)", f"{where}{next(iter(material))}")

@@ -386,12 +386,17 @@ class RadialSolver:
         K, G = m["K"], m["G"]
         volumetric = 0.5 * K * theta_e ** 2
         if np.any(np.isfinite(m["crush"])):
-            x_l = m["lock_pressure"] / K
+            # a layer without the hydrostat (crush = inf) is never locked; its infinite lock
+            # constants are replaced by 0 before the arithmetic (no inf - inf, no inf * 0)
+            compacting = np.isfinite(m["crush"])
+            P_l, e_l, K_l = (np.where(compacting, m[k], 0.0)
+                             for k in ("lock_pressure", "lock_strain", "locked_modulus"))
+            x_l = P_l / K
             x = -theta_e
-            locked = (-one.state["theta_p"] >= m["lock_strain"] - x_l) & (x > x_l)
+            locked = compacting & (-one.state["theta_p"] >= e_l - x_l) & (x > x_l)
             past = np.where(locked, x - x_l, 0.0)
-            volumetric = np.where(locked, 0.5 * K * x_l ** 2 + m["lock_pressure"] * past
-                                  + 0.5 * m["locked_modulus"] * past ** 2, volumetric)
+            volumetric = np.where(locked, 0.5 * K * x_l ** 2 + P_l * past
+                                  + 0.5 * K_l * past ** 2, volumetric)
         return float(np.sum(disc.weights * (volumetric + (2.0 / 3.0) * G * gamma_e ** 2)))
 
     # single-case shorthands (the solver of one problem)

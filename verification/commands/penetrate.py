@@ -118,7 +118,8 @@ def penetration_job(target, projectile, *, resistance="derived", boundary=None,
             "table": None if table is None else str(table), "crater": crater,
             "runs": runs, "table2": table2_comparison(runs["runway"]) if paper else None,
             "target_label": target_label(paper, target.debonded),
-            "notes": crater_notes(target, projectile, crater),
+            "notes": crater_notes(target, projectile, crater)
+            + fe_only_notes(target, closed, model.takes_table),
             "debonded": bool(target.debonded),
             "interface_depths": target.interface_depths,
             "title": model.describe(boundary, epsilon, table, settings.get("law")),
@@ -243,6 +244,23 @@ def crater_notes(target, projectile, crater):
     return [f"the crater ({depth:.4g} m, 4.5 r from the {crater}) reaches below the first layer "
             f"({first:.4g} m thick); the crater stage uses the first layer's properties "
             "throughout"]
+
+
+def fe_only_notes(target, closed, table):
+    """A sentence if a layer has FE-only keys (``tau_max``, ``tensile_strength``, the
+    hydrostat: the realistic concrete, ``concrete = {..., capped = true}``): the closed forms
+    ignore them, so the run flown with the closed form ``closed`` (the first layer alone with a
+    table, else both runs) is of another material than the FE's (docs/table2.md)."""
+    from cavex.materials import fe_only_parameters
+
+    named = [target.layer_name(i) for i, material in enumerate(target.layers)
+             if any(getattr(material, k) is not None for k in fe_only_parameters())]
+    if not named:
+        return []
+    runs = "the first layer alone is" if table else "both runs are"
+    return [f"{runs} flown with the {closed} closed form, which ignores the FE-only keys of "
+            f"{', '.join(named)} (cap, tension cut-off, compaction): another material than "
+            "the FE's; an FE table of the target carries them (docs/table2.md)"]
 
 
 def phases_as_dicts(trajectory):
