@@ -149,7 +149,9 @@ def test_the_command_writes_the_cross_validation(capsys, tmp_path):
     assert code == 0
     result = json.loads(text)
     cv = result["cross_validation"]
-    assert set(cv) == {"families", "folds", "regimes", "chosen_on_shots", "choice_on_all_shots"}
+    assert set(cv) == {"families", "folds", "regimes", "chosen_on_shots", "choice_on_all_shots",
+                       "option_depths"}
+    assert cv["option_depths"] == {}  # nothing chosen on shots
     assert cv["families"] == ["reference", "yield"]  # no shot of 13 mm or above 1000 m/s
     assert list(cv["folds"]) == ["reference A", "reference B", "projectile yield < 1 GPa"]
     for fold in cv["folds"].values():

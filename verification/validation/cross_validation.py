@@ -23,7 +23,9 @@ over its depths there; a tie goes to the first in the model's order. A calibrati
 again (its model and free parameters, :func:`cavex.verification.validation.calibration.fit`) on
 its fitted shots less the fold, where the fold holds any of them; else it is used as it is.
 
-Statistics (:func:`cross_validation`): per fold and model the choice, ``n``, mean
+Statistics (:func:`cross_validation`; ``option_depths``: every option's depth of every shot,
+for the models that choose one, so that each choice can be checked from the file): per fold
+and model the choice, ``n``, mean
 ``|ln(predicted/measured)|`` and bias (mean ``ln``) over the fold's shots, and the same by
 regime (:mod:`cavex.verification.validation.regimes`); over the reference folds together, by
 regime (``regimes``). Rounded like every statistic of a validation.
@@ -203,7 +205,9 @@ def cross_validation(result, shots, option_depths, calibrations, families, refit
                 "chosen_on_shots": chosen_on_shots(columns, option_depths, calibrations),
                 "choice_on_all_shots": {c: choose(option_depths[c], measured, sorted(everyone))
                                         for c in columns if c not in calibrations
-                                        and list(option_depths[c]) != [None]}}
+                                        and list(option_depths[c]) != [None]},
+                "option_depths": {c: option_depths[c] for c in columns
+                                  if c not in calibrations and list(option_depths[c]) != [None]}}
     if "reference" in families:
         for i, row in enumerate(result["shots"]):
             row["cross_validated_m"] = {c: held_out[c][i] for c in columns}
