@@ -107,7 +107,7 @@ def run(args, target, projectile):
     # again; the tables go into --out/tables/ with the other files, in the staged write
     tables = TableCache(workers=workers, scheduler=scheduler,
                         progress=show_progress(args.progress))
-    size = estimate(shot_file.shots, calibrations, tables, workers, models)
+    size = estimate(shot_file.shots, calibrations, tables, workers, models, folds)
     print(f"cavex: validate {size}", file=sys.stderr, flush=True)
     began = time.monotonic()
     result = job(shot_file, calibrations, workers=workers, scheduler=scheduler,
@@ -141,14 +141,16 @@ def columns_of(calibrations, models=None):
     return columns
 
 
-def estimate(shots, calibrations, tables, workers, models=None):
+def estimate(shots, calibrations, tables, workers, models=None, cross_validate=None):
     """The run's size and time (:func:`cavex.verification.validation.predict.run_estimate`);
-    ``tables``: a :class:`TableCache` (None: a new one)."""
+    ``tables``: a :class:`TableCache` (None: a new one); ``cross_validate``: the fold
+    families (every option of the concrete model is then run)."""
     from cavex.verification.validation.predict import run_estimate
 
     workers = workers or os.cpu_count() or 1
     return run_estimate(shots, columns_of(calibrations, models),
-                        TableCache() if tables is None else tables, workers)
+                        TableCache() if tables is None else tables, workers,
+                        every_option=cross_validate is not None)
 
 
 def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=None,

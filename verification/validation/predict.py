@@ -294,10 +294,12 @@ class TableCache:
 
 # --- many shots -------------------------------------------------------------------------------
 
-def run_estimate(shots, models, tables, workers):
+def run_estimate(shots, models, tables, workers, every_option=False):
     """One line: the size of a run of ``models`` (column -> ``(model, mapping)``) over
     ``shots`` and its time, from :data:`TABLE_CASES_PER_SECOND_PER_WORKER` and
-    each model's ``prediction_seconds`` and ``concrete_table_seconds`` (the registry's)."""
+    each model's ``prediction_seconds`` and ``concrete_table_seconds`` (the registry's); with
+    ``every_option`` (a cross-validation) the concrete tables of every option of the concrete
+    model."""
     tables.velocities_for(shots)
     table_mappings = [mapping or Mapping() for model, mapping in models.values()
                       if model_of(model).takes_table]
@@ -307,6 +309,8 @@ def run_estimate(shots, models, tables, workers):
     per_shot = sum(model.prediction_seconds for model in chosen)
     table_seconds = max((model.concrete_table_seconds for model in chosen), default=0.0)
     concretes = len({(s.fc, s.rho) for s in shots}) if table_seconds else 0
+    if every_option:
+        concretes *= len(get(CONCRETE_MODEL).options)
     seconds = (cases / (TABLE_CASES_PER_SECOND_PER_WORKER * max(1, workers))
                + len(shots) * per_shot + concretes * table_seconds / max(1, workers))
     when = ("under a minute" if seconds < 60.0 else f"about {seconds / 60.0:.0f} min"
