@@ -201,3 +201,35 @@ def test_a_yield_that_is_not_a_number_is_refused(capsys, tmp_path):
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1
     assert "proj_yield_MPa of shot 'X0'' must be a yield strength in MPa > 0" in err
+
+
+def test_a_calibrated_column_is_refitted_without_each_reference(capsys, tmp_path):
+    """A derived-quasi-static calibration of ``strength_factor`` on all four shots: leaving out
+    reference A, its mapping is fitted again on B's two shots (the same fit as
+    :func:`cavex.verification.validation.calibration.fit` there, to the 6 written digits), and
+    A's shots are predicted with it."""
+    from cavex.verification.validation.calibration import fit
+    from cavex.verification.validation.predict import predict
+    from cavex.verification.validation.shots import read_shots
+
+    shots_path = write_shots(tmp_path / "s.csv")
+    cal = tmp_path / "cal.toml"
+    assert main(["calibrate", "--shots", str(shots_path), "--resistance", "derived",
+                 "--boundary", "quasi-static", "--params", "strength_factor",
+                 "--out", str(cal)]) == 0
+    capsys.readouterr()
+    code = main(["validate", "--shots", str(shots_path), "--models", "li-chen-2003",
+                 "--calibration", str(cal), "--cross-validate", "reference", "--json",
+                 "--out", str(tmp_path / "out")])
+    result = json.loads(capsys.readouterr().out)
+    assert code == 0
+    column = "derived-quasi-static calibrated"
+    shots = read_shots(str(shots_path)).shots
+    refit = fit(shots[2:], "derived", ("strength_factor",), boundary="quasi-static")
+    value = refit.mapping.strength_factor
+    fold = result["cross_validation"]["folds"]["reference A"]["models"][column]
+    assert fold["choice"] == f"refitted on 2 shots: strength_factor = {value:.6g}"
+    for row, shot in zip(result["shots"][:2], shots[:2], strict=True):
+        assert row["cross_validated_m"][column] == pytest.approx(
+            predict(shot, "derived-quasi-static", refit.mapping), rel=DIGITS_6)
+    assert result["cross_validation"]["chosen_on_shots"][column].startswith("a mapping fitted")
