@@ -278,7 +278,8 @@ def cross_validation_section(result):
         first = columns[0]
         lines += ["### Leaving out one reference at a time, by regime", "",
                   "Every shot predicted by the choices made without its reference; in "
-                  "brackets the plain mean |ln ratio| (choices made on all shots).", "",
+                  "brackets the plain mean |ln ratio| (each model as it runs, its choices "
+                  "those of the registry).", "",
                   "| model | " + " | ".join(f"{REGIME_TITLES[n]} ({cv['regimes'][n][first]['n']})"
                                             for n in names) + " |",
                   "|---|" + "---:|" * len(names)]
