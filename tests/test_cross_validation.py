@@ -69,7 +69,8 @@ def test_the_choice_without_each_fold_is_the_one_worked_by_hand():
     cross_validation(result, SHOTS, {"chooser": {"x": x, "y": y}, "fixed": {None: plain}}, {},
                      FOLDS, refit=None)
     cv = result["cross_validation"]
-    choices = {name: fold["models"]["chooser"]["choice"] for name, fold in cv["folds"].items()}
+    folds = {fold["name"]: fold for fold in cv["folds"]}
+    choices = {name: fold["models"]["chooser"]["choice"] for name, fold in folds.items()}
     assert choices == {"reference A": "y", "reference B": "y", "reference C": "x",
                        "calibre <= 13 mm": "x", "projectile yield < 1 GPa": "y",
                        "V0 > 1000 m/s": "x"}
@@ -79,7 +80,7 @@ def test_the_choice_without_each_fold_is_the_one_worked_by_hand():
     assert every["n"] == 6
     assert every["mean_abs_log_ratio"] == pytest.approx((4 * 0.5 + 2 * 1.2) / 6, rel=DIGITS_6)
     assert every["mean_log_ratio"] == pytest.approx((4 * 0.5 - 2 * 1.2) / 6, rel=DIGITS_6)
-    fold = cv["folds"]["reference C"]["models"]["chooser"]
+    fold = folds["reference C"]["models"]["chooser"]
     assert (fold["n"], fold["mean_abs_log_ratio"], fold["mean_log_ratio"]) == (2, 1.2, -1.2)
     assert cv["choice_on_all_shots"] == {"chooser": "y"}  # 2/6 against 2.4/6
     fixed = cv["regimes"]["all"]["fixed"]
@@ -115,7 +116,7 @@ def test_a_calibration_is_refitted_only_without_a_fold_that_holds_its_fitted_sho
     assert calls == [(["S2", "S4"], ["S0", "S1"]), (["S0", "S4"], ["S2", "S3"]),
                      (["S0", "S2"], ["S4", "S5"]), (["S0", "S2"], ["S4", "S5"])]
     folds = result["cross_validation"]["folds"]
-    assert all(f["models"][column]["choice"] == "refitted" for f in folds.values())
+    assert all(f["models"][column]["choice"] == "refitted" for f in folds)
     assert result["cross_validation"]["regimes"]["all"][column]["mean_abs_log_ratio"] == \
         pytest.approx(0.1, rel=DIGITS_6)
     calls.clear()
@@ -124,8 +125,8 @@ def test_a_calibration_is_refitted_only_without_a_fold_that_holds_its_fitted_sho
                      ("velocity",), refit)
     assert calls == []
     assert folds is not result["cross_validation"]["folds"]
-    assert result["cross_validation"]["folds"]["V0 > 1000 m/s"]["models"][column]["choice"] \
-        == "as calibrated"
+    fold = result["cross_validation"]["folds"][0]
+    assert fold["name"] == "V0 > 1000 m/s" and fold["models"][column]["choice"] == "as calibrated"
 
 
 def write_shots(path, sources=("A", "A", "B", "B"), yields=("", "", "", "")):
@@ -150,18 +151,22 @@ def test_the_command_writes_the_cross_validation(capsys, tmp_path):
     result = json.loads(text)
     cv = result["cross_validation"]
     assert set(cv) == {"families", "folds", "regimes", "chosen_on_shots", "choice_on_all_shots",
-                       "option_depths"}
-    assert cv["option_depths"] == {}  # nothing chosen on shots
+                       "option_depths_m"}
+    assert cv["option_depths_m"] == {}  # nothing chosen on shots
     assert cv["families"] == ["reference", "yield"]  # no shot of 13 mm or above 1000 m/s
-    assert list(cv["folds"]) == ["reference A", "reference B", "projectile yield < 1 GPa"]
-    for fold in cv["folds"].values():
-        assert set(fold) == {"family", "n", "models", "regimes"}
+    assert [f["name"] for f in cv["folds"]] == ["reference A", "reference B",
+                                                "projectile yield < 1 GPa"]
+    for fold in cv["folds"]:
+        assert set(fold) == {"name", "family", "n", "models", "regimes"}
         for stats in fold["models"].values():
             assert set(stats) == {"choice", "n", "mean_abs_log_ratio", "mean_log_ratio"}
     assert cv["chosen_on_shots"] == {"li-chen-2003": None, "forrestal-1994": None}
     assert cv["regimes"] == result["regimes"]
     for row in result["shots"]:
         assert row["cross_validated_m"] == row["predicted_m"]
+    from test_json_keys import offending_keys
+
+    assert offending_keys(result) == []
     report = (out / "report.md").read_text()
     assert "## Cross-validation" in report and "(cross_validation.png)" in report
     assert "nothing chosen on shots: predicted as it is" in report
@@ -227,7 +232,7 @@ def test_a_calibrated_column_is_refitted_without_each_reference(capsys, tmp_path
     shots = read_shots(str(shots_path)).shots
     refit = fit(shots[2:], "derived", ("strength_factor",), boundary="quasi-static")
     value = refit.mapping.strength_factor
-    fold = result["cross_validation"]["folds"]["reference A"]["models"][column]
+    fold = result["cross_validation"]["folds"][0]["models"][column]
     assert fold["choice"] == f"refitted on 2 shots: strength_factor = {value:.6g}"
     for row, shot in zip(result["shots"][:2], shots[:2], strict=True):
         assert row["cross_validated_m"][column] == pytest.approx(

@@ -619,20 +619,22 @@ def test_committed_cross_validation_is_consistent():
     members["projectile yield < 1 GPa"] = [i for i, c in enumerate(info)
                                            if float(c["proj_yield_MPa"] or "inf") < 1000.0]
     members["V0 > 1000 m/s"] = [i for i, c in enumerate(info) if float(c["V0_m_s"]) > 1000.0]
-    assert list(cv["folds"]) == list(members) and len(members) == 21 + 3
+    folds = {fold["name"]: fold for fold in cv["folds"]}
+    assert list(folds) == list(members) and len(members) == 21 + 3
+    stored = {c: dict(zip(v["options"], v["depths_m"], strict=True))
+              for c, v in cv["option_depths_m"].items()}
 
     def score(depths, where):
         logs = [abs(math.log(depths[i] / measured[i])) for i in where if depths[i] is not None]
         return len(where) - len(logs), np.mean(logs)
 
     for column in result["models"]:
-        options = cv["option_depths"].get(column, {None: [r["predicted_m"][column]
-                                                          for r in rows]})
+        options = stored.get(column, {None: [r["predicted_m"][column] for r in rows]})
         for name, held in members.items():
             rest = sorted(set(range(len(rows))) - set(held))
             ranked = sorted((score(d, rest), k, o) for k, (o, d) in enumerate(options.items()))
             chosen = ranked[0][2]
-            stats = cv["folds"][name]["models"][column]
+            stats = folds[name]["models"][column]
             assert stats["choice"] == chosen
             logs = np.log([options[chosen][i] / measured[i] for i in held
                            if options[chosen][i] is not None])
@@ -643,7 +645,7 @@ def test_committed_cross_validation_is_consistent():
             if name.startswith("reference "):
                 for i in held:
                     assert rows[i]["cross_validated_m"][column] == options[chosen][i]
-        if column not in cv["option_depths"]:
+        if column not in stored:
             assert cv["chosen_on_shots"][column] is None
             assert all(r["cross_validated_m"][column] == r["predicted_m"][column] for r in rows)
     for name, models in cv["regimes"].items():
@@ -656,5 +658,4 @@ def test_committed_cross_validation_is_consistent():
                                                                 rel=DIGITS_6)
     concrete = get("concrete")
     assert cv["choice_on_all_shots"]["concrete"] == concrete.option
-    assert [r["predicted_m"]["concrete"] for r in rows] == \
-        cv["option_depths"]["concrete"][concrete.option]
+    assert [r["predicted_m"]["concrete"] for r in rows] == stored["concrete"][concrete.option]

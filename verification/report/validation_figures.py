@@ -344,17 +344,17 @@ def draw_cv_folds(ax, result, key):
     """Each model's ``key`` over each fold's shots left out (the kinds first, then the
     references), a point per model and fold."""
     cv, columns = result["cross_validation"], result["models"]
-    folds = sorted(cv["folds"], key=lambda n: (cv["folds"][n]["family"] == "reference", 0))
+    folds = sorted(cv["folds"], key=lambda f: f["family"] == "reference")  # stable
     x = np.arange(len(folds))
     for k, column in enumerate(columns):
         _, marker, colour = model_style(column)
-        values = [cv["folds"][f]["models"][column][key] for f in folds]
+        values = [f["models"][column][key] for f in folds]
         ax.plot(x + (k - (len(columns) - 1) / 2) * 0.08,
                 [np.nan if v is None else v for v in values], marker=marker, color=colour,
                 linestyle="none", markersize=5, label=column)
     ax.axhline(0.0, color="k", linewidth=0.8)
     ax.set_xticks(x)
-    ax.set_xticklabels([f"{f.removeprefix('reference ')} ({cv['folds'][f]['n']})"
+    ax.set_xticklabels([f"{f['name'].removeprefix('reference ')} ({f['n']})"
                         for f in folds], rotation=70, ha="right", fontsize=7)
     ax.set_ylabel(_CV_LABELS[key])
     ax.set_title("each fold left out (n shots)", fontsize=9)

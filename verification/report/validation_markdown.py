@@ -287,7 +287,7 @@ def cross_validation_section(result):
             lines.append(f"| {m} | " + " | ".join(
                 _cell(cv["regimes"][n][m], plain.get(n, {}).get(m)) for n in names) + " |")
         lines.append("")
-    kinds = {n: f for n, f in cv["folds"].items() if f["family"] != "reference"}
+    kinds = {f["name"]: f for f in cv["folds"] if f["family"] != "reference"}
     if kinds:
         lines += ["### Leaving out one kind of shot, by regime", "",
                   "| kind left out | regime (n) | " + " | ".join(columns) + " |",
@@ -298,7 +298,7 @@ def cross_validation_section(result):
                 lines.append(f"| {table_cell(name)} | {REGIME_TITLES[regime]} ({n}) | "
                              + " | ".join(_cell(stats[m]) for m in columns) + " |")
         lines.append("")
-    refs = {n: f for n, f in cv["folds"].items() if f["family"] == "reference"}
+    refs = {f["name"]: f for f in cv["folds"] if f["family"] == "reference"}
     if refs:
         lines += ["### Each reference left out", "",
                   "| reference left out | n | " + " | ".join(columns) + " |",
@@ -312,8 +312,8 @@ def cross_validation_section(result):
         lines += ["### The choice made without each fold", "",
                   "| fold left out | " + " | ".join(choosing) + " |",
                   "|---|" + "---|" * len(choosing)]
-        for name, fold in cv["folds"].items():
-            lines.append(f"| {table_cell(name)} | " + " | ".join(
+        for fold in cv["folds"]:
+            lines.append(f"| {table_cell(fold['name'])} | " + " | ".join(
                 table_cell(fold["models"][c]["choice"]) for c in choosing) + " |")
         lines.append("")
     return lines
@@ -330,10 +330,10 @@ def cross_validation_lines(cv):
         for m, _ in cv["regimes"][names[0]].items():
             lines.append(f"  {m:<38} " + "  ".join(f"{_cell(cv['regimes'][n][m]):>16}"
                                                    for n in names))
-    for name, fold in cv["folds"].items():
+    for fold in cv["folds"]:
         if fold["family"] == "reference":
             continue
-        lines.append(f"leaving out {name} ({fold['n']} shots):")
+        lines.append(f"leaving out {fold['name']} ({fold['n']} shots):")
         for m, stats in fold["models"].items():
             lines.append(f"  {m:<38} {_cell(stats):>16}"
                          + (f"  chose {stats['choice']}" if stats["choice"] else ""))

@@ -23,9 +23,9 @@ over its depths there; a tie goes to the first in the model's order. A calibrati
 again (its model and free parameters, :func:`cavex.verification.validation.calibration.fit`) on
 its fitted shots less the fold, where the fold holds any of them; else it is used as it is.
 
-Statistics (:func:`cross_validation`; ``option_depths``: every option's depth of every shot,
+Statistics (:func:`cross_validation`; ``option_depths_m``: every option's depth of every shot,
 for the models that choose one, so that each choice can be checked from the file): per fold
-and model the choice, ``n``, mean
+(a list: ``name``, ``family``, ``n``) and model the choice, ``n``, mean
 ``|ln(predicted/measured)|`` and bias (mean ``ln``) over the fold's shots, and the same by
 regime (:mod:`cavex.verification.validation.regimes`); over the reference folds together, by
 regime (``regimes``). Rounded like every statistic of a validation.
@@ -177,7 +177,7 @@ def cross_validation(result, shots, option_depths, calibrations, families, refit
     folds = fold_indices(shots, families)
     everyone = set(range(len(shots)))
     held_out = {c: [None] * len(shots) for c in columns}  # the reference folds' predictions
-    out = {}
+    out = []
     for name, (family, held) in folds.items():
         rest = sorted(everyone - set(held))
         models, predicted = {}, {}
@@ -199,15 +199,17 @@ def cross_validation(result, shots, option_depths, calibrations, families, refit
                     held_out[column][i] = d
         rows = [_row(result["shots"][i], {c: predicted[c][k] for c in columns})
                 for k, i in enumerate(held)]
-        out[name] = {"family": family, "n": len(held), "models": models,
-                     "regimes": regime_statistics(rows, columns, _digits())}
+        out.append({"name": name, "family": family, "n": len(held), "models": models,
+                    "regimes": regime_statistics(rows, columns, _digits())})
     document = {"families": list(families), "folds": out,
                 "chosen_on_shots": chosen_on_shots(columns, option_depths, calibrations),
                 "choice_on_all_shots": {c: choose(option_depths[c], measured, sorted(everyone))
                                         for c in columns if c not in calibrations
                                         and list(option_depths[c]) != [None]},
-                "option_depths": {c: option_depths[c] for c in columns
-                                  if c not in calibrations and list(option_depths[c]) != [None]}}
+                "option_depths_m": {c: {"options": list(option_depths[c]),
+                                        "depths_m": list(option_depths[c].values())}
+                                    for c in columns if c not in calibrations
+                                    and list(option_depths[c]) != [None]}}
     if "reference" in families:
         for i, row in enumerate(result["shots"]):
             row["cross_validated_m"] = {c: held_out[c][i] for c in columns}
