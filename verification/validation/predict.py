@@ -472,21 +472,26 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         refits = {c.column: c for c in calibrations}
         cross_validation(result, shots, option_depths, refits, cross_validate,
                          refit=lambda c, train, held: refitted_depths(c, train, held, tables,
-                                                                      erosion))
+                                                                      erosion, shots))
     return result
 
 
-def refitted_depths(calibration, train, held, tables=None, erosion=None):
+def refitted_depths(calibration, train, held, tables=None, erosion=None, shots=None):
     """``(choice, depths)``: ``calibration``'s model fitted again, its free parameters from its
     file, to the shots ``train`` (:func:`cavex.verification.validation.calibration.fit`) and
-    its depths of the shots ``held`` (None where it fails); ``choice`` says what was fitted."""
+    its depths of the shots ``held`` (None where it fails); ``choice`` says what was fitted.
+    The fit sets the FE tables' velocity grid to its shots': it is set back to cover
+    ``shots`` (default ``train`` and ``held``) for the predictions."""
     from cavex.verification.validation.calibration import fit
 
     model, boundary = parse_label(calibration.model, "models", labels(fits_mapping=True))
+    tables = tables or TableCache()
     try:
         refit = fit(train, model.name, calibration.params, tables=tables, boundary=boundary)
     except CavexNumericalError as exc:
         return f"refit failed: {str(exc).splitlines()[0]}", [None] * len(held)
+    finally:
+        tables.velocities_for(list(shots) if shots is not None else [*train, *held])
     depths = []
     for shot in held:
         try:
