@@ -10,6 +10,7 @@ draws the same panels; :func:`write_figures` lays them out and writes the PNGs.
 """
 
 import math
+import textwrap
 
 import numpy as np
 
@@ -334,7 +335,7 @@ def draw_cv_regimes(ax, result, key):
         ax.plot(x, [np.nan if v is None else v for v in plain], "k_", markersize=6)
     ax.axhline(0.0, color="k", linewidth=0.8)
     ax.set_xticks(np.arange(len(regimes)))
-    ax.set_xticklabels([REGIME_TITLES[r].replace(", ", ",\n") for r in regimes], fontsize=8)
+    ax.set_xticklabels([textwrap.fill(REGIME_TITLES[r], 14) for r in regimes], fontsize=8)
     ax.set_ylabel(_CV_LABELS[key])
     ax.set_title("each reference left out, by regime (tick: plain)", fontsize=9)
     ax.grid(alpha=0.3, axis="y")
