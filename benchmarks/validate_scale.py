@@ -5,11 +5,12 @@ Writes a shot file of ``--shots`` (default 1000) shots made from the development
 ``k mod 286`` with its ``f_c`` scaled by ``1 + 0.001 k`` and its ``V0`` by ``1 + 0.0005 k``, so
 that every shot has its own concrete (no cavity table is shared: the worst case for the
 concrete model, which tabulates one cavity solution per concrete) and its own velocity. Then
-times ``cavex validate --shots FILE --models li-chen-concrete --no-figures --no-progress
---workers W`` (the recommended model, which runs the concrete model on every shot for the
-rigid-regime flags)
-as a user runs it (the whole process, cold: the concrete tables live in the process) over
-``--runs`` runs and prints the median, min and max.
+times ``cavex validate --shots FILE --models MODEL --no-figures --no-progress --workers W``
+with the recommended model (the registry's: the concrete model, one cavity table per
+concrete) as a user runs it (the whole process, cold: the concrete tables live in the process)
+over ``--runs`` runs and prints the median, min and max of the wall time and the CPU time of
+the command's processes (the CPU time is the steadier figure on a shared machine: divided by
+the workers it is the wall time of an unloaded one).
 
 Run as ``python benchmarks/validate_scale.py [--shots N] [--runs R] [--workers W]`` from the
 repository root.
@@ -17,6 +18,7 @@ repository root.
 
 import argparse
 import csv
+import resource
 import statistics
 import subprocess
 import sys
@@ -55,19 +57,26 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "shots.csv"
         shot_file(path, args.shots)
-        argv = [CAVEX, "validate", "--shots", str(path), "--models", "li-chen-concrete",
+        from cavex.analytic.models import names
+
+        model = names(recommended=True)[0]
+        argv = [CAVEX, "validate", "--shots", str(path), "--models", model,
                 "--no-figures", "--no-progress", "--workers", str(args.workers),
                 "--out", str(Path(folder) / "out")]
-        times = []
+        times, cpu = [], []
         for _ in range(args.runs):
+            before = resource.getrusage(resource.RUSAGE_CHILDREN)
             start = time.perf_counter()
             done = subprocess.run(argv, capture_output=True, text=True, check=False)
             times.append(time.perf_counter() - start)
+            after = resource.getrusage(resource.RUSAGE_CHILDREN)
+            cpu.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
             if done.returncode != 0:
                 raise SystemExit(f"exit {done.returncode}: {done.stderr}")
-        print(f"cavex validate, {args.shots} shots, --models li-chen-concrete, --workers "
+        print(f"cavex validate, {args.shots} shots, --models {model}, --workers "
               f"{args.workers}: median {statistics.median(times):.1f} s (min {min(times):.1f}, "
-              f"max {max(times):.1f}, {len(times)} runs)")
+              f"max {max(times):.1f}, {len(times)} runs); CPU median "
+              f"{statistics.median(cpu):.1f} s (min {min(cpu):.1f}, max {max(cpu):.1f})")
         print(done.stdout.splitlines()[0])
 
 

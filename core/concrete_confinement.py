@@ -2,8 +2,10 @@ r"""Concrete at the cavity's pressures (0.1-2 GPa) as functions of ``f_c``: the 
 the compressive meridian and the constants of the compaction hydrostat, each from a published
 source (issue 31, item 2; docs/concrete.md "Strength and hydrostat at high confinement").
 The data used are in ``core/data/concrete_confinement.csv`` (:func:`load_data`), one row a
-datum with its citation. Nothing here is fitted to penetration shots, and nothing here is wired
-into a model yet (:mod:`cavex.concrete` keeps HJC's constants until the hydrostat lands).
+datum with its citation. Nothing here is fitted to penetration shots. The porosity lock strain
+(:func:`hydrostat`) is an option of the concrete model (``"porosity lock"``,
+:mod:`cavex.analytic.models.concrete`), cross-validated on the development shots and not chosen
+there; the meridians are not wired into a model.
 
 Stresses in Pa, compression positive. On the compressive meridian (one principal stress above
 two equal ones: a triaxial compression test, and the comminuted zone of a spherical cavity,

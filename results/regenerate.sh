@@ -37,8 +37,8 @@ cavex validate --shots examples/shots_forrestal1994.csv --calibration \
   results/validation/calibration_derived-quasi-static.toml results/validation/calibration_paper.toml \
   results/validation/calibration_table.toml results/validation/calibration_derived-dynamic.toml \
   --out results/validation --no-progress > /dev/null
-cavex validate --shots examples/shots_compilation_dev.csv --out results/validation/compilation_dev \
-  --no-progress > /dev/null
+cavex validate --shots examples/shots_compilation_dev.csv --cross-validate \
+  --out results/validation/compilation_dev --no-progress > /dev/null
 cavex verify --no-progress > /dev/null
 python -m cavex.verification.studies.oblique_study --no-progress > /dev/null
 # the same study with debonded interfaces: on another CPU the rows its report.md lists under

@@ -84,7 +84,7 @@ def test_calibration_file_reads_back_for_any_id_and_path(tmp_path, capsys):
                        tmp_path / "v", "--no-progress")
     assert code == 0, err
     # the size and time first (a derived-dynamic calibration: its column and the table's;
-    # 8 uncalibrated models, concrete, Li and Chen and the recommended split included)
+    # 8 uncalibrated models, the concrete model (recommended), Li and Chen and their split)
     assert re.match(r"cavex: validate 2 shots x 10 models = 20 predictions; FE tables: 2 to "
                     r"build \(\d+ FE cases\), 0 on disk; under a minute on \d+ worker", err), err
     code, _, err = run(capsys, "penetrate", "--config", out, "--out", tmp_path / "p")

@@ -46,7 +46,7 @@ def test_the_registry_is_the_vocabulary():
         "li-chen-2003", "li-chen-concrete", "forrestal-1994")
     assert names(flies=True) == ("derived", "paper", "table", "law")
     assert names(closed_form=True) == ("derived", "paper")
-    assert names(recommended=True) == ("li-chen-concrete",)
+    assert names(recommended=True) == ("concrete",)
     for label in labels():
         model, boundary = parse_label(label)
         assert model.label(boundary) == label

@@ -412,10 +412,11 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
 def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
     """``--models concrete li-chen-concrete forrestal-1994``: those three columns and nothing
     else, in JSON, CSV and report; the concrete model's depths are
-    :func:`model_depth`'s, the recommended model's
-    :mod:`cavex.analytic.models.li_chen_concrete`'s (Li and Chen up to 100 MPa, above the concrete
-    model's); the recommended model and its sentence are there."""
+    :func:`model_depth`'s with its option's constants (the recommended model), those of
+    :mod:`cavex.analytic.models.li_chen_concrete` Li and Chen's up to 100 MPa, above the concrete
+    model's; the recommended model and its sentence are there."""
     from cavex.analytic.empirical import li_chen_depth
+    from cavex.analytic.models import get
     from cavex.analytic.models.li_chen_concrete import SPLIT_STRENGTH
     from cavex.analytic.penetration.concrete_table import model_depth
     from cavex.verification.report.validation_markdown import recommendation
@@ -426,7 +427,7 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
     assert code == 0 and err.startswith("cavex: validate 17 shots x 3 models = 51 predictions")
     result = json.loads(out)
     assert result["models"] == ["concrete", "li-chen-concrete", "forrestal-1994"]
-    assert result["recommended_model"] == "li-chen-concrete"
+    assert result["recommended_model"] == "concrete"
     assert json.loads((out_dir / "validation.json").read_text()) == result
     assert set(result["summary"]) == {"concrete", "li-chen-concrete", "forrestal-1994"}
     assert result["failures"] == {}
@@ -437,15 +438,15 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
                  else row["predicted_m"]["concrete"])  # F94-41 and F94-46 are above
         assert row["predicted_m"]["li-chen-concrete"] == pytest.approx(split, rel=DIGITS_6)
         assert row["predicted_m"]["concrete"] == pytest.approx(
-            model_depth(shot), rel=DIGITS_6)
+            model_depth(shot, get("concrete").constants(shot)), rel=DIGITS_6)
         assert row["predicted_m"]["forrestal-1994"] == pytest.approx(
             empirical.shot_depth(shot), rel=DIGITS_6)
     header = (out_dir / "predictions.csv").read_text().splitlines()[0].split(",")
     assert header[5:] == ["flag", "concrete_m", "li_chen_concrete_m", "forrestal_1994_m",
                           "concrete_ratio", "li_chen_concrete_ratio", "forrestal_1994_ratio"]
     report = (out_dir / "report.md").read_text()
-    sentence = recommendation("li-chen-concrete", result["summary"])
-    assert sentence.startswith("Recommended model: `li-chen-concrete`") and sentence in report
+    sentence = recommendation("concrete", result["summary"])
+    assert sentence.startswith("Recommended model: `concrete`") and sentence in report
     assert "--models concrete li-chen-concrete forrestal-1994" in report
     assert "| derived-dynamic |" not in report and "| table |" not in report
 
@@ -562,7 +563,7 @@ def test_committed_development_validation_is_consistent():
 
     folder = Path("results/validation/compilation_dev")
     result = json.loads((folder / "validation.json").read_text())
-    assert result["shots_file"]["n"] == 286 and result["recommended_model"] == "li-chen-concrete"
+    assert result["shots_file"]["n"] == 286 and result["recommended_model"] == "concrete"
     for name, models in result["regimes"].items():
         rows = [r for r in result["shots"] if REGIMES[name](r["fc_Pa"], r["V0_m_s"], r["flag"])]
         for model, stats in models.items():
@@ -590,33 +591,71 @@ def test_a_shot_id_of_any_characters_is_one_markdown_table_cell():
         assert row.replace("\\|", "").count("|") == 3 and "\n" not in row
 
 
-def test_recommended_split_holds_with_each_reference_left_out():
-    """The recommended model's two choices (Li and Chen at f_c <= 100 MPa, the concrete model
-    above) were made on the development shots: refitted with each of the 21 references left
-    out, both choices stay the same (so its LORO scores are its in-sample ones: 0.433 all,
-    0.356 normal strength, docs/validation.md), and the split beats both of its parts over all
-    shots and at every threshold from 60 to 120 MPa."""
+def test_committed_cross_validation_is_consistent():
+    """results/validation/compilation_dev/ (``--cross-validate``): recomputed here from the
+    committed depths of every option and the shot file's references and columns, each fold's
+    choice (fewest missing depths, then the smallest mean |ln ratio| on the other shots, the
+    first on a tie), its statistics, each shot's cross-validated depth and the regime table; a
+    model with nothing chosen keeps its plain depths; and the option the registry gives the
+    concrete model is the one it chooses on all the development shots."""
     import csv
     from pathlib import Path
 
+    from cavex.analytic.models import get
+    from cavex.verification.validation.regimes import REGIMES
+
     result = json.loads(Path("results/validation/compilation_dev/validation.json").read_text())
     with open("examples/shots_compilation_dev.csv", newline="") as handle:
-        source = {r["id"]: r["source"] for r in csv.DictReader(
+        columns = {r["id"]: r for r in csv.DictReader(
             line for line in handle if not line.startswith("#"))}
     rows = result["shots"]
-    logs = {m: np.array([abs(math.log(r["predicted_m"][m] / r["measured_m"])) for r in rows])
-            for m in ("li-chen-2003", "concrete", "li-chen-concrete")}
-    fc = np.array([r["fc_Pa"] for r in rows])
-    refs = np.array([source[r["id"]] for r in rows])
-    high = fc > 100e6
-    for ref in sorted(set(refs)):
-        rest = refs != ref
-        assert logs["li-chen-2003"][rest & ~high].mean() < logs["concrete"][rest & ~high].mean()
-        assert logs["concrete"][rest & high].mean() < logs["li-chen-2003"][rest & high].mean()
-    split = np.where(high, logs["concrete"], logs["li-chen-2003"])
-    assert np.allclose(split, logs["li-chen-concrete"], rtol=1e-5, atol=1e-6)
-    assert split.mean() == pytest.approx(0.433, abs=5e-4)
-    for threshold in (60e6, 80e6, 100e6, 120e6):
-        other = np.where(fc > threshold, logs["concrete"], logs["li-chen-2003"]).mean()
-        assert other < min(logs["concrete"].mean(), logs["li-chen-2003"].mean()) - 0.03
-        assert other <= 0.445
+    cv = result["cross_validation"]
+    measured = np.array([r["measured_m"] for r in rows])
+    info = [columns[r["id"]] for r in rows]
+    members = {f"reference {ref}": [i for i, c in enumerate(info) if c["source"] == ref]
+               for ref in sorted({c["source"] for c in info})}
+    members["calibre <= 13 mm"] = [i for i, c in enumerate(info)
+                                   if float(c["diameter_m"]) <= 0.013]
+    members["projectile yield < 1 GPa"] = [i for i, c in enumerate(info)
+                                           if float(c["proj_yield_MPa"] or "inf") < 1000.0]
+    members["V0 > 1000 m/s"] = [i for i, c in enumerate(info) if float(c["V0_m_s"]) > 1000.0]
+    folds = {fold["name"]: fold for fold in cv["folds"]}
+    assert list(folds) == list(members) and len(members) == 21 + 3
+    stored = {c: dict(zip(v["options"], v["depths_m"], strict=True))
+              for c, v in cv["option_depths_m"].items()}
+
+    def score(depths, where):
+        logs = [abs(math.log(depths[i] / measured[i])) for i in where if depths[i] is not None]
+        return len(where) - len(logs), np.mean(logs)
+
+    for column in result["models"]:
+        options = stored.get(column, {None: [r["predicted_m"][column] for r in rows]})
+        for name, held in members.items():
+            rest = sorted(set(range(len(rows))) - set(held))
+            ranked = sorted((score(d, rest), k, o) for k, (o, d) in enumerate(options.items()))
+            chosen = ranked[0][2]
+            stats = folds[name]["models"][column]
+            assert stats["choice"] == chosen
+            logs = np.log([options[chosen][i] / measured[i] for i in held
+                           if options[chosen][i] is not None])
+            assert stats["n"] == len(logs)
+            assert stats["mean_abs_log_ratio"] == pytest.approx(np.abs(logs).mean(),
+                                                                rel=DIGITS_6)
+            assert stats["mean_log_ratio"] == pytest.approx(logs.mean(), rel=DIGITS_6)
+            if name.startswith("reference "):
+                for i in held:
+                    assert rows[i]["cross_validated_m"][column] == options[chosen][i]
+        if column not in stored:
+            assert cv["chosen_on_shots"][column] is None
+            assert all(r["cross_validated_m"][column] == r["predicted_m"][column] for r in rows)
+    for name, models in cv["regimes"].items():
+        chosen = [r for r in rows if REGIMES[name](r["fc_Pa"], r["V0_m_s"], r["flag"])]
+        for model, stats in models.items():
+            logs = np.log([r["cross_validated_m"][model] / r["measured_m"] for r in chosen
+                           if r["cross_validated_m"][model] is not None])
+            assert stats["n"] == len(logs)
+            assert stats["mean_abs_log_ratio"] == pytest.approx(np.abs(logs).mean(),
+                                                                rel=DIGITS_6)
+    concrete = get("concrete")
+    assert cv["choice_on_all_shots"]["concrete"] == concrete.option
+    assert [r["predicted_m"]["concrete"] for r in rows] == stored["concrete"][concrete.option]

@@ -96,6 +96,19 @@ class Model:
         model has it).
     regime_figure : bool
         Drawn in ``validate``'s regime figures (beside the recommended model).
+    options : tuple of str
+        The published options the model chooses among on measured shots (``shot_depth(shot,
+        option=...)``); empty: nothing is chosen on shots. ``cavex validate --cross-validate``
+        makes the choice again without each fold (:mod:`cavex.verification.validation.
+        cross_validation`).
+    option : str or None
+        The option the model runs with: the one chosen on the development shots (one of
+        ``options``; None where it has none).
+    option_words : str
+        How the option was chosen, in words, for the reports.
+    tabulates_concrete : bool
+        Predicts with the concrete cavity model's tables (one per concrete; ``validate`` runs
+        it once per option and shares it with the models that have it as a part).
     """
 
     name = None
@@ -120,6 +133,10 @@ class Model:
     empirical_reference = regime_figure = False
     #: its shots can be flown with nose erosion (``shot_depth(..., erosion=law)``)
     erodes = False
+    options = ()
+    option = None
+    option_words = ""
+    tabulates_concrete = False
 
     # --- labels and options -----------------------------------------------------------------
 
@@ -251,3 +268,9 @@ def parse_label(label, parameter="model", offered=None):
             boundary = label[len(model.name) + 1:] if model.boundaries else None
             return model, boundary
     raise AssertionError(label)  # every offered label is some model's
+
+
+def require_option(model, option):
+    """``option`` is one of ``model``'s published :attr:`Model.options` (one line naming them
+    otherwise)."""
+    require_choice(option, model.options, f"option of the {model.name} model")

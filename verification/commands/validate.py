@@ -32,6 +32,7 @@ from cavex.verification.output.files import write_text_atomic
 from cavex.verification.output.json_document import json_text
 from cavex.verification.output.paths import check_output_dir, write_staged
 from cavex.verification.report.validation_markdown import (
+    cross_validation_lines,
     number_or_na,
     ranking,
     report_markdown,
@@ -65,6 +66,12 @@ def add_arguments(parser):
                         help="run only these models: " + ", ".join(labels(predicts_shots=True))
                         + " (default: all; calibrations add their columns)")
     add_erosion_option(parser)
+    parser.add_argument("--cross-validate", nargs="*", metavar="FOLD",
+                        help="also predict each fold with the choices its models make on the "
+                        "other shots (options, splits, calibrations): FOLD of reference (each "
+                        "reference, column source, left out), calibre (<= 13 mm), yield "
+                        "(projectile yield < 1 GPa), velocity (V0 > 1000 m/s); none given: all "
+                        "(docs/validation.md \"Cross-validation\")")
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.add_argument("--out", help="output folder (default results/validation)")
     add_figures_option(parser, "validation.json, predictions.csv and report.md")
@@ -81,6 +88,11 @@ def run(args, target, projectile):
     workers, scheduler = args.workers, scheduler_of(args)
     models = check_models(args.models)
     shot_file = read_shots(shots_path)
+    folds = None
+    if args.cross_validate is not None:
+        from cavex.verification.validation.cross_validation import check_folds
+
+        folds = check_folds(args.cross_validate, shot_file.shots)
     calibrations = [read_calibration(p) for p in calibration_paths or ()]
     columns = [c.column for c in calibrations]
     repeated = sorted({c for c in columns if columns.count(c) > 1})
@@ -95,14 +107,15 @@ def run(args, target, projectile):
     # again; the tables go into --out/tables/ with the other files, in the staged write
     tables = TableCache(workers=workers, scheduler=scheduler,
                         progress=show_progress(args.progress))
-    size = estimate(shot_file.shots, calibrations, tables, workers, models)
+    size = estimate(shot_file.shots, calibrations, tables, workers, models, folds)
     print(f"cavex: validate {size}", file=sys.stderr, flush=True)
     began = time.monotonic()
     result = job(shot_file, calibrations, workers=workers, scheduler=scheduler,
-                 progress=args.progress, models=models, tables=tables, erosion=args.erosion)
+                 progress=args.progress, models=models, tables=tables, erosion=args.erosion,
+                 cross_validate=folds)
     seconds = time.monotonic() - began
     result["command"] = command_line(shots_path, calibration_paths, out, args.models,
-                                     args.erosion)
+                                     args.erosion, args.cross_validate)
     written = write_staged(out, lambda stage: write_outputs(result, stage, draw=args.figures))
     result["seconds"], result["outputs"] = seconds, written
     return result
@@ -128,22 +141,26 @@ def columns_of(calibrations, models=None):
     return columns
 
 
-def estimate(shots, calibrations, tables, workers, models=None):
+def estimate(shots, calibrations, tables, workers, models=None, cross_validate=None):
     """The run's size and time (:func:`cavex.verification.validation.predict.run_estimate`);
-    ``tables``: a :class:`TableCache` (None: a new one)."""
+    ``tables``: a :class:`TableCache` (None: a new one); ``cross_validate``: the fold
+    families (every option of the concrete model is then run)."""
     from cavex.verification.validation.predict import run_estimate
 
     workers = workers or os.cpu_count() or 1
     return run_estimate(shots, columns_of(calibrations, models),
-                        TableCache() if tables is None else tables, workers)
+                        TableCache() if tables is None else tables, workers,
+                        every_option=cross_validate is not None)
 
 
 def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=None,
-        progress=None, models=None, tables=None, erosion="none"):
+        progress=None, models=None, tables=None, erosion="none", cross_validate=None):
     """:func:`cavex.verification.validation.predict.validate` plus the compressibility column and
     the shots file's description; ``tables``: the :class:`TableCache` to use (default a new
     one copying its tables into ``tables_dir``); ``erosion``: a name of
-    :data:`cavex.analytic.penetration.erosion.CHOICES` ("none": rigid)."""
+    :data:`cavex.analytic.penetration.erosion.CHOICES` ("none": rigid); ``cross_validate``:
+    the fold families, checked (:func:`cavex.verification.validation.cross_validation.
+    check_folds`; None: no cross-validation)."""
     from cavex.analytic.penetration.erosion import law_named
     from cavex.verification.fedata.runner import show_progress
 
@@ -152,7 +169,8 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
         tables = TableCache(tables_dir, workers=workers, scheduler=scheduler,
                             progress=show_progress(progress))
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
-                      progress=progress, models=models, erosion=law)
+                      progress=progress, models=models, erosion=law,
+                      cross_validate=cross_validate)
     if any(c.model == FE_PARTNER for c in calibrations):
         columns = {COMPRESSIBILITY_COLUMN: columns_of(calibrations)[COMPRESSIBILITY_COLUMN]}
         depths, failures = predictions(shot_file.shots, columns, tables, progress, law)
@@ -259,6 +277,8 @@ def text(result):
     sentence = verdict(result.get("held_out_summary", {}), result["calibrations"])
     if sentence:
         lines += [f"held-out: {sentence}", ""]
+    if result.get("cross_validation"):
+        lines += cross_validation_lines(result["cross_validation"]) + [""]
     if result["failures"]:
         count = sum(len(v) for v in result["failures"].values())
         lines += [f"{count} prediction(s) failed (see report.md)", ""]
@@ -266,13 +286,16 @@ def text(result):
     return "\n".join(lines)
 
 
-def command_line(shots_path, calibration_paths, out_dir, models=None, erosion="none"):
+def command_line(shots_path, calibration_paths, out_dir, models=None, erosion="none",
+                 cross_validate=None):
     """The ``cavex validate`` command that makes these outputs (the report's provenance)."""
     words = ["cavex", "validate", "--shots", str(shots_path)]
     if models:
         words += ["--models", *models]
     if erosion != "none":
         words += ["--erosion", erosion]
+    if cross_validate is not None:
+        words += ["--cross-validate", *cross_validate]
     if calibration_paths:
         words += ["--calibration", *map(str, calibration_paths)]
     return " ".join(shlex.quote(w) for w in [*words, "--out", str(out_dir)])

@@ -10,6 +10,7 @@ draws the same panels; :func:`write_figures` lays them out and writes the PNGs.
 """
 
 import math
+import textwrap
 
 import numpy as np
 
@@ -68,7 +69,8 @@ def write_figures(result, out):
         fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
         fig.tight_layout(rect=(0, 0.1 if rows == 1 else 0.06, 1, 0.97))
         written.append(save_figure(fig, out / name, dpi=110))
-    return written + write_regime_figures(result, out, plt)
+    return (written + write_regime_figures(result, out, plt)
+            + write_cross_validation_figure(result, out, plt))
 
 
 def panels(result):
@@ -281,3 +283,80 @@ def _frame(ax, measured, predicted):
         ax.axhspan(1 - BAND, 1 + BAND, color="grey", alpha=0.2, label="+-20 %")
         ax.set(xlabel="striking velocity (m/s)", ylabel="predicted / measured depth")
     ax.grid(alpha=0.3, which="both")
+
+
+CROSS_VALIDATION_FIGURE = "cross_validation.png"
+
+
+def write_cross_validation_figure(result, out, plt):
+    """``cross_validation.png`` (with ``--cross-validate``): mean ``|ln ratio|`` (top) and bias
+    (bottom) of every model, by regime over the reference folds (left, :func:`draw_cv_regimes`;
+    the plain score a black tick) and per fold left out (right, :func:`draw_cv_folds`).
+    Returns the paths written (none without a cross-validation)."""
+    cv = result.get("cross_validation")
+    if not cv:
+        return []
+    left = "regimes" in cv
+    fig, axes = plt.subplots(2, 2 if left else 1, figsize=(15.0 if left else 10.0, 8.5),
+                             squeeze=False,
+                             gridspec_kw={"width_ratios": [1, 1.6]} if left else None)
+    for row, key in enumerate(("mean_abs_log_ratio", "mean_log_ratio")):
+        if left:
+            draw_cv_regimes(axes[row, 0], result, key)
+        draw_cv_folds(axes[row, -1], result, key)
+    for ax in axes[0]:
+        ax.tick_params(labelbottom=False)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=min(5, len(labels)), fontsize=8,
+               frameon=False)
+    fig.suptitle("Cross-validated: each fold predicted by the choices made without it",
+                 fontsize=11)
+    fig.tight_layout(rect=(0, 0.07, 1, 0.96))
+    return [save_figure(fig, out / CROSS_VALIDATION_FIGURE, dpi=110)]
+
+
+_CV_LABELS = {"mean_abs_log_ratio": "mean |ln(predicted/measured)|",
+              "mean_log_ratio": "bias, mean ln(predicted/measured)"}
+
+
+def draw_cv_regimes(ax, result, key):
+    """Grouped bars: each model's cross-validated ``key`` (``mean_abs_log_ratio`` or
+    ``mean_log_ratio``) by regime over the reference folds, the plain one a black tick."""
+    cv, columns = result["cross_validation"], result["models"]
+    regimes = list(cv["regimes"])
+    width = 0.8 / len(columns)
+    for k, column in enumerate(columns):
+        _, _, colour = model_style(column)
+        x = np.arange(len(regimes)) + (k - (len(columns) - 1) / 2) * width
+        values = [cv["regimes"][r][column][key] for r in regimes]
+        plain = [result["regimes"].get(r, {}).get(column, {}).get(key) for r in regimes]
+        ax.bar(x, [np.nan if v is None else v for v in values], width, color=colour,
+               label=column)
+        ax.plot(x, [np.nan if v is None else v for v in plain], "k_", markersize=6)
+    ax.axhline(0.0, color="k", linewidth=0.8)
+    ax.set_xticks(np.arange(len(regimes)))
+    ax.set_xticklabels([textwrap.fill(REGIME_TITLES[r], 14) for r in regimes], fontsize=8)
+    ax.set_ylabel(_CV_LABELS[key])
+    ax.set_title("each reference left out, by regime (tick: plain)", fontsize=9)
+    ax.grid(alpha=0.3, axis="y")
+
+
+def draw_cv_folds(ax, result, key):
+    """Each model's ``key`` over each fold's shots left out (the kinds first, then the
+    references), a point per model and fold."""
+    cv, columns = result["cross_validation"], result["models"]
+    folds = sorted(cv["folds"], key=lambda f: f["family"] == "reference")  # stable
+    x = np.arange(len(folds))
+    for k, column in enumerate(columns):
+        _, marker, colour = model_style(column)
+        values = [f["models"][column][key] for f in folds]
+        ax.plot(x + (k - (len(columns) - 1) / 2) * 0.08,
+                [np.nan if v is None else v for v in values], marker=marker, color=colour,
+                linestyle="none", markersize=5, label=column)
+    ax.axhline(0.0, color="k", linewidth=0.8)
+    ax.set_xticks(x)
+    ax.set_xticklabels([f"{f['name'].removeprefix('reference ')} ({f['n']})"
+                        for f in folds], rotation=70, ha="right", fontsize=7)
+    ax.set_ylabel(_CV_LABELS[key])
+    ax.set_title("each fold left out (n shots)", fontsize=9)
+    ax.grid(alpha=0.3)

@@ -140,6 +140,7 @@ def report_markdown(result, figures=True):
     lines += ["Ratio = predicted / measured depth; std is the sample standard deviation; "
               "mean abs ln ratio is the mean of |ln(predicted/measured)|.", ""]
     lines += _regime_section(result)
+    lines += cross_validation_section(result)
     lines += _outlier_section(result)
     lines += ["## Compressibility: the FE table against the incompressible closed forms", ""]
     for column, what in ((FE_MODEL, "uncalibrated mapping"),
@@ -168,7 +169,9 @@ def report_markdown(result, figures=True):
               "predicted against measured by regime (open: flagged non-rigid)](by_regime.png)",
               "",
               "![ln(predicted/measured) against striking velocity and f_c](residuals.png)",
-              ""] if figures \
+              "", *(["![cross-validated mean |ln ratio| and bias by regime and per fold left "
+                     "out](cross_validation.png)", ""] if result.get("cross_validation")
+                    else [])] if figures \
         else ["", "(figures not drawn: `--no-figures`)", ""]
     if result["failures"]:
         lines += ["## Failures", ""]
@@ -235,3 +238,103 @@ def _outlier_section(result):
                      f"{max(ratios):.3g} |")
     lines += ["", "Without them:", ""] + _summary_table(result["summary_without_outliers"])
     return lines + [""]
+
+
+def _cell(stats, plain=None):
+    """``mean |ln| / bias`` of ``stats`` (``n/a`` without shots), with ``(plain ...)``."""
+    if stats is None or stats["mean_abs_log_ratio"] is None:
+        return "n/a"
+    text = f"{stats['mean_abs_log_ratio']:.3f} / {stats['mean_log_ratio']:+.3f}"
+    if plain is not None and plain.get("mean_abs_log_ratio") is not None:
+        text += f" ({plain['mean_abs_log_ratio']:.3f})"
+    return text
+
+
+def cross_validation_section(result):
+    """The report's "Cross-validation" section (docs/validation.md): what each model chooses
+    on shots, the reference folds by regime beside the plain scores, the kinds of shot left
+    out by regime, each reference left out and each fold's choices."""
+    cv = result.get("cross_validation")
+    if not cv:
+        return []
+    columns = result["models"]
+    chosen = cv["chosen_on_shots"]
+    lines = ["## Cross-validation", "",
+             "Each choice a model makes on shots is made again without each fold (on the other "
+             "shots given) and the fold is predicted with it (`--cross-validate "
+             + " ".join(cv["families"]) + "`; docs/validation.md \"Cross-validation\"). "
+             "Mean |ln(predicted/measured)| / bias over the shots left out.", ""]
+    for column in columns:
+        what = chosen[column]
+        lines.append(f"- `{column}`: " + (f"chooses {what}" + (
+            f"; on all these shots: '{cv['choice_on_all_shots'][column]}'"
+            if column in cv["choice_on_all_shots"] else "") if what else
+            "nothing chosen on shots: predicted as it is, its cross-validated score equals "
+            "its plain score"))
+    lines.append("")
+    plain = result["regimes"]
+    if "regimes" in cv:
+        names = list(cv["regimes"])
+        first = columns[0]
+        lines += ["### Leaving out one reference at a time, by regime", "",
+                  "Every shot predicted by the choices made without its reference; in "
+                  "brackets the plain mean |ln ratio| (each model as it runs, its choices "
+                  "those of the registry).", "",
+                  "| model | " + " | ".join(f"{REGIME_TITLES[n]} ({cv['regimes'][n][first]['n']})"
+                                            for n in names) + " |",
+                  "|---|" + "---:|" * len(names)]
+        for m in columns:
+            lines.append(f"| {m} | " + " | ".join(
+                _cell(cv["regimes"][n][m], plain.get(n, {}).get(m)) for n in names) + " |")
+        lines.append("")
+    kinds = {f["name"]: f for f in cv["folds"] if f["family"] != "reference"}
+    if kinds:
+        lines += ["### Leaving out one kind of shot, by regime", "",
+                  "| kind left out | regime (n) | " + " | ".join(columns) + " |",
+                  "|---|---|" + "---:|" * len(columns)]
+        for name, fold in kinds.items():
+            for regime, stats in fold["regimes"].items():
+                n = stats[columns[0]]["n"] if stats else 0
+                lines.append(f"| {table_cell(name)} | {REGIME_TITLES[regime]} ({n}) | "
+                             + " | ".join(_cell(stats[m]) for m in columns) + " |")
+        lines.append("")
+    refs = {f["name"]: f for f in cv["folds"] if f["family"] == "reference"}
+    if refs:
+        lines += ["### Each reference left out", "",
+                  "| reference left out | n | " + " | ".join(columns) + " |",
+                  "|---|---:|" + "---:|" * len(columns)]
+        for name, fold in refs.items():
+            lines.append(f"| {table_cell(name.removeprefix('reference '))} | {fold['n']} | "
+                         + " | ".join(_cell(fold["models"][m]) for m in columns) + " |")
+        lines.append("")
+    choosing = [c for c in columns if chosen[c]]
+    if choosing:
+        lines += ["### The choice made without each fold", "",
+                  "| fold left out | " + " | ".join(choosing) + " |",
+                  "|---|" + "---|" * len(choosing)]
+        for fold in cv["folds"]:
+            lines.append(f"| {table_cell(fold['name'])} | " + " | ".join(
+                table_cell(fold["models"][c]["choice"]) for c in choosing) + " |")
+        lines.append("")
+    return lines
+
+
+def cross_validation_lines(cv):
+    """The command's text: the cross-validated mean |ln ratio| / bias per model, over the
+    reference folds by regime and over each kind of shot left out."""
+    lines = ["cross-validated (" + " ".join(cv["families"]) + "), mean |ln r| / bias:"]
+    if "regimes" in cv:
+        names = list(cv["regimes"])
+        lines.append("leaving out each reference: " + ", ".join(REGIME_TITLES[n]
+                                                                 for n in names))
+        for m, _ in cv["regimes"][names[0]].items():
+            lines.append(f"  {m:<38} " + "  ".join(f"{_cell(cv['regimes'][n][m]):>16}"
+                                                   for n in names))
+    for fold in cv["folds"]:
+        if fold["family"] == "reference":
+            continue
+        lines.append(f"leaving out {fold['name']} ({fold['n']} shots):")
+        for m, stats in fold["models"].items():
+            lines.append(f"  {m:<38} {_cell(stats):>16}"
+                         + (f"  chose {stats['choice']}" if stats["choice"] else ""))
+    return lines

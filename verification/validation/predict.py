@@ -55,9 +55,11 @@ FE_MODEL = names(takes_table=True)[0]  # the model that needs FE tables
 #: column runs the FE with that label's calibrated mapping
 FE_PARTNER = get(FE_MODEL).compressible_partner
 EMPIRICAL = the(empirical_reference=True).name  # the report compares the calibrated with it
-#: The model ``cavex validate`` recommends (the registry's ``recommended`` model: Li and Chen
-#: (2003) at normal strength, the concrete model above; docs/validation.md)
+#: The model ``cavex validate`` recommends (the registry's ``recommended`` model: the concrete
+#: cavity model; docs/validation.md)
 RECOMMENDED_MODEL = names(recommended=True)[0]
+#: the model of the concrete cavity tables (run once per option, shared with its parts' users)
+CONCRETE_MODEL = names(tabulates_concrete=True)[0]
 DEPTH_DIGITS = FE_DIGITS  # predicted depths and statistics in the result files
 TABLE_VELOCITY_STEP = 50.0  # m/s between FE table velocities (interpolated by PCHIP in V^2)
 TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on depth
@@ -292,10 +294,12 @@ class TableCache:
 
 # --- many shots -------------------------------------------------------------------------------
 
-def run_estimate(shots, models, tables, workers):
+def run_estimate(shots, models, tables, workers, every_option=False):
     """One line: the size of a run of ``models`` (column -> ``(model, mapping)``) over
     ``shots`` and its time, from :data:`TABLE_CASES_PER_SECOND_PER_WORKER` and
-    each model's ``prediction_seconds`` and ``concrete_table_seconds`` (the registry's)."""
+    each model's ``prediction_seconds`` and ``concrete_table_seconds`` (the registry's); with
+    ``every_option`` (a cross-validation) the concrete tables of every option of the concrete
+    model."""
     tables.velocities_for(shots)
     table_mappings = [mapping or Mapping() for model, mapping in models.values()
                       if model_of(model).takes_table]
@@ -305,6 +309,8 @@ def run_estimate(shots, models, tables, workers):
     per_shot = sum(model.prediction_seconds for model in chosen)
     table_seconds = max((model.concrete_table_seconds for model in chosen), default=0.0)
     concretes = len({(s.fc, s.rho) for s in shots}) if table_seconds else 0
+    if every_option:
+        concretes *= len(get(CONCRETE_MODEL).options)
     seconds = (cases / (TABLE_CASES_PER_SECOND_PER_WORKER * max(1, workers))
                + len(shots) * per_shot + concretes * table_seconds / max(1, workers))
     when = ("under a minute" if seconds < 60.0 else f"about {seconds / 60.0:.0f} min"
@@ -381,7 +387,7 @@ def validation_columns(calibrations=(), mapping=None, models=None):
 
 
 def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None, models=None,
-             erosion=None):
+             erosion=None, cross_validate=None):
     """Per-shot predictions of every model and their statistics.
 
     Parameters
@@ -398,6 +404,11 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         Nose erosion in every model that flies the integrator
         (:mod:`cavex.analytic.penetration.erosion`); None: rigid. Set, the result says so
         (``erosion``: the law's name).
+    cross_validate : sequence of str, optional
+        The fold families of :data:`cavex.verification.validation.cross_validation.FOLDS`
+        (checked with the shots by its ``check_folds``); set, the result has
+        ``cross_validation`` and each shot ``cross_validated_m``
+        (:func:`cavex.verification.validation.cross_validation.cross_validation`).
 
     Returns
     -------
@@ -419,18 +430,22 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         shots, {k: v for k, v in columns.items() if k not in concrete}, tables, progress,
         erosion)
     flags = [None] * len(shots)
-    if concrete:  # the concrete model's depths and flags, once for both models that use them
-        concrete_depths, flags, concrete_failures = concrete_predictions(
-            shots, tables.workers, progress, erosion)
+    option_depths = {}  # column -> {option: depths}, the columns with options, when asked
+    if concrete:  # the concrete model's depths and flags, once for the models that use them
+        runs = concrete_runs(shots, tables.workers, progress, erosion,
+                             every_option=cross_validate is not None)
+        concrete_depths, flags, concrete_failures = runs[get(CONCRETE_MODEL).option]
         for name in concrete:
+            chosen = model_of(columns[name][0])
             depths[name], failed = concrete_depths, concrete_failures
-            if model_of(columns[name][0]).parts:
-                depths[name] = [_split_depth(shot, depth)
-                                for shot, depth in zip(shots, concrete_depths, strict=True)]
+            if chosen.parts:
+                depths[name] = split_depths(chosen, shots, concrete_depths)
                 failed = {i: reason for i, reason in concrete_failures.items()
                           if depths[name][ids.index(i)] is None}
             if failed:
                 failures[name] = failed
+            if cross_validate is not None:
+                option_depths[name] = every_option_depths(chosen, shots, runs)
     depths = {name: depths[name] for name in columns}
     rows = []
     for i, shot in enumerate(shots):
@@ -448,25 +463,88 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         result["held_out"] = [row["id"] for row in rows if row["id"] not in fitted]
     if erosion is not None:
         result["erosion"] = erosion.name
-    return add_statistics(result)
+    add_statistics(result)
+    if cross_validate is not None:
+        from cavex.verification.validation.cross_validation import cross_validation
+
+        for name in columns:  # a column with nothing chosen on shots: its one "option"
+            option_depths.setdefault(name, {None: depths[name]})
+        refits = {c.column: c for c in calibrations}
+        cross_validation(result, shots, option_depths, refits, cross_validate,
+                         refit=lambda c, train, held: refitted_depths(c, train, held, tables,
+                                                                      erosion, shots))
+    return result
 
 
-def _split_depth(shot, concrete_depth):
-    """The recommended model's depth from the concrete model's (None where that failed and
-    the shot needs it), rounded like every depth."""
-    part = get(RECOMMENDED_MODEL).part(shot)
-    if not part.concrete_table_seconds:
-        return round_significant(part.shot_depth(shot), DEPTH_DIGITS)
-    return None if concrete_depth is None else round_significant(concrete_depth, DEPTH_DIGITS)
+def refitted_depths(calibration, train, held, tables=None, erosion=None, shots=None):
+    """``(choice, depths)``: ``calibration``'s model fitted again, its free parameters from its
+    file, to the shots ``train`` (:func:`cavex.verification.validation.calibration.fit`) and
+    its depths of the shots ``held`` (None where it fails); ``choice`` says what was fitted.
+    The fit sets the FE tables' velocity grid to its shots': it is set back to cover
+    ``shots`` (default ``train`` and ``held``) for the predictions."""
+    from cavex.verification.validation.calibration import fit
+
+    model, boundary = parse_label(calibration.model, "models", labels(fits_mapping=True))
+    tables = tables or TableCache()
+    try:
+        refit = fit(train, model.name, calibration.params, tables=tables, boundary=boundary)
+    except CavexNumericalError as exc:
+        return f"refit failed: {str(exc).splitlines()[0]}", [None] * len(held)
+    finally:
+        tables.velocities_for(list(shots) if shots is not None else [*train, *held])
+    depths = []
+    for shot in held:
+        try:
+            depths.append(round_significant(predict(shot, calibration.model, refit.mapping,
+                                                    tables, erosion), DEPTH_DIGITS))
+        except (CavexInputError, CavexNumericalError):
+            depths.append(None)
+    values = ", ".join(f"{p} = {getattr(refit.mapping, p):.6g}" for p in calibration.params)
+    return f"refitted on {len(refit.shots)} shots: {values}", depths
 
 
-def concrete_predictions(shots, workers=None, progress=None, erosion=None):
+def split_depths(model, shots, concrete_depths, option=None):
+    """Depths of ``model`` (one with ``parts``, the concrete model one of them) under
+    ``option`` (default its own) from the concrete model's ``concrete_depths`` (None where
+    that failed and the shot needs it), rounded like every depth."""
+    out = []
+    for shot, depth in zip(shots, concrete_depths, strict=True):
+        part = model.part(shot, option)
+        if not part.tabulates_concrete:
+            out.append(round_significant(part.shot_depth(shot), DEPTH_DIGITS))
+        else:
+            out.append(None if depth is None else round_significant(depth, DEPTH_DIGITS))
+    return out
+
+
+def concrete_runs(shots, workers=None, progress=None, erosion=None, every_option=False):
+    """``{option: (depths, flags, failures)}`` of :func:`concrete_predictions` under the
+    concrete model's option, and (``every_option``) under each of its options."""
+    concrete = get(CONCRETE_MODEL)
+    chosen = concrete.options if every_option else (concrete.option,)
+    return {option: concrete_predictions(shots, workers, progress, erosion, option)
+            for option in chosen}
+
+
+def every_option_depths(model, shots, runs):
+    """``{option: depths}`` of ``model`` (the concrete model or one with it as a part) under
+    every option, from the concrete model's ``runs`` (:func:`concrete_runs`); a model with
+    parts takes every pair of its own option and the concrete model's (``"<own>;
+    concrete: <option>"``)."""
+    if not model.parts:
+        return {option: runs[option][0] for option in model.options}
+    return {f"{own}; {CONCRETE_MODEL}: {inner}": split_depths(model, shots, runs[inner][0], own)
+            for own in model.options for inner in runs}
+
+
+def concrete_predictions(shots, workers=None, progress=None, erosion=None, option=None):
     """The concrete model's ``(depths, flags, failures)`` for ``shots``: per shot the depth
     (rounded like every depth, None if it failed), the rigid-regime flag
     (:func:`~cavex.verification.validation.regimes.rigid_flag`, None if it failed) and
     ``{shot id: reason}``. The shots of one concrete (``f_c``, ``rho``) go to one task, so its
     cavity table is built once; tasks run on ``workers`` local processes (default: the CPUs).
-    ``erosion``: :func:`~cavex.analytic.penetration.concrete_table.table_depth`'s.
+    ``erosion``: :func:`~cavex.analytic.penetration.concrete_table.table_depth`'s; ``option``:
+    one of the concrete model's published options (default its own).
     """
     from cavex.analytic.penetration import concrete_table  # noqa: F401 (before the fork)
     from cavex.verification.fedata.runner import Progress, process_pool, show_progress
@@ -474,7 +552,7 @@ def concrete_predictions(shots, workers=None, progress=None, erosion=None):
     groups = {}
     for i, shot in enumerate(shots):
         groups.setdefault((shot.fc, shot.rho), []).append(i)
-    tasks = [([shots[i] for i in group], erosion) for group in groups.values()]
+    tasks = [([shots[i] for i in group], erosion, option) for group in groups.values()]
     workers = min(workers or os.cpu_count() or 1, len(tasks))
     bar = Progress(len(shots), 0, show_progress(progress), unit="prediction")
     results = []
@@ -498,19 +576,22 @@ def concrete_predictions(shots, workers=None, progress=None, erosion=None):
 
 
 def _concrete_task(task):
-    """:func:`concrete_group` of one task ``(shots, erosion)`` (a pool maps one argument)."""
+    """:func:`concrete_group` of one task ``(shots, erosion, option)`` (a pool maps one
+    argument)."""
     return concrete_group(*task)
 
 
-def concrete_group(shots, erosion=None):
-    """``[(depth, flag, reason)]`` of the concrete model for ``shots`` (one concrete);
-    ``erosion``: :func:`~cavex.analytic.penetration.concrete_table.table_depth`'s."""
+def concrete_group(shots, erosion=None, option=None):
+    """``[(depth, flag, reason)]`` of the concrete model for ``shots`` (one concrete) under
+    ``option`` (default the model's own); ``erosion``:
+    :func:`~cavex.analytic.penetration.concrete_table.table_depth`'s."""
     from cavex.analytic.penetration.concrete_table import TableResistance, table_depth
 
+    model = get(CONCRETE_MODEL)
     out = []
     for shot in shots:
         try:
-            resistance = TableResistance(shot)
+            resistance = TableResistance(shot, model.constants(shot, option))
             depth = round_significant(table_depth(shot, resistance, erosion), DEPTH_DIGITS)
             out.append((depth, rigid_flag(shot, resistance), None))
         except (CavexInputError, CavexNumericalError) as exc:
