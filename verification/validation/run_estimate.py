@@ -23,10 +23,10 @@ time is then
 
     T = f [sum_m n t_m + n t_table + (n_c t_c + n t_f) / s_c + N_e n_e t_e / s_e]
 
-with ``f`` the wall time over the CPU time of one process now, the larger of the probe's and
-``L/c`` of the one-minute load average ``L`` on ``c`` CPUs (:meth:`Clock.slowdown`: a
-one-second probe alone can catch a quiet moment of a loaded machine, and did: 20 000 shots
-were estimated at 426 s and took 980 s),
+with ``f`` the wall time over the CPU time of one process now, the geometric mean of the
+probe's and ``L/c`` of the one-minute load average ``L`` on ``c`` CPUs (:meth:`Clock.slowdown`:
+a one-second probe alone can catch a quiet moment of a loaded machine, and the load average
+lags a falling load),
 with ``n`` shots, ``n_c`` distinct concretes, ``N_e`` tables to build of ``n_e`` cases each,
 and ``s`` the speed-up of ``w`` worker processes over the one process the probe ran in,
 on ``c`` CPUs carrying a load ``L`` besides this process (:func:`parallel_speedup`):
@@ -99,11 +99,14 @@ class Clock:
         return sum(times) / len(times)
 
     def slowdown(self, cpus=None, load=None):
-        """``f``: wall time over CPU time of one process now, the larger of the probe's and the
-        one-minute load average's (:func:`load_slowdown`): the probe lasts a second, the load
-        average a minute, and either may have caught a quiet moment."""
+        """``f``: wall time over CPU time of one process, the geometric mean of the probe's
+        and the one-minute load average's (:func:`load_slowdown`): the probe lasts a second
+        and may catch a quiet moment (20 000 shots estimated at 426 s took 980 s), the load
+        average lags a minute behind a load that falls (the larger of the two: 1120 s
+        estimated, 352 s taken); the mean is within the square root of their ratio of
+        either."""
         probe = self.wall / self.cpu if self.cpu > 0.0 else 1.0
-        return max(1.0, probe, load_slowdown(cpus, load))
+        return max(1.0, (max(1.0, probe) * load_slowdown(cpus, load)) ** 0.5)
 
 
 def load_slowdown(cpus=None, load=None):
