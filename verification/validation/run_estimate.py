@@ -27,7 +27,8 @@ with ``f`` the wall time over the CPU time of one process now, the geometric mea
 probe's and ``L/c`` of the one-minute load average ``L`` on ``c`` CPUs (:meth:`Clock.slowdown`:
 a one-second probe alone can catch a quiet moment of a loaded machine, and the load average
 lags a falling load),
-with ``n`` shots, ``n_c`` distinct concretes, ``N_e`` tables to build of ``n_e`` cases each,
+with ``n`` shots, ``n_c`` cavity tables (:func:`cavity_tables`), ``N_e`` tables to build of
+``n_e`` cases each,
 and ``s`` the speed-up of ``w`` worker processes over the one process the probe ran in,
 on ``c`` CPUs carrying a load ``L`` besides this process (:func:`parallel_speedup`):
 ``s = w min(1, c/(L + w)) / min(1, c/(L + 1))``, at most the number of tasks.
@@ -152,6 +153,15 @@ def concrete_seconds(clock, shots, erosion):
     return table, flight
 
 
+def cavity_tables(shots):
+    """``n_c``: the concrete model's cavity tables ``shots`` need, one per concrete and table
+    top (:func:`~cavex.analytic.penetration.concrete_table.table_top` of each shot's
+    ``rho V0^2/f_c``: shots into one concrete at different speeds need several)."""
+    from cavex.analytic.penetration.concrete_table import table_top
+
+    return len({(s.fc, s.rho, table_top(s.rho * s.V0 ** 2 / s.fc)) for s in shots})
+
+
 def cases_per_table(target, projectile, velocities):
     """``n_e``: the FE cases of one table (its grid and the first-layer row)."""
     from cavex.verification.fedata.table import grid_depths
@@ -209,7 +219,7 @@ def run_estimate(shots, models, tables, workers, erosion=None):
             closed_form = seconds
     concrete = [c for c, (model, _) in models.items() if model_of(model).concrete_table_seconds]
     if concrete:
-        concretes = len({(s.fc, s.rho) for s in shots})
+        concretes = cavity_tables(shots)
         table_s, flight_s = concrete_seconds(clock, shots, erosion)
         total = (concretes * table_s + n * flight_s) / parallel_speedup(workers, concretes)
         for column in concrete:
