@@ -129,6 +129,13 @@ def tensile_strength(fc):
     return 2.12 * math.log(1.0 + 0.1 * f) * 1e6
 
 
+#: the strengths (Pa) and densities (kg/m^3) a concrete may have: a shot file's ranges
+#: (:mod:`cavex.verification.validation.shots`); outside them the correlations are far from
+#: their data, and a strength in MPa or a density in g/cm^3 is caught
+FC_RANGE = (1e6, 1e9)
+RHO_RANGE = (1000.0, 4000.0)
+
+
 @dataclass(frozen=True)
 class Concrete:
     """One concrete, described once: mean strength ``fc`` (Pa), density ``rho`` (kg/m^3) and
@@ -148,11 +155,12 @@ class Concrete:
     constants: Constants = field(default_factory=Constants)
 
     def __post_init__(self):
-        for name in ("fc", "rho"):
+        for name, (low, high), hint in (("fc", FC_RANGE, " (is it in MPa?)"),
+                                        ("rho", RHO_RANGE, " (is it in g/cm^3?)")):
             value = getattr(self, name)
             require(isinstance(value, (int, float)) and not isinstance(value, bool)
-                    and math.isfinite(value) and value > 0.0, name, "a finite number > 0",
-                    value)
+                    and math.isfinite(value) and low <= value <= high, name,
+                    f"a number in [{low:g}, {high:g}]{hint}", value)
 
     @property
     def modulus(self):

@@ -44,7 +44,17 @@ def require(condition, parameter, accepted, value):
         The value that was given.
     """
     if not condition:
-        raise CavexInputError(f"must be {accepted} (got {value!r})", parameter)
+        raise CavexInputError(f"must be {accepted} (got {shown(value)})", parameter)
+
+
+#: the characters of a refused value a message shows (a huge array or string is cut)
+SHOWN_CHARACTERS = 120
+
+
+def shown(value):
+    """``repr(value)``, cut to :data:`SHOWN_CHARACTERS` with ``...`` (one short line)."""
+    text = repr(value)
+    return text if len(text) <= SHOWN_CHARACTERS else text[:SHOWN_CHARACTERS - 3] + "..."
 
 
 def require_choice(value, choices, parameter):
@@ -53,10 +63,17 @@ def require_choice(value, choices, parameter):
         require(False, parameter, " or ".join(map(repr, choices)), value)
 
 
+#: the bidirectional formatting characters (U+202A-U+202E, U+2066-U+2069): they reorder the
+#: text printed after them, so that an id could show as another ("Trojan source")
+BIDI_CONTROLS = frozenset(chr(c) for c in (*range(0x202A, 0x202F), *range(0x2066, 0x206A)))
+
+
 def has_control_characters(text):
-    """Whether ``text`` holds a control character (U+0000-U+001F, U+007F-U+009F, NUL too):
-    none belongs in an id or a name that is written into files and printed."""
-    return any(ord(ch) < 0x20 or 0x7F <= ord(ch) <= 0x9F for ch in text)
+    """Whether ``text`` holds a control character (U+0000-U+001F, U+007F-U+009F, NUL too) or
+    a bidirectional formatting one (:data:`BIDI_CONTROLS`): none belongs in an id or a name
+    that is written into files and printed."""
+    return any(ord(ch) < 0x20 or 0x7F <= ord(ch) <= 0x9F or ch in BIDI_CONTROLS
+               for ch in text)
 
 
 def require_name(text, parameter):

@@ -92,3 +92,6 @@ def read_toml(path):
         where = (f"line {match['line']}, column {match['column']}" if match["line"]
                  else "the end of the file")
         raise file_error(path, f"is not valid TOML ({match['what']})", where) from None
+    except (ValueError, RecursionError) as exc:  # tomllib's own: an integer of > 4300 digits
+        raise file_error(path, "is not a TOML file cavex reads ("  # or arrays nested too deep
+                         f"{str(exc).splitlines()[0][:80] or type(exc).__name__})") from None

@@ -65,9 +65,11 @@ def test_concrete_layer_flies_in_penetrate(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("concrete, extra, where, accepted", [
-    ("{ fc = -40e6, rho = 2300 }", "", "layers[0].concrete.fc", "a finite number > 0"),
-    ("{ fc = 40e6, rho = 0 }", "", "layers[0].concrete.rho", "a finite number > 0"),
-    ("{ fc = inf, rho = 2300 }", "", "layers[0].concrete.fc", "a finite number > 0"),
+    ("{ fc = -40e6, rho = 2300 }", "", "layers[0].concrete.fc", "a number in [1e+06, 1e+09]"),
+    ("{ fc = 40e6, rho = 0 }", "", "layers[0].concrete.rho", "a number in [1000, 4000]"),
+    ("{ fc = inf, rho = 2300 }", "", "layers[0].concrete.fc", "a number in [1e+06, 1e+09]"),
+    ("{ fc = 40, rho = 2300 }", "", "layers[0].concrete.fc", "(is it in MPa?)"),
+    ("{ fc = 40e6, rho = 2.3 }", "", "layers[0].concrete.rho", "(is it in g/cm^3?)"),
     ('{ fc = "40 MPa", rho = 2300 }', "", "layers[0].concrete.fc", "a number"),
     ("{ fc = 40e6 }", "", "layers[0].concrete.rho", "is missing"),
     ("{ fc = 40e6, rho = 2300, E = 30e9 }", "", "layers[0].concrete.E", "is not a known key"),

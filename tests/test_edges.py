@@ -86,7 +86,8 @@ def test_calibration_file_reads_back_for_any_id_and_path(tmp_path, capsys):
     # the size and time first (a derived-dynamic calibration: its column and the table's;
     # 8 uncalibrated models, the concrete model (recommended), Li and Chen and their split)
     assert re.match(r"cavex: validate 2 shots x 10 models = 20 predictions; FE tables: 2 to "
-                    r"build \(\d+ FE cases\), 0 on disk; under a minute on \d+ worker", err), err
+                    r"build \(\d+ FE cases\), 0 on disk; (under a minute|about [0-9.]+ (min|h)) "
+                    r"\[~[0-9.e+]+ s\] on \d+ worker", err), err
     code, _, err = run(capsys, "penetrate", "--config", out, "--out", tmp_path / "p")
     assert code == 0, err
 

@@ -45,6 +45,9 @@ from cavex.errors import require
 NOSE_POINTS = 16  # Gauss points in phi; convergence: docs/oblique.md "Convergence"
 AZIMUTHS = 16
 SHANK_RINGS = 16
+#: the most points a body takes in each direction (512 x 512 nose elements: ~0.1 GB of
+#: element arrays); beyond, a run would exhaust memory before it answered
+MAX_POINTS = 512
 
 
 @dataclass(frozen=True)
@@ -163,7 +166,8 @@ def build_body(projectile, nose_points=NOSE_POINTS, azimuths=AZIMUTHS, shank_rin
     ``azimuths`` in ``theta`` and ``shank_rings`` rings along the shank."""
     for name, value, low in (("nose_points", nose_points, 1), ("azimuths", azimuths, 4),
                              ("shank_rings", shank_rings, 1)):
-        require(isinstance(value, int) and value >= low, name, f"an integer >= {low}", value)
+        require(isinstance(value, int) and not isinstance(value, bool) and low <= value
+                <= MAX_POINTS, name, f"an integer in [{low}, {MAX_POINTS}]", value)
     r, R = projectile.r, projectile.R
     ln = projectile.ogive_length
     length = projectile.body_length

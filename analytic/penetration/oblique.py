@@ -50,6 +50,9 @@ MAX_TIME = 1.0  # s
 # the reference. Convergence: docs/oblique.md
 COMPILED = "ROS2"
 METHOD, RTOL, ATOL = COMPILED, 1e-3, 1e-6
+#: the integrators offered: the compiled one and scipy's (``solve_ivp``)
+METHODS = (COMPILED, "RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+MAX_RTOL = 0.1  # a looser tolerance answers nothing worth a trajectory
 CHUNK = 2000  # accepted steps per call of the compiled integrator (progress is reported after)
 # smallest step, relative to the time the striking speed takes to cover the body's length
 # (measured shots take steps >= 2e-8 of it, the first step): below it the step size has
@@ -175,7 +178,11 @@ class ObliqueModel:
         self.target, self.projectile, self.law = target, projectile, law
         self.body = body or build_body(projectile)
         self.bottom = bottom
-        self.rtol, self.atol, self.method = rtol, atol, method
+        require(is_finite_number(rtol) and 0.0 < rtol <= MAX_RTOL, "rtol",
+                f"in (0, {MAX_RTOL:g}]", rtol)
+        require(is_finite_number(atol) and atol > 0.0, "atol", "a finite number > 0", atol)
+        require(method in METHODS, "method", " or ".join(map(repr, METHODS)), method)
+        self.rtol, self.atol, self.method = float(rtol), float(atol), method
         contact_ramp = CONTACT_RAMP if contact_ramp is None else contact_ramp
         require(is_finite_number(contact_ramp) and 0.0 <= contact_ramp <= 100.0,
                 "contact_ramp", "in [0, 100] m/s", contact_ramp)

@@ -12,6 +12,7 @@ import time
 
 import numpy as np
 
+from cavex.errors import CavexInputError
 from cavex.verification.commands.shared_options import (
     add_config_option,
     add_figures_option,
@@ -69,7 +70,7 @@ def job(target, projectile, velocities=None, depths=None, out_path="results/tabl
         grid_depths,
         tabulate,
     )
-    from cavex.verification.output.paths import check_output_file
+    from cavex.verification.output.paths import check_output_file, output_refusals
 
     velocities = DEFAULT_VELOCITIES if velocities is None else velocities
     depths = DEFAULT_DEPTHS if depths is None else depths
@@ -81,8 +82,16 @@ def job(target, projectile, velocities=None, depths=None, out_path="results/tabl
     if sys.stderr.isatty():  # said before the run, as the progress bar (the text says it too)
         print(f"cavex table: {grid_line(grid)}", file=sys.stderr, flush=True)
     start = time.perf_counter()
-    table = tabulate(target, projectile, velocities, depths, nu=nu, numerics=numerics,
-                     scheduler=scheduler, workers=workers, progress=progress, store=store)
+    resumed = store.exists()  # a killed run's store: kept; this run's: removed on a refusal
+    try:
+        with output_refusals("out", out_path):  # a full disk: one line naming --out
+            table = tabulate(target, projectile, velocities, depths, nu=nu, numerics=numerics,
+                             scheduler=scheduler, workers=workers, progress=progress,
+                             store=store)
+    except CavexInputError:
+        if not resumed:
+            shutil.rmtree(store, ignore_errors=True)
+        raise
     return {"table": table, "seconds": time.perf_counter() - start, "output": out_path,
             "store": store, "grid": grid}
 

@@ -107,7 +107,8 @@ def run(args, target, projectile):
     # again; the tables go into --out/tables/ with the other files, in the staged write
     tables = TableCache(workers=workers, scheduler=scheduler,
                         progress=show_progress(args.progress))
-    size = estimate(shot_file.shots, calibrations, tables, workers, models, folds)
+    size = estimate(shot_file.shots, calibrations, tables, workers, models, args.erosion,
+                    folds)
     print(f"cavex: validate {size}", file=sys.stderr, flush=True)
     began = time.monotonic()
     result = job(shot_file, calibrations, workers=workers, scheduler=scheduler,
@@ -141,15 +142,18 @@ def columns_of(calibrations, models=None):
     return columns
 
 
-def estimate(shots, calibrations, tables, workers, models=None, cross_validate=None):
-    """The run's size and time (:func:`cavex.verification.validation.predict.run_estimate`);
-    ``tables``: a :class:`TableCache` (None: a new one); ``cross_validate``: the fold
-    families (every option of the concrete model is then run)."""
-    from cavex.verification.validation.predict import run_estimate
+def estimate(shots, calibrations, tables, workers, models=None, erosion="none",
+             cross_validate=None):
+    """The run's size and time, measured by a short probe on ``shots``
+    (:func:`cavex.verification.validation.run_estimate.run_estimate`); ``tables``: a
+    :class:`TableCache` (None: a new one); ``erosion``: the name of the run's erosion law;
+    ``cross_validate``: the fold families (every option of the concrete model is then run)."""
+    from cavex.analytic.penetration.erosion import law_named
+    from cavex.verification.validation.run_estimate import run_estimate
 
     workers = workers or os.cpu_count() or 1
     return run_estimate(shots, columns_of(calibrations, models),
-                        TableCache() if tables is None else tables, workers,
+                        TableCache() if tables is None else tables, workers, law_named(erosion),
                         every_option=cross_validate is not None)
 
 

@@ -169,6 +169,7 @@ class TableCache:
         self._velocities = None
         self.built = 0
         self.reused = 0
+        self.to_build = []  # (target, projectile) of each table :meth:`plan` found to build
 
     def velocities_for(self, shots):
         """Set the velocity grid to cover ``shots`` (call before :meth:`table`)."""
@@ -186,11 +187,13 @@ class TableCache:
                 wanted.setdefault(self.key(target, projectile, self._velocities),
                                   (target, projectile))
         keys = set(wanted) - set(self._tables)
+        self.to_build = []
         for k in keys - set(self._checked) if self.cache is not None else ():
             table = read_entry(self._entry(k), *wanted[k], self._velocities, self.numerics)[0]
             if table is not None:  # checked now, used by :meth:`table` without a second read
                 self._checked[k] = table
         cached = keys & set(self._checked)
+        self.to_build = [wanted[k] for k in sorted(keys - cached)]
         return len(keys - cached), len(cached)
 
     def key(self, target, projectile, velocities):
@@ -293,32 +296,6 @@ class TableCache:
 
 
 # --- many shots -------------------------------------------------------------------------------
-
-def run_estimate(shots, models, tables, workers, every_option=False):
-    """One line: the size of a run of ``models`` (column -> ``(model, mapping)``) over
-    ``shots`` and its time, from :data:`TABLE_CASES_PER_SECOND_PER_WORKER` and
-    each model's ``prediction_seconds`` and ``concrete_table_seconds`` (the registry's); with
-    ``every_option`` (a cross-validation) the concrete tables of every option of the concrete
-    model."""
-    tables.velocities_for(shots)
-    table_mappings = [mapping or Mapping() for model, mapping in models.values()
-                      if model_of(model).takes_table]
-    build, reused = tables.plan(shots, table_mappings) if table_mappings else (0, 0)
-    cases = build * len(tables._velocities) * len(TABLE_DEPTHS)
-    chosen = [model_of(model) for model, _ in models.values()]
-    per_shot = sum(model.prediction_seconds for model in chosen)
-    table_seconds = max((model.concrete_table_seconds for model in chosen), default=0.0)
-    concretes = len({(s.fc, s.rho) for s in shots}) if table_seconds else 0
-    if every_option:
-        concretes *= len(get(CONCRETE_MODEL).options)
-    seconds = (cases / (TABLE_CASES_PER_SECOND_PER_WORKER * max(1, workers))
-               + len(shots) * per_shot + concretes * table_seconds / max(1, workers))
-    when = ("under a minute" if seconds < 60.0 else f"about {seconds / 60.0:.0f} min"
-            if seconds < 3600.0 else f"about {seconds / 3600.0:.1f} h")
-    return (f"{len(shots)} shots x {len(models)} models = {len(shots) * len(models)} "
-            f"predictions; FE tables: {build} to build ({cases} FE cases), {reused} on disk; "
-            f"{when} on {workers} worker(s) of an unloaded machine")
-
 
 def predictions(shots, models, tables=None, progress=None, erosion=None):
     """``{model: [depth or None]}`` and ``{model: {shot id: reason}}`` for the failures.

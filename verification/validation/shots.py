@@ -21,7 +21,7 @@ import math
 from dataclasses import dataclass, field
 
 from cavex.analytic.models.shots import shot_projectile, shot_target  # noqa: F401 (re-exported)
-from cavex.errors import CavexInputError, require_name
+from cavex.errors import CavexInputError, require_name, shown
 from cavex.input_files import in_file, read_text
 from cavex.materials import MASS_RANGE, MAX_CRH, MAX_VELOCITY, RADIUS_RANGE
 
@@ -196,7 +196,7 @@ def _parse_row(number, cells, header):
         value = _number(text)
         low_ok = value >= lower if column in INCLUSIVE_LOWER else value > lower
         if not (math.isfinite(value) and low_ok and value <= upper):
-            raise CavexInputError(f"must be {accepted} (got {text!r})",
+            raise CavexInputError(f"must be {accepted} (got {shown(text)})",
                                   f"{where}, column {column}")
         values[attribute] = value
     extra = {k: v for k, v in row.items() if k not in COLUMNS}
@@ -209,6 +209,10 @@ def _parse_row(number, cells, header):
 
 
 def _number(text):
+    """The number a cell holds in plain decimal notation (``1e6``, ``-0.5``, ``nan``); NaN
+    for anything else, e.g. ``3_00`` (Python's ``float`` reads it as 300) or ``0x12C``."""
+    if "_" in text:
+        return math.nan
     try:
         return float(text)
     except ValueError:
