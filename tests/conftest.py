@@ -29,9 +29,12 @@ def pytest_unconfigure(config):
 # The modules with the largest summed durations (measured 2026-11-27, largest first: the held
 # contact's 3-D runs, the concrete solver's 10 100-point sweep, the edge cases, the signal
 # faults). They run first, so that on two workers (pyproject addopts: each module on one
-# worker, taken in collection order) no long module starts last while the other worker idles.
-HEAVY_FIRST = ("test_contact_hold.py", "test_contact_hold_balances.py",
-               "test_concrete_cavity_sweep.py", "test_edges.py",
+# worker, taken in collection order, --no-loadscope-reorder) no long module starts last while
+# the other worker idles. The concrete sweep comes second so that the second worker does not
+# compile the held contact's 3-D kernel at the same time as the first (46 s of CPU on a cold
+# numba cache, measured): by the time it reaches the balances the first has cached it.
+HEAVY_FIRST = ("test_contact_hold.py", "test_concrete_cavity_sweep.py",
+               "test_contact_hold_balances.py", "test_edges.py",
                "test_faults_signals.py", "test_interfaces.py", "test_validation.py",
                "test_entry_crater.py", "test_command_figures.py", "test_adversarial.py",
                "test_oblique.py")
