@@ -167,14 +167,15 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
     check_folds`; None: no cross-validation)."""
     from cavex.analytic.penetration.erosion import law_named
     from cavex.verification.fedata.runner import show_progress
+    from cavex.verification.validation.cross_validation import fold_validator
 
     law = law_named(erosion)
     if tables is None:
         tables = TableCache(tables_dir, workers=workers, scheduler=scheduler,
                             progress=show_progress(progress))
+    folds = None if cross_validate is None else fold_validator(cross_validate, law)
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
-                      progress=progress, models=models, erosion=law,
-                      cross_validate=cross_validate)
+                      progress=progress, models=models, erosion=law, cross_validate=folds)
     if any(c.model == FE_PARTNER for c in calibrations):
         columns = {COMPRESSIBILITY_COLUMN: columns_of(calibrations)[COMPRESSIBILITY_COLUMN]}
         depths, failures = predictions(shot_file.shots, columns, tables, progress, law)

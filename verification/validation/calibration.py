@@ -26,12 +26,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cavex.analytic.models import model_label, parse_label, parse_model_label
+from cavex.analytic.models import labels, model_label, parse_label, parse_model_label
 from cavex.concrete import BOUNDS, FREE_PARAMETERS, Mapping
 from cavex.errors import CavexInputError, CavexNumericalError, check_keys, prefixed, require
 from cavex.input_files import in_file, read_toml
 from cavex.verification.output.number_format import round_significant
-from cavex.verification.validation.predict import OUTLIER_FACTOR, TableCache, predict
+from cavex.verification.validation.predict import (
+    DEPTH_DIGITS,
+    OUTLIER_FACTOR,
+    TableCache,
+    predict,
+)
 from cavex.verification.validation.shots import shot_projectile, shot_target
 
 PARAMETER_DIGITS = 6
@@ -189,6 +194,32 @@ def fit(shots, resistance="derived", params=None, start=None, tables=None, progr
                        skipped=tuple(skipped),
                        outliers=tuple(s.id for s, f in zip(active, flagged, strict=True) if f),
                        without_outliers=fit_statistics(r[~flagged]), standard_errors=errors)
+
+
+def refitted_depths(calibration, train, held, tables=None, erosion=None, shots=None):
+    """``(choice, depths)``: ``calibration``'s model fitted again, its free parameters from its
+    file, to the shots ``train`` (:func:`cavex.verification.validation.calibration.fit`) and
+    its depths of the shots ``held`` (None where it fails); ``choice`` says what was fitted.
+    The fit sets the FE tables' velocity grid to its shots': it is set back to cover
+    ``shots`` (default ``train`` and ``held``) for the predictions."""
+    model, boundary = parse_label(calibration.model, "models", labels(fits_mapping=True))
+    tables = tables or TableCache()
+    try:
+        refit = fit(train, model.name, calibration.params, tables=tables, boundary=boundary)
+    except CavexNumericalError as exc:
+        return f"refit failed: {str(exc).splitlines()[0]}", [None] * len(held)
+    finally:
+        tables.velocities_for(list(shots) if shots is not None else [*train, *held])
+    depths = []
+    for shot in held:
+        try:
+            depths.append(round_significant(predict(shot, calibration.model, refit.mapping,
+                                                    tables, erosion), DEPTH_DIGITS))
+        except (CavexInputError, CavexNumericalError):
+            depths.append(None)
+    values = ", ".join(f"{p} = {getattr(refit.mapping, p):.6g}" for p in calibration.params)
+    return f"refitted on {len(refit.shots)} shots: {values}", depths
+
 
 
 def fit_statistics(r):

@@ -36,7 +36,12 @@ import math
 import numpy as np
 
 from cavex.errors import CavexInputError, require, require_choice
-from cavex.verification.validation.regimes import FAST, log_statistics, regime_statistics
+from cavex.verification.validation.regimes import (
+    DEPTH_DIGITS,
+    FAST,
+    log_statistics,
+    regime_statistics,
+)
 
 REFERENCE_COLUMN = "source"
 YIELD_COLUMN = "proj_yield_MPa"
@@ -219,17 +224,32 @@ def cross_validation(result, shots, option_depths, calibrations, families, refit
     return result
 
 
+def fold_validator(families, erosion=None):
+    """The ``cross_validate`` of :func:`cavex.verification.validation.predict.validate`:
+    :func:`cross_validation` over the fold ``families``, a calibrated column refitted per fold
+    (:func:`cavex.verification.validation.calibration.refitted_depths`, with ``erosion``)."""
+    def run(result, shots, option_depths, calibrations, tables):
+        from cavex.verification.validation.calibration import refitted_depths
+
+        def refit(calibration, train, held):
+            return refitted_depths(calibration, train, held, tables, erosion, shots)
+
+        return cross_validation(result, shots, option_depths, calibrations, families, refit)
+
+    return run
+
+
 def chosen_on_shots(columns, option_depths, calibrations):
     """``{column: what it chooses on shots, in words, or None}``."""
-    from cavex.analytic.models import labels
-    from cavex.verification.validation.predict import model_of
+    from cavex.analytic.models import labels, parse_label
 
     out = {}
     for column in columns:
         if column in calibrations:
             out[column] = "a mapping fitted to shots (its calibration, refitted per fold)"
         elif list(option_depths[column]) != [None]:
-            words = (model_of(column).option_words if column in labels(predicts_shots=True)
+            offered = labels(predicts_shots=True)
+            words = (parse_label(column, "models", offered)[0].option_words if column in offered
                      else "an option")
             out[column] = (f"{words}: one of "
                            + ", ".join(f"'{o}'" for o in option_depths[column]))
@@ -260,6 +280,4 @@ def _row(row, depths):
 
 
 def _digits():
-    from cavex.verification.validation.predict import DEPTH_DIGITS
-
     return DEPTH_DIGITS

@@ -42,8 +42,8 @@ from cavex.analytic.models import get, labels, names, parse_label, the
 from cavex.analytic.penetration.nose import nose_rule
 from cavex.concrete import Mapping
 from cavex.errors import CavexInputError, CavexNumericalError, require_choice
-from cavex.verification.output.number_format import FE_DIGITS, round_significant
-from cavex.verification.validation.regimes import regime_statistics, rigid_flag
+from cavex.verification.output.number_format import round_significant
+from cavex.verification.validation.regimes import DEPTH_DIGITS, regime_statistics, rigid_flag
 from cavex.verification.validation.shots import shot_projectile, shot_target
 
 #: the labels of the models validate runs, in the order of its columns (the registry's when
@@ -60,7 +60,6 @@ EMPIRICAL = the(empirical_reference=True).name  # the report compares the calibr
 RECOMMENDED_MODEL = names(recommended=True)[0]
 #: the model of the concrete cavity tables (run once per option, shared with its parts' users)
 CONCRETE_MODEL = names(tabulates_concrete=True)[0]
-DEPTH_DIGITS = FE_DIGITS  # predicted depths and statistics in the result files
 TABLE_VELOCITY_STEP = 50.0  # m/s between FE table velocities (interpolated by PCHIP in V^2)
 TABLE_DEPTHS = (0.0, 1.0)  # a one-layer target's sigma_r does not depend on depth
 # for run estimates only, measured on the development shots (one worker, x86_64, unloaded):
@@ -381,11 +380,13 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         Nose erosion in every model that flies the integrator
         (:mod:`cavex.analytic.penetration.erosion`); None: rigid. Set, the result says so
         (``erosion``: the law's name).
-    cross_validate : sequence of str, optional
-        The fold families of :data:`cavex.verification.validation.cross_validation.FOLDS`
-        (checked with the shots by its ``check_folds``); set, the result has
-        ``cross_validation`` and each shot ``cross_validated_m``
-        (:func:`cavex.verification.validation.cross_validation.cross_validation`).
+    cross_validate : callable, optional
+        ``cross_validate(result, shots, option_depths, calibrations, tables)``, from
+        :func:`cavex.verification.validation.cross_validation.fold_validator` (the fold
+        families, checked with the shots by its ``check_folds``): every option's depths are
+        then computed, and the result gets ``cross_validation`` and each shot
+        ``cross_validated_m``. Passed in, not imported: the cross-validation refits
+        calibrations, which predict through this module.
 
     Returns
     -------
@@ -442,42 +443,11 @@ def validate(shots, *, calibrations=(), tables=None, progress=None, mapping=None
         result["erosion"] = erosion.name
     add_statistics(result)
     if cross_validate is not None:
-        from cavex.verification.validation.cross_validation import cross_validation
-
         for name in columns:  # a column with nothing chosen on shots: its one "option"
             option_depths.setdefault(name, {None: depths[name]})
-        refits = {c.column: c for c in calibrations}
-        cross_validation(result, shots, option_depths, refits, cross_validate,
-                         refit=lambda c, train, held: refitted_depths(c, train, held, tables,
-                                                                      erosion, shots))
+        cross_validate(result, shots, option_depths, {c.column: c for c in calibrations},
+                       tables)
     return result
-
-
-def refitted_depths(calibration, train, held, tables=None, erosion=None, shots=None):
-    """``(choice, depths)``: ``calibration``'s model fitted again, its free parameters from its
-    file, to the shots ``train`` (:func:`cavex.verification.validation.calibration.fit`) and
-    its depths of the shots ``held`` (None where it fails); ``choice`` says what was fitted.
-    The fit sets the FE tables' velocity grid to its shots': it is set back to cover
-    ``shots`` (default ``train`` and ``held``) for the predictions."""
-    from cavex.verification.validation.calibration import fit
-
-    model, boundary = parse_label(calibration.model, "models", labels(fits_mapping=True))
-    tables = tables or TableCache()
-    try:
-        refit = fit(train, model.name, calibration.params, tables=tables, boundary=boundary)
-    except CavexNumericalError as exc:
-        return f"refit failed: {str(exc).splitlines()[0]}", [None] * len(held)
-    finally:
-        tables.velocities_for(list(shots) if shots is not None else [*train, *held])
-    depths = []
-    for shot in held:
-        try:
-            depths.append(round_significant(predict(shot, calibration.model, refit.mapping,
-                                                    tables, erosion), DEPTH_DIGITS))
-        except (CavexInputError, CavexNumericalError):
-            depths.append(None)
-    values = ", ".join(f"{p} = {getattr(refit.mapping, p):.6g}" for p in calibration.params)
-    return f"refitted on {len(refit.shots)} shots: {values}", depths
 
 
 def split_depths(model, shots, concrete_depths, option=None):

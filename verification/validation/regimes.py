@@ -26,7 +26,9 @@ import math
 import numpy as np
 
 from cavex.errors import require
-from cavex.verification.output.number_format import round_significant
+from cavex.verification.output.number_format import FE_DIGITS, round_significant
+
+DEPTH_DIGITS = FE_DIGITS  # predicted depths and statistics in the result files
 
 NORMAL_STRENGTH = 100e6  # Pa
 FAST = 1000.0  # m/s
