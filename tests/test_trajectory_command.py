@@ -65,7 +65,7 @@ def test_no_figures_writes_the_same_numbers_without_pictures(command_run, tmp_pa
     assert main(args) == 0
     document = json.loads(capsys.readouterr().out)
     assert sorted(p.name for p in out.iterdir()) == [
-        "history_first_layer_only.csv", "history_runway.csv", "summary.json"]
+        "history_first_layer_only.csv", "history_target.csv", "summary.json"]
     assert sorted(document["outputs"]) == sorted(str(p) for p in out.iterdir())
     target, projectile = load_config()
     api = fly(target, projectile, Strike(500.0, obliquity=25.0), "law", law_A=2e8, law_B=2500.0,
