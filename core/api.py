@@ -141,7 +141,7 @@ class Penetration:
     @property
     def phases(self):
         """The target's phase table as ``cavex penetrate`` prints and writes it
-        (``phases_runway.csv``): one row per phase, ``phase``, ``stage``, ``label``,
+        (``phases_target.csv``): one row per phase, ``phase``, ``stage``, ``label``,
         ``end_depth_m``, ``end_velocity_m_s``, ``end_time_s``, ``end_reason``
         (:class:`pandas.DataFrame`)."""
         import pandas as pd
@@ -152,7 +152,7 @@ class Penetration:
 
     @property
     def trajectory(self):
-        """The target's trajectory, the rows of ``trajectory_runway.csv`` at full precision:
+        """The target's trajectory, the rows of ``trajectory_target.csv`` at full precision:
         ``t_s``, ``depth_m``, ``velocity_m_s``, ``deceleration_m_s2``, ``phase``
         (:class:`pandas.DataFrame`)."""
         return _frame(self.job["runs"]["runway"].rows())
@@ -252,7 +252,7 @@ class Shot:
 
     @property
     def history(self):
-        """The target's history, the columns of ``history_runway.csv`` at full precision
+        """The target's history, the columns of ``history_target.csv`` at full precision
         (time, centre of mass and nose tip, attitude, velocities, overloads),
         :class:`pandas.DataFrame`."""
         return _frame(self.job["runs"]["runway"].history)

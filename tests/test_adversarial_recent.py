@@ -346,8 +346,8 @@ def test_a_full_disk_under_table_is_named_and_nothing_is_left(tmp_path, capsys):
 
 
 FINAL_NAMES = {
-    "trajectory": (["trajectory", "--no-figures"], ["summary.json", "history_runway.csv"]),
-    "penetrate": (["penetrate", "--no-figures"], ["phases_runway.csv"]),
+    "trajectory": (["trajectory", "--no-figures"], ["summary.json", "history_target.csv"]),
+    "penetrate": (["penetrate", "--no-figures"], ["phases_target.csv"]),
 }
 
 

@@ -130,16 +130,16 @@ def test_penetration_frames_equal_the_command_csv(penetration, capsys, tmp_path)
     assert isinstance(penetration.trajectory, pd.DataFrame)
     code, _, err = run(capsys, "penetrate", "--out", tmp_path / "cmd", "--no-figures")
     assert code == 0, err
-    for frame, name in ((penetration.trajectory, "trajectory_runway.csv"),
+    for frame, name in ((penetration.trajectory, "trajectory_target.csv"),
                         (penetration.first_layer_trajectory,
                          "trajectory_first_layer_only.csv")):
         mine = write_columns_csv(tmp_path / name, {c: frame[c].to_numpy() for c in frame},
                                  TRAJECTORY_QUANTA)
         assert mine.read_bytes() == (tmp_path / "cmd" / name).read_bytes(), name
     phases = penetration.phases.drop(columns="stage")  # a bonded target's file has none
-    mine = write_columns_csv(tmp_path / "phases_runway.csv",
+    mine = write_columns_csv(tmp_path / "phases_target.csv",
                              {c: phases[c].tolist() for c in phases})
-    assert mine.read_bytes() == (tmp_path / "cmd" / "phases_runway.csv").read_bytes()
+    assert mine.read_bytes() == (tmp_path / "cmd" / "phases_target.csv").read_bytes()
     assert penetration.final_depth == penetration.trajectory["depth_m"].iloc[-1]
     assert penetration.phases["end_depth_m"].iloc[-1] == pytest.approx(penetration.final_depth,
                                                                        rel=1e-12)
@@ -156,7 +156,7 @@ def test_shot_history_equals_the_command_csv(shot, capsys, tmp_path):
     assert code == 0, err
     mine = write_columns_csv(tmp_path / "h.csv",
                              {c: shot.history[c].to_numpy() for c in shot.history})
-    assert mine.read_bytes() == (tmp_path / "cmd" / "history_runway.csv").read_bytes()
+    assert mine.read_bytes() == (tmp_path / "cmd" / "history_target.csv").read_bytes()
     assert shot.end["state"] == "stopped"
     assert shot.summary["settings"]["obliquity_deg"] == 20.0
 

@@ -79,14 +79,14 @@ def test_penetrate_json_outputs_and_files(capsys, tmp_path, default):
                                              phase.end_velocity, "time_s": phase.end_time},
                                             rel=ROUNDOFF)
     # files: two trajectories, the phase table and two PNG figures, all inside out_dir
-    names = {"trajectory_runway.csv", "trajectory_first_layer_only.csv", "phases_runway.csv",
+    names = {"trajectory_target.csv", "trajectory_first_layer_only.csv", "phases_target.csv",
              "velocity_time.png", "deceleration_depth.png"}
     assert {Path(p).name for p in result["outputs"]} == names
     assert {p.name for p in out_dir.iterdir()} == names  # no temporary files left
     for name in ("velocity_time.png", "deceleration_depth.png"):
         data = (out_dir / name).read_bytes()
         assert data[:8] == PNG_SIGNATURE and len(data) > 1000
-    header, rows = _read_csv(out_dir / "trajectory_runway.csv")
+    header, rows = _read_csv(out_dir / "trajectory_target.csv")
     assert header == TRAJECTORY_COLUMNS
     written = trajectory.rows()  # equal intervals of time within each phase
     assert len(rows) == len(written["t_s"])
@@ -102,7 +102,7 @@ def test_penetrate_json_outputs_and_files(capsys, tmp_path, default):
     header, rows = _read_csv(out_dir / "trajectory_first_layer_only.csv")
     assert header == TRAJECTORY_COLUMNS and len(rows) > 10
     assert float(rows[-1][2]) == 0.0  # velocity at the stop
-    header, rows = _read_csv(out_dir / "phases_runway.csv")
+    header, rows = _read_csv(out_dir / "phases_target.csv")
     assert header == PHASE_COLUMNS
     assert [row[1] for row in rows] == [p.label for p in trajectory.phases]
     assert [float(row[2]) for row in rows] == pytest.approx(

@@ -230,7 +230,7 @@ def test_trajectory_figures(capsys, tmp_path, drawn, case, argv, config):
     # it are named in its legend (a ricochet's block is not the whole target, issue 33)
     target, _ = load_config(tmp_path / "target.toml" if config else None)
     (_, _, (bottom, top)) = drawn.limits_3d["path_3d.png"]  # depth downward
-    deepest = np.loadtxt(out / "history_runway.csv", delimiter=",", skiprows=1,
+    deepest = np.loadtxt(out / "history_target.csv", delimiter=",", skiprows=1,
                          usecols=6).max()
     assert top < 0.0 < deepest < bottom
     for name, H in zip(target.layer_names()[1:], target.interface_depths, strict=True):

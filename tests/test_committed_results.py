@@ -13,7 +13,7 @@ Measured (16 seeds of this model): with 6 significant digits everywhere 40 value
 trajectory files changed (29 velocities near the stop of the derived model's first layer, the
 0.952771 against 0.95264 m/s another CPU wrote; 9 of the paper model's first layer; 2 times);
 with the quanta of ``TRAJECTORY_QUANTA`` none did. While the rows were the steps,
-``results/penetration_paper/trajectory_runway.csv`` changed its number of rows in 15 of the 16
+``results/penetration_paper/trajectory_target.csv`` changed its number of rows in 15 of the 16
 seeds (phase ``Eq. 21 (b)`` took 12 to 16 steps); with rows equally spaced in each phase every
 file, that one included, is rewritten byte for byte under all 16 seeds (measured when the rows
 changed, 2026-11-27).
@@ -41,7 +41,7 @@ COMMANDS = {  # the folder and its options in results/regenerate.sh
     "results/penetration": [],
     "results/penetration_paper": ["--resistance", "paper", "--epsilon", "cylindrical-sigma_c"],
 }
-FILES = ("trajectory_runway.csv", "trajectory_first_layer_only.csv", "phases_runway.csv")
+FILES = ("trajectory_target.csv", "trajectory_first_layer_only.csv", "phases_target.csv")
 SEEDS = (0, 1, 2)  # of the 16 measured
 EMULATION = {"NPY_DISABLE_CPU_FEATURES": "X86_V3 X86_V4 AVX512_ICL", "NUMBA_CPU_NAME": "generic"}
 

@@ -254,8 +254,8 @@ def test_penetrate_no_figures_writes_no_png(capsys, tmp_path):
     code, out, err = _run(capsys, "penetrate", "--no-figures", "--out", str(tmp_path / "p"))
     assert (code, err) == (0, "")
     written = sorted(p.name for p in (tmp_path / "p").iterdir())
-    assert written == ["phases_runway.csv", "trajectory_first_layer_only.csv",
-                       "trajectory_runway.csv"]
+    assert written == ["phases_target.csv", "trajectory_first_layer_only.csv",
+                       "trajectory_target.csv"]
 
 
 def test_compiling_is_announced_once():

@@ -174,7 +174,7 @@ def test_penetrate_json_lists_stages(capsys, tmp_path):
     document = json.loads(out)
     assert [i["bottom"] for i in document["interfaces"]] == ["debonded", "debonded"]
     assert {p["stage"] for p in document["phases"]} == {"crater", "tunnel", "rear face"}
-    assert "stage" in (tmp_path / "phases_runway.csv").read_text().splitlines()[0]
+    assert "stage" in (tmp_path / "phases_target.csv").read_text().splitlines()[0]
 
 
 def test_zones_of_the_3d_model(debonded):

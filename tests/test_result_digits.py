@@ -172,7 +172,7 @@ def test_penetration_csv_is_byte_identical_and_has_nine_digits(penetration, tmp_
     first = penetration_report.write_outputs(penetration, tmp_path / "a", draw=False)
     second = penetration_report.write_outputs(penetration, tmp_path / "b", draw=False)
     assert [p.rsplit("/", 1)[1] for p in first] == [
-        "trajectory_runway.csv", "trajectory_first_layer_only.csv", "phases_runway.csv"]
+        "trajectory_target.csv", "trajectory_first_layer_only.csv", "phases_target.csv"]
     numbers = 0
     for a, b in zip(first, second, strict=True):
         assert Path(a).read_bytes() == Path(b).read_bytes()

@@ -42,7 +42,7 @@ def test_files_figures_and_json_hold_the_api_trajectory(command_run, capsys):
     assert document["runs"]["first layer only"]["end"]["nose_tip_m"] == single.end["nose_tip_m"]
     assert {"state", "time_s", "nose_tip_m", "pitch_deg", "speed_m_s"} <= set(document["end"])
     assert document["phases"] and document["phases"][-1]["end_reason"] == "stopped"
-    for name, result in (("runway", api), ("first_layer_only", single)):
+    for name, result in (("target", api), ("first_layer_only", single)):
         with open(out / f"history_{name}.csv", newline="") as handle:
             rows = list(csv.DictReader(handle))
         assert len(rows) == result.history["t_s"].size
@@ -65,7 +65,7 @@ def test_no_figures_writes_the_same_numbers_without_pictures(command_run, tmp_pa
     assert main(args) == 0
     document = json.loads(capsys.readouterr().out)
     assert sorted(p.name for p in out.iterdir()) == [
-        "history_first_layer_only.csv", "history_runway.csv", "summary.json"]
+        "history_first_layer_only.csv", "history_target.csv", "summary.json"]
     assert sorted(document["outputs"]) == sorted(str(p) for p in out.iterdir())
     target, projectile = load_config()
     api = fly(target, projectile, Strike(500.0, obliquity=25.0), "law", law_A=2e8, law_B=2500.0,

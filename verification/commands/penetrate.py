@@ -23,7 +23,7 @@ from cavex.verification.commands.options import (
     resistance_settings,
 )
 from cavex.verification.commands.shared_options import add_config_option, add_figures_option
-from cavex.verification.output.files import write_columns_csv
+from cavex.verification.output.files import run_stem, write_columns_csv
 from cavex.verification.output.number_format import TRAJECTORY_QUANTA
 from cavex.verification.output.paths import check_output_dir, write_staged
 from cavex.verification.studies.table2 import not_reproduced_line, table2_comparison
@@ -277,12 +277,13 @@ def write_outputs(job, out_dir, draw=True):
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, trajectory in job["runs"].items():
-        written.append(write_columns_csv(out / f"trajectory_{name}.csv", trajectory.rows(),
+        written.append(write_columns_csv(out / f"trajectory_{run_stem(name)}.csv",
+                                         trajectory.rows(),
                                          TRAJECTORY_QUANTA))
     rows = phases_as_dicts(job["runs"]["runway"])
     if not job["debonded"]:  # the stage column only where there is more than one tunnel
         rows = [{k: v for k, v in row.items() if k != "stage"} for row in rows]
-    written.append(write_columns_csv(out / "phases_runway.csv", _columns(rows)))
+    written.append(write_columns_csv(out / f"phases_{run_stem('runway')}.csv", _columns(rows)))
     if draw:
         from cavex.verification.report.penetration_figures import figures
 

@@ -31,7 +31,7 @@ from cavex.verification.commands.options import (
 )
 from cavex.verification.commands.shared_options import add_config_option, add_figures_option
 from cavex.verification.fedata.runner import show_progress
-from cavex.verification.output.files import write_columns_csv, write_text_atomic
+from cavex.verification.output.files import run_stem, write_columns_csv, write_text_atomic
 from cavex.verification.output.json_document import json_text
 from cavex.verification.output.paths import check_output_dir, write_staged
 from cavex.verification.report.trajectory_figures import figures, run_label, shot_title
@@ -244,7 +244,7 @@ def write_outputs(job, out, draw=True):
     if ``draw``, the figures into ``out``; returns the paths written."""
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
-    written = [str(write_columns_csv(folder / f"history_{name.replace(' ', '_')}.csv",
+    written = [str(write_columns_csv(folder / f"history_{run_stem(name)}.csv",
                                      result.history))
                for name, result in job["runs"].items()]
     path = folder / "summary.json"

@@ -70,8 +70,9 @@ def add_arguments(parser):
                         help="also predict each fold with the choices its models make on the "
                         "other shots (options, splits, calibrations): FOLD of reference (each "
                         "reference, column source, left out), calibre (<= 13 mm), yield "
-                        "(projectile yield < 1 GPa), velocity (V0 > 1000 m/s); none given: all "
-                        "(docs/validation.md \"Cross-validation\")")
+                        "(projectile yield < 1 GPa), velocity (V0 > 1000 m/s); given without FOLD: "
+                        "all; default: no cross-validation (docs/validation.md "
+                        "\"Cross-validation\")")
     parser.add_argument("--json", action="store_true", help="print JSON")
     parser.add_argument("--out", help="output folder (default results/validation)")
     add_figures_option(parser, "validation.json, predictions.csv and report.md")

@@ -90,6 +90,14 @@ def write_text_atomic(path, text, durable=True):
             os.remove(tmp)
 
 
+def run_stem(name):
+    """A run's name in file names (``trajectory_<stem>.csv``, ``history_<stem>.csv``,
+    ``phases_<stem>.csv``): the whole target's run, ``"runway"`` in the commands' JSON (kept
+    for scripts that read it), is ``target``, whatever the target (a user's own is no runway);
+    another run its own name, spaces as ``_`` (``first_layer_only``)."""
+    return "target" if name == "runway" else name.replace(" ", "_")
+
+
 def write_columns_csv(path, columns, quanta=None):
     """``columns`` (name -> sequence) as CSV, atomically, every number through
     :func:`~cavex.verification.output.number_format.format_number`, with the rule
