@@ -364,6 +364,27 @@ def test_validation_figures(tmp_path, drawn, calibrated):
         not_blank(path)
 
 
+def test_validation_points_of_alike_models_both_show():
+    """Li and Chen's and Forrestal's formulas predict alike: in both panels (predicted against
+    measured, residuals) Forrestal's larger markers lie behind Li and Chen's, so neither
+    model's points hide the other's (issue 33: the li-chen-2003 points hid)."""
+    from matplotlib.figure import Figure
+
+    from cavex.verification.report.validation_figures import draw_models, draw_residuals
+
+    result = json.loads((ROOT / "results" / "validation" / "compilation_dev"
+                         / "validation.json").read_text())
+    models = ["li-chen-2003", "forrestal-1994"]
+    for draw in (lambda ax: draw_models(ax, result, models),
+                 lambda ax: draw_residuals(ax, result, models, "velocity")):
+        ax = Figure().subplots()
+        draw(ax)
+        lines = {line.get_label(): line for line in ax.lines if line.get_label() in models}
+        li_chen, forrestal = lines["li-chen-2003"], lines["forrestal-1994"]
+        assert forrestal.get_markersize() > li_chen.get_markersize()
+        assert forrestal.get_zorder() < li_chen.get_zorder()
+
+
 def test_trajectory_figures_import_neither_pyplot_nor_a_3d_engine(tmp_path):
     """The figures are drawn on Agg canvases without pyplot, the 3-D view with mplot3d (the
     figure time, issue 21: benchmarks/commands.py, docs/oblique.md "Speed")."""

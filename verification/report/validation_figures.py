@@ -205,11 +205,19 @@ def plain_log_ticks(axis):
     axis.set_minor_formatter(NullFormatter())
 
 
+def _size_and_order(model, scale=1.0):
+    """``{"markersize", "zorder"}`` of a model's points: the registry's ``marker_size`` times
+    ``scale``, a larger marker drawn behind a smaller one, so that the points of two models
+    that predict alike (Li and Chen's and Forrestal's formulas) both show."""
+    size = scale * parse_label(model)[0].marker_size
+    return {"markersize": size, "zorder": 2.0 + 10.0 / size}
+
+
 def _scatter(ax, x, y, flagged, model):
     """One model's points, the shots flagged non-rigid open."""
     _, marker, colour = model_style(model)
-    style = {"marker": marker, "color": colour, "linestyle": "none",
-             "markersize": 5, "alpha": 0.8}
+    style = {"marker": marker, "color": colour, "linestyle": "none", "alpha": 0.8,
+             **_size_and_order(model, scale=5.0 / 7.0)}
     ax.plot(x[~flagged], y[~flagged], label=model, **style)
     ax.plot(x[flagged], y[flagged], markerfacecolor="white", **style)
 
@@ -256,8 +264,7 @@ def _draw_model(ax, result, model, measured, velocity):
     x = measured * 1e3 if velocity is None else velocity
     y = y * 1e3 if velocity is None else y / measured
     marker = "P" if model == result.get("compressibility_column") else marker
-    style = {"marker": marker, "color": colour, "linestyle": "none",
-             "markersize": parse_label(base)[0].marker_size}
+    style = {"marker": marker, "color": colour, "linestyle": "none", **_size_and_order(base)}
     if model in labels(predicts_shots=True):
         ax.plot(x, y, label=model, markerfacecolor=colour, **style)
         return
