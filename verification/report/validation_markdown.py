@@ -181,6 +181,14 @@ def report_markdown(result, figures=True):
     return "\n".join(lines)
 
 
+def _regime_header(regimes, names, first):
+    """The two header lines of a table of models by regime: each regime's title with the
+    number of shots of the model ``first`` in it."""
+    return ["| model | " + " | ".join(f"{REGIME_TITLES[n]} ({regimes[n][first]['n']})"
+                                     for n in names) + " |",
+            "|---|" + "---:|" * len(names)]
+
+
 def _regime_section(result):
     """Mean |ln ratio| / bias per regime (docs/validation.md, "Regimes")."""
     regimes = result.get("regimes", {})
@@ -193,9 +201,7 @@ def _regime_section(result):
              "Mean |ln(predicted/measured)| / bias (mean ln ratio; positive: too deep), n shots "
              "per regime. A shot's regime follows from its inputs "
              "(`cavex.verification.validation.regimes`).", "",
-             "| model | " + " | ".join(f"{REGIME_TITLES[n]} ({regimes[n][first]['n']})"
-                                       for n in names) + " |",
-             "|---|" + "---:|" * len(names)]
+             *_regime_header(regimes, names, first)]
     for m in result["models"]:
         cells = []
         for n in names:
@@ -280,9 +286,7 @@ def cross_validation_section(result):
                   "Every shot predicted by the choices made without its reference; in "
                   "brackets the plain mean |ln ratio| (each model as it runs, its choices "
                   "those of the registry).", "",
-                  "| model | " + " | ".join(f"{REGIME_TITLES[n]} ({cv['regimes'][n][first]['n']})"
-                                            for n in names) + " |",
-                  "|---|" + "---:|" * len(names)]
+                  *_regime_header(cv["regimes"], names, first)]
         for m in columns:
             lines.append(f"| {m} | " + " | ".join(
                 _cell(cv["regimes"][n][m], plain.get(n, {}).get(m)) for n in names) + " |")

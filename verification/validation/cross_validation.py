@@ -198,14 +198,14 @@ def cross_validation(result, shots, option_depths, calibrations, families, refit
             models[column] = {"choice": choice, **log_statistics(
                 [None if d is None else d / measured[i] for d, i in zip(depths, held,
                                                                          strict=True)],
-                _digits())}
+                DEPTH_DIGITS)}
             if family == "reference":
                 for d, i in zip(depths, held, strict=True):
                     held_out[column][i] = d
         rows = [_row(result["shots"][i], {c: predicted[c][k] for c in columns})
                 for k, i in enumerate(held)]
         out.append({"name": name, "family": family, "n": len(held), "models": models,
-                    "regimes": regime_statistics(rows, columns, _digits())})
+                    "regimes": regime_statistics(rows, columns, DEPTH_DIGITS)})
     document = {"families": list(families), "folds": out,
                 "chosen_on_shots": chosen_on_shots(columns, option_depths, calibrations),
                 "choice_on_all_shots": {c: choose(option_depths[c], measured, sorted(everyone))
@@ -219,7 +219,7 @@ def cross_validation(result, shots, option_depths, calibrations, families, refit
         for i, row in enumerate(result["shots"]):
             row["cross_validated_m"] = {c: held_out[c][i] for c in columns}
         rows = [_row(row, row["cross_validated_m"]) for row in result["shots"]]
-        document["regimes"] = regime_statistics(rows, columns, _digits())
+        document["regimes"] = regime_statistics(rows, columns, DEPTH_DIGITS)
     result["cross_validation"] = document
     return result
 
@@ -277,7 +277,3 @@ def _row(row, depths):
     return {"fc_Pa": row["fc_Pa"], "V0_m_s": row["V0_m_s"], "flag": row.get("flag"),
             "ratio": {c: None if d is None else d / row["measured_m"]
                       for c, d in depths.items()}}
-
-
-def _digits():
-    return DEPTH_DIGITS
