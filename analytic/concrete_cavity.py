@@ -90,12 +90,16 @@ ELASTIC_PLASTIC, CRACKED, JOINT_FRONT, SUPERSEISMIC = 0, 1, 2, 3
 STRUCTURES = {ELASTIC_PLASTIC: "elastic-comminuted", CRACKED: "elastic-cracked-comminuted",
               JOINT_FRONT: "elastic-comminuted, cracking at the comminution front",
               SUPERSEISMIC: "comminuted shock into undisturbed concrete"}
+EPS = np.finfo(np.float64).eps
 DEFAULT_STEPS = 256  # RK4 steps across the comminuted zone (see the convergence test)
 # columns of the parameter vector of the compiled functions
 (E_, MU, LAM, TAU0, TAU_MAX, BULK, ETA, LOCKED, TENSILE, W, WB, PHI, POWER_B, POWER_N,
- CRUSH, P_LOCK, E_LOCK, OPEN, S_CAP, S_OPEN, S_CRUSH, S_LOCK) = range(22)
-NPAR = 22  # S_CAP ... S_LOCK: the kinks (kink_stresses), computed once per vector; OPEN: the
-# crack opening the comminuted material carries (set_opening, per front tried)
+ CRUSH, P_LOCK, E_LOCK, OPEN, S_CAP, S_OPEN, S_CRUSH, S_LOCK, Q_OPEN, Q_CRUSH,
+ Q_LOCK) = range(25)
+NPAR = 25  # S_CAP ... S_LOCK: the kinks (kink_stresses) and Q_OPEN ... Q_LOCK: the pressures
+# of the hydrostat's pieces (opening_pressure, crush_pressure, lock_pressure), computed once
+# per vector; OPEN: the crack opening the comminuted material carries (set_opening, per front
+# tried)
 
 
 @dataclass(frozen=True)
@@ -399,6 +403,7 @@ def set_opening(p, opening):
     cut-off) that the comminuted material carries from the cracked zone, and the kinks
     (:func:`kink_stresses`) that move with it."""
     p[OPEN] = max(opening, 0.0)
+    p[Q_OPEN], p[Q_CRUSH], p[Q_LOCK] = opening_pressure(p), crush_pressure(p), lock_pressure(p)
     p[S_CAP], p[S_OPEN], p[S_CRUSH], p[S_LOCK] = kink_stresses(p)
 
 
@@ -427,11 +432,11 @@ def compaction_piece(p, branch):
     opening closing at the crush pressure (``P = P_c``), compaction, or locked (the FE's
     :func:`cavex.fem.constitutive.hydrostat` on loading from ``theta_p = theta_o``)."""
     K, P_c, P_l, e_l = p[BULK], p[CRUSH], p[P_LOCK], p[E_LOCK]
-    if branch < opening_pressure(p):
+    if branch < p[Q_OPEN]:
         return K * p[OPEN], K
-    if branch < crush_pressure(p):
+    if branch < p[Q_CRUSH]:
         return P_c, 0.0
-    if branch < lock_pressure(p):
+    if branch < p[Q_LOCK]:
         e_0 = P_c / K
         slope = (P_l - P_c) / (e_l - e_0)
         return P_c - slope * e_0, slope
@@ -469,7 +474,7 @@ def hydrostat(p, pressure, branch):
         e = compaction_strain(a, b, pressure)
         inverse_R = math.exp(-e)
         return 1.0 - inverse_R, inverse_R * inverse_R / (a + b * e + b)
-    p_lock = lock_pressure(p)
+    p_lock = p[Q_LOCK]
     if branch < p_lock:
         return pressure / p[BULK], 1.0 / p[BULK]
     return p[ETA] + (pressure - p_lock) / p[LOCKED], 1.0 / p[LOCKED]
@@ -535,19 +540,43 @@ def _radial_stress(p, pressure):
 @njit(cache=True, error_model="numpy")
 def _split_step(p, t, s, U, h, s_kink, floor):
     """The part of the RK4 step from ``t`` (length ``h``) that ends where ``s`` reaches
-    ``s_kink`` (``s`` below it), by bisection on its length with the law's pieces kept below
-    the kink; returns ``(length, s, U)`` there."""
+    ``s_kink`` (``s`` below it), with the law's pieces kept below the kink; returns
+    ``(length, s, U)`` there.
+
+    The length ``l`` solves ``s_l = s_kink``, ``s_l`` the RK4 update over the length ``l`` (a
+    polynomial in ``l`` where the law is smooth): Illinois regula falsi on the bracket
+    ``(0, h)``, the end past the kink kept (``s_l >= s_kink``, or not finite: a stage turned
+    sonic, then a bisection step), to ``|bracket| <= 4 eps |h|``; the state is the one at that
+    end. (A bisection to the last bit took 65 RK4 updates; this takes about 8.)"""
     ceiling = s_kink - 1e-12 * (1.0 + abs(s_kink))
     lo, hi = 0.0, h
-    for _ in range(64):
+    f_lo = s - s_kink
+    s_hi, U_hi = _rk4(p, t, s, U, h, floor, ceiling)
+    f_hi = s_hi - s_kink  # NaN where a stage turned sonic
+    kept = 0  # the end kept by the last update: -1 lo, +1 hi
+    for _ in range(200):
+        if abs(hi - lo) <= 4.0 * EPS * abs(h):
+            break
         mid = 0.5 * (lo + hi)
-        s_mid = _rk4(p, t, s, U, mid, floor, ceiling)[0]
-        if math.isfinite(s_mid) and s_mid < s_kink:
-            lo = mid
+        if math.isfinite(f_hi) and f_hi > f_lo:
+            secant = hi - f_hi * (hi - lo) / (f_hi - f_lo)
+            if min(lo, hi) < secant < max(lo, hi):
+                mid = secant
+        s_mid, U_mid = _rk4(p, t, s, U, mid, floor, ceiling)
+        f_mid = s_mid - s_kink
+        if f_mid < 0.0:  # below the kink (False for NaN)
+            lo, f_lo = mid, f_mid
+            if kept == 1:
+                f_hi *= 0.5
+            kept = 1
         else:
-            hi = mid
-    s_end, U_end = _rk4(p, t, s, U, hi, floor, ceiling)
-    return hi, s_end, U_end
+            hi, s_hi, U_hi, f_hi = mid, s_mid, U_mid, f_mid
+            if f_mid == 0.0:
+                break
+            if kept == -1:
+                f_lo *= 0.5
+            kept = -1
+    return hi, s_hi, U_hi
 
 
 @njit(cache=True, error_model="numpy")
@@ -804,6 +833,11 @@ REFINE_DEPTH = 8  # NaN pockets cut out of one bracket at most
 # phi = 40.9, joint front; 139.6 MPa, phi = 26.3, cracked) are kept as the old solver kept
 # them, their U(1) - 1 in the solution (CavitySolution.residual)
 RESIDUAL_TOLERANCE = 0.1
+# The scan's sign tests (grid and edges) run the residual at SCAN_STEPS RK4 steps first and
+# take its sign where it lies at least SCAN_MARGIN from zero, else the residual at the
+# solution's steps (:func:`_screened`); Brent's method always runs on the latter.
+SCAN_STEPS = 64
+SCAN_MARGIN = 0.1
 
 
 class NoSolution(CavexNumericalError):
@@ -818,6 +852,11 @@ class NoSolution(CavexNumericalError):
 
 class _NaNResidual(Exception):
     """The residual is NaN (no admissible state) at a point Brent's method asked for."""
+
+
+class _ScreenMismatch(Exception):
+    """The residual has one sign at both ends of a bracket whose screened values
+    (:func:`_screened`) changed sign: the scan is run again unscreened."""
 
 
 def _finite_edge(residual, finite, beyond, halvings=EDGE_HALVINGS):
@@ -839,7 +878,8 @@ def _finite_edge(residual, finite, beyond, halvings=EDGE_HALVINGS):
 
 def _brent(residual, a, b):
     """Brent's method (scipy ``brentq``, ``xtol = rtol = XTOL``) on a sign change; raises
-    :class:`_NaNResidual` (with the point) where the residual is NaN."""
+    :class:`_NaNResidual` (with the point) where the residual is NaN and
+    :class:`_ScreenMismatch` where it has one sign at both ends."""
     from scipy.optimize import brentq
 
     def finite(x):
@@ -848,7 +888,10 @@ def _brent(residual, a, b):
             raise _NaNResidual(x)
         return value
 
-    return brentq(finite, a, b, xtol=XTOL, rtol=XTOL, maxiter=200)
+    try:
+        return brentq(finite, a, b, xtol=XTOL, rtol=XTOL, maxiter=200)
+    except ValueError as exc:  # f(a) and f(b) of one sign (brentq's only ValueError here)
+        raise _ScreenMismatch(a, b) from exc
 
 
 def _last_finite(residual, finite, nan, halvings=EDGE_HALVINGS):
@@ -894,22 +937,40 @@ def _refine(residual, lower, upper, depth=0):
     return None
 
 
-def _roots(residual, lo, hi, summary=None, points=BRACKET_POINTS):
+def _screened(residual, coarse):
+    """``residual`` for the scan's sign tests: ``coarse(x)`` (the same residual at
+    :data:`SCAN_STEPS` RK4 steps, a quarter of the cost) where it is finite and at least
+    :data:`SCAN_MARGIN` from zero, else ``residual(x)``. The two differ by the step error
+    (measured up to 1e-3 of the value, where ``U(1) - 1`` is large) and by the discrete events
+    of the integration (a compaction shock placed at another step: measured up to 0.012 at a
+    value of -8.5e-4, where the scan then asks ``residual``)."""
+    def value(x):
+        v = coarse(x)
+        if math.isfinite(v) and abs(v) >= SCAN_MARGIN:
+            return v
+        return residual(x)
+    return value
+
+
+def _roots(residual, lo, hi, summary=None, points=BRACKET_POINTS, screen=None):
     """The roots of ``residual`` in ``(lo, hi)`` going outward (a generator); the finite values
-    met on the grid are appended to the list ``summary`` (if given).
+    met on the grid are appended to the list ``summary`` (if given). ``screen`` (default
+    ``residual``) gives the grid's and the edges' values, of which only the sign and
+    finiteness are used (:func:`_screened`).
 
     Scans a grid of ``points`` geometric in ``xi``; each sign change between consecutive finite
     values (across NaN points too) is refined (:func:`_refine`). Where the residual turns NaN
     (no admissible state) or finite again, the edge of the finite part is bisected for a sign
     change hidden between the grid point and the edge (:func:`_finite_edge`).
     """
+    screen = residual if screen is None else screen
     previous = None  # last finite (x, value)
     previous_nan = None  # last NaN grid point, if after the last finite one
     for x in np.geomspace(lo, hi, points):
-        value = residual(x)
+        value = screen(x)
         if not math.isfinite(value):
             if previous is not None and previous_nan is None:  # finite -> NaN
-                edge = _finite_edge(residual, previous, x)
+                edge = _finite_edge(screen, previous, x)
                 if edge is not None:
                     root = _refine(residual, previous, edge)
                     if root is not None:
@@ -919,7 +980,7 @@ def _roots(residual, lo, hi, summary=None, points=BRACKET_POINTS):
         if summary is not None:
             summary.append(value)
         if previous_nan is not None:  # NaN -> finite
-            edge = _finite_edge(residual, (x, value), previous_nan)
+            edge = _finite_edge(screen, (x, value), previous_nan)
             if edge is not None:
                 root = _refine(residual, edge, (x, value))
                 if root is not None:
@@ -936,9 +997,34 @@ def _roots(residual, lo, hi, summary=None, points=BRACKET_POINTS):
         previous, previous_nan = (x, value), None
 
 
-def _root(residual, lo, hi, summary=None):
-    """The first root of ``residual`` in ``(lo, hi)`` going outward (:func:`_roots`), or None."""
-    return next(_roots(residual, lo, hi, summary), None)
+def _root(structure, p, steps, lo, hi, summary=None):
+    """The first front speed ``x`` in ``(lo, hi)``, going outward, at which ``structure``'s
+    wall condition holds (:func:`_roots` of ``structure(p, x, steps)[0]``, screened at
+    :data:`SCAN_STEPS`): ``(x, structure(p, x, steps))``, or None. Each ``x`` is integrated
+    once (Brent's last point is the root, which :func:`_refine` checks again)."""
+    memo = {}
+
+    def solution(x):
+        if x not in memo:
+            memo[x] = structure(p, x, steps)
+        return memo[x]
+
+    def residual(x):
+        return solution(x)[0]
+
+    if steps > SCAN_STEPS:
+        screen = _screened(residual, lambda x: structure(p, x, SCAN_STEPS)[0])
+        values = []
+        try:
+            root = next(_roots(residual, lo, hi, values, screen=screen), None)
+        except _ScreenMismatch:  # the scan is run again unscreened
+            root = next(_roots(residual, lo, hi, summary), None)
+        else:
+            if summary is not None:
+                summary.extend(values)
+    else:
+        root = next(_roots(residual, lo, hi, summary), None)
+    return None if root is None else (root, solution(root))
 
 
 def _reason(values):
@@ -995,9 +1081,9 @@ def _solve(material, phi, steps):
     upper = _upper_front(p)
     reasons = {}
     values = []
-    beta = _root(lambda b: elastic_plastic(p, b, steps)[0], 1.0 + 1e-6, upper, values)
-    if beta is not None:
-        residual, S, C = elastic_plastic(p, beta, steps)
+    found = _root(elastic_plastic, p, steps, 1.0 + 1e-6, upper, values)
+    if found is not None:
+        beta, (residual, S, C) = found
         s_a, D_a = elastic_state(p, C, beta)[:2]
         if s_a - D_a >= -p[TENSILE] * (1.0 + 1e-12):
             return CavitySolution(S, phi, ELASTIC_PLASTIC, beta, math.nan, C, residual)
@@ -1007,22 +1093,22 @@ def _solve(material, phi, steps):
     if math.isfinite(p[TENSILE]):
         gamma_hi = min(upper, (1.0 / p[WB]) * (1.0 - 1e-12) if p[WB] > 0.0 else 1e6)
         values = []
-        gamma = _root(lambda g: cracked(p, g, steps)[0], 1.0 + 1e-6, gamma_hi, values)
-        if gamma is not None:
-            residual, S, beta, C = cracked(p, gamma, steps)
+        found = _root(cracked, p, steps, 1.0 + 1e-6, gamma_hi, values)
+        if found is not None:
+            gamma, (residual, S, beta, C) = found
             return CavitySolution(S, phi, CRACKED, beta, gamma, C, residual)
         reasons[CRACKED] = _reason(values)
         values = []
-        beta = _root(lambda b: cracking_plastic(p, b, steps)[0], 1.0 + 1e-6, upper, values)
-        if beta is not None:
-            residual, S, C = cracking_plastic(p, beta, steps)
+        found = _root(cracking_plastic, p, steps, 1.0 + 1e-6, upper, values)
+        if found is not None:
+            beta, (residual, S, C) = found
             return CavitySolution(S, phi, JOINT_FRONT, beta, beta, C, residual)
         reasons[JOINT_FRONT] = _reason(values)
     if p[W] > 0.0:
         values = []
-        beta = _root(lambda b: superseismic(p, b, steps)[0], 1.0 / p[W], 1e4, values)
-        if beta is not None:
-            residual, S = superseismic(p, beta, steps)
+        found = _root(superseismic, p, steps, 1.0 / p[W], 1e4, values)
+        if found is not None:
+            beta, (residual, S) = found
             return CavitySolution(S, phi, SUPERSEISMIC, beta, math.nan, math.nan, residual)
         reasons[SUPERSEISMIC] = _reason(values)
     text = "; ".join(f"{STRUCTURES[k]}: {v}" for k, v in reasons.items())

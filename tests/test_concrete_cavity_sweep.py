@@ -6,6 +6,7 @@ rho = 2400 kg/m^3) and ``phi = rho V^2/f_c`` 0-50, 101 x 100 points: every point
 :class:`~cavex.analytic.concrete_cavity.NoSolution` states why (none is raised on this sweep:
 measured). ``S`` is continuous along the sweep, with tolerances from the measured spread."""
 
+import dataclasses
 import time
 
 import numpy as np
@@ -156,6 +157,37 @@ def test_step_count_refinement(fc, rho, phi):
     order = -np.polyfit(np.log(steps), np.log(errors), 1)[0]
     assert 3.5 < order < 4.5
     assert errors[2] < STEP_TOLERANCE
+
+
+def test_screened_scan_finds_the_unscreened_roots(monkeypatch):
+    """The scan's sign tests at ``SCAN_STEPS`` (docs/concrete.md "Root finding"): every field
+    of the solution (structure, fronts, amplitude, ``S``, residual) to the last bit as with the
+    scan at the solution's 256 steps, on 5 x 6 points across the sweep (measured: all 10 100
+    points of the sweep identical, with 64 and with 32 screening steps)."""
+    def fields(material, phi):
+        return dataclasses.astuple(cc._solve.__wrapped__(material, float(phi), 256))
+
+    for fc in STRENGTHS[::25]:
+        material = concrete_cavity(fc, RHO)
+        for phi in PHIS[::17]:
+            screened = fields(material, phi)
+            with monkeypatch.context() as patch:
+                patch.setattr(cc, "SCAN_STEPS", 256)  # no screening
+                plain = fields(material, phi)
+            np.testing.assert_array_equal(np.array(screened), np.array(plain))
+
+
+def test_a_screen_that_misleads_is_caught():
+    """Where the screened values change sign between two grid points but the residual does
+    not (the screen's sign wrong at a bracket end), Brent's method cannot start; the scan is
+    then run again unscreened and finds the residual's first root. A made-up structure: the
+    residual ``x - 2``, its screen ``x - 3`` (at least SCAN_MARGIN from zero on the grid)."""
+    def structure(p, x, steps):
+        return ((x - 2.0) if steps == 256 else (x - 3.0),)
+
+    x, values = cc._root(structure, None, 256, 1.0, 10.0)
+    assert abs(x - 2.0) < 1e-13 and values == (x - 2.0,)
+    assert abs(cc._root(structure, None, cc.SCAN_STEPS, 1.0, 10.0)[0] - 3.0) < 1e-13
 
 
 def test_no_root_reasons():
