@@ -414,7 +414,14 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
     else, in JSON, CSV and report; the concrete model's depths are
     :func:`model_depth`'s with its option's constants (the recommended model), those of
     :mod:`cavex.analytic.models.li_chen_concrete` Li and Chen's up to 100 MPa, above the concrete
-    model's; the recommended model and its sentence are there."""
+    model's; the recommended model and its sentence are there.
+
+    The run is in this process (``--workers 1``): its 17 cavity tables (one per concrete, 1 s
+    each) are then in :func:`~cavex.analytic.penetration.concrete_table.material_table`'s
+    cache when :func:`model_depth` recomputes the depths, so they are computed once, not twice
+    (the pool of workers is test_validate_reports_by_regime's). No figures (``--no-figures``):
+    test_calibration_file_runs_in_penetrate_and_validate and test_validate_reports_by_regime
+    check them."""
     from cavex.analytic.empirical import li_chen_depth
     from cavex.analytic.models import get
     from cavex.analytic.models.li_chen_concrete import SPLIT_STRENGTH
@@ -423,7 +430,8 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
 
     out_dir = tmp_path / "val"
     code, out, err = run(capsys, "validate", "--shots", SHOTS, "--models", "concrete",
-                         "li-chen-concrete", "forrestal-1994", "--json", "--out", str(out_dir))
+                         "li-chen-concrete", "forrestal-1994", "--json", "--workers", "1",
+                         "--no-figures", "--out", str(out_dir))
     assert code == 0 and err.startswith("cavex: validate 17 shots x 3 models = 51 predictions")
     result = json.loads(out)
     assert result["models"] == ["concrete", "li-chen-concrete", "forrestal-1994"]
