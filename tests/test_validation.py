@@ -312,23 +312,28 @@ def test_ratio_statistics():
 
 # --- calibration ------------------------------------------------------------------------------
 
-def synthetic_file(path, mapping, resistance="derived", boundary="quasi-static"):
-    """The committed shots' inputs with depths predicted by cavex's own model."""
+def synthetic_file(path, mapping, resistance="derived", boundary="quasi-static", every=1):
+    """The committed shots' inputs (every ``every``-th) with depths predicted by cavex's own
+    model."""
     data = read_shots(SHOTS)
     with open(path, "w", newline="") as handle:
         handle.write("# synthetic: depths from cavex's derived quasi-static model\n")
         writer = csv.writer(handle)
         writer.writerow(COLUMNS.split(","))
-        for s in data.shots:
+        for s in data.shots[::every]:
             writer.writerow([s.id, s.mass, s.diameter, s.length, s.crh, s.V0, s.fc, s.rho,
                              repr(closed_form_depth(s, resistance, boundary=boundary,
                                                     mapping=mapping))])
 
 
 def test_synthetic_shots_calibrate_back_to_their_parameters(capsys, tmp_path):
+    """Depths made by a model under known parameters are fitted back to them. Every third
+    shot of the file (6 of 17; f_c 32-91 MPa, V0 561-800 m/s): shots made without noise by
+    the model being fitted are fitted exactly by any set that determines the parameters, so
+    the 11 others (each a dozen flights per Jacobian) would add time, not a check."""
     truth = Mapping(lam=0.45, strength_factor=0.7)
     shots_path = tmp_path / "synthetic.csv"
-    synthetic_file(shots_path, truth)
+    synthetic_file(shots_path, truth, every=3)
     cal = tmp_path / "cal.toml"
     code, out, err = run(capsys, "calibrate", "--shots", str(shots_path), "--out", str(cal),
                          "--resistance", "derived", "--boundary", "quasi-static")
@@ -403,8 +408,9 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     for png in ("predicted_vs_measured.png", "ratio_vs_velocity.png"):
         assert (out_dir / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     first = (out_dir / "validation.json").read_text()
+    # (the rerun draws no figures: validation.json, compared, does not depend on them)
     code, out, err = run(capsys, "validate", "--shots", str(small), "--calibration", str(cal),
-                         "--out", str(out_dir))
+                         "--no-figures", "--out", str(out_dir))
     assert code == 0 and "FE tables built 0, reused 2" in out
     assert (out_dir / "validation.json").read_text() == first
 
