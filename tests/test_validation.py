@@ -415,23 +415,34 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     assert (out_dir / "validation.json").read_text() == first
 
 
-def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
+@pytest.fixture(scope="module")
+def forrestal_concrete_depths():
+    """``{shot id: depth}`` of the concrete model (its option's constants) for :data:`SHOTS`,
+    computed in this process: their 17 cavity tables (one per concrete, about 1 s each) are
+    then in :func:`~cavex.analytic.penetration.concrete_table.material_table`'s cache, where
+    the validate runs of this module find them (in this process, or in the workers it forks,
+    which inherit it), so this module computes them once."""
+    from cavex.analytic.models import get
+    from cavex.analytic.penetration.concrete_table import model_depth
+
+    return {shot.id: model_depth(shot, get("concrete").constants(shot))
+            for shot in read_shots(SHOTS).shots}
+
+
+def test_validate_models_runs_only_the_named_models(capsys, tmp_path, forrestal_concrete_depths):
     """``--models concrete li-chen-concrete forrestal-1994``: those three columns and nothing
     else, in JSON, CSV and report; the concrete model's depths are
     :func:`model_depth`'s with its option's constants (the recommended model), those of
     :mod:`cavex.analytic.models.li_chen_concrete` Li and Chen's up to 100 MPa, above the concrete
     model's; the recommended model and its sentence are there.
 
-    The run is in this process (``--workers 1``): its 17 cavity tables (one per concrete, 1 s
-    each) are then in :func:`~cavex.analytic.penetration.concrete_table.material_table`'s
-    cache when :func:`model_depth` recomputes the depths, so they are computed once, not twice
-    (the pool of workers is test_validate_reports_by_regime's). No figures (``--no-figures``):
+    The run is in this process (``--workers 1``), where the expected depths
+    (:func:`forrestal_concrete_depths`) left the cavity tables cached; the pool of workers is
+    test_validate_reports_by_regime's. No figures (``--no-figures``):
     test_calibration_file_runs_in_penetrate_and_validate and test_validate_reports_by_regime
     check them."""
     from cavex.analytic.empirical import li_chen_depth
-    from cavex.analytic.models import get
     from cavex.analytic.models.li_chen_concrete import SPLIT_STRENGTH
-    from cavex.analytic.penetration.concrete_table import model_depth
     from cavex.verification.report.validation_markdown import recommendation
 
     out_dir = tmp_path / "val"
@@ -452,7 +463,7 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
                  else row["predicted_m"]["concrete"])  # F94-41 and F94-46 are above
         assert row["predicted_m"]["li-chen-concrete"] == pytest.approx(split, rel=DIGITS_6)
         assert row["predicted_m"]["concrete"] == pytest.approx(
-            model_depth(shot, get("concrete").constants(shot)), rel=DIGITS_6)
+            forrestal_concrete_depths[shot.id], rel=DIGITS_6)
         assert row["predicted_m"]["forrestal-1994"] == pytest.approx(
             empirical.shot_depth(shot), rel=DIGITS_6)
     header = (out_dir / "predictions.csv").read_text().splitlines()[0].split(",")
@@ -465,11 +476,12 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
     assert "| derived-dynamic |" not in report and "| table |" not in report
 
 
-def test_validate_reports_by_regime(capsys, tmp_path):
+def test_validate_reports_by_regime(capsys, tmp_path, forrestal_concrete_depths):
     """Every regime's statistics recomputed here from the per-shot JSON (the regime of a shot
     from its f_c, V0 and flag written beside it), Li and Chen's column equal to
     :func:`li_chen_depth`, the flag equal to :func:`rigid_flag`,
-    the regime table in the report and both regime figures written."""
+    the regime table in the report and both regime figures written. (The cavity tables:
+    :func:`forrestal_concrete_depths`'s, inherited by the run's forked workers.)"""
     from cavex.analytic.empirical import li_chen_depth
     from cavex.analytic.penetration.concrete_table import TableResistance
     from cavex.verification.validation.regimes import rigid_flag
