@@ -369,7 +369,7 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     assert abs(math.log(data["calibration"]["strength_factor"])) > 0.1  # it moved
     assert data["calibration"]["reference_shot"] == "F94-52"
     code, out, err = run(capsys, "penetrate", "--config", str(cal), "--boundary", "quasi-static",
-                         "--json", "--out", str(tmp_path / "pen"))
+                         "--json", "--no-figures", "--out", str(tmp_path / "pen"))
     assert (code, err) == (0, "")
     final = json.loads(out)["phases"][-1]["end_depth_m"]
     out_dir = tmp_path / "val"
