@@ -132,7 +132,6 @@ def test_a_signal_leaves_out_untouched_or_complete(tmp_path, sig, moment, capsys
         assert "Traceback" not in err_path.read_text()
     # the next run completes into the same folder and removes a stage kill -9 left
     monkeypatch.setenv("CAVEX_CACHE_DIR", str(cache))
-    capsys.readouterr()
     assert main(command[3:]) == 0, capsys.readouterr().err
     assert check_untouched_or_complete(out) == "complete"
     assert not [p for p in out.iterdir() if p.name.startswith(STAGE_PREFIX)]
