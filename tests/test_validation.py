@@ -312,23 +312,28 @@ def test_ratio_statistics():
 
 # --- calibration ------------------------------------------------------------------------------
 
-def synthetic_file(path, mapping, resistance="derived", boundary="quasi-static"):
-    """The committed shots' inputs with depths predicted by cavex's own model."""
+def synthetic_file(path, mapping, resistance="derived", boundary="quasi-static", every=1):
+    """The committed shots' inputs (every ``every``-th) with depths predicted by cavex's own
+    model."""
     data = read_shots(SHOTS)
     with open(path, "w", newline="") as handle:
         handle.write("# synthetic: depths from cavex's derived quasi-static model\n")
         writer = csv.writer(handle)
         writer.writerow(COLUMNS.split(","))
-        for s in data.shots:
+        for s in data.shots[::every]:
             writer.writerow([s.id, s.mass, s.diameter, s.length, s.crh, s.V0, s.fc, s.rho,
                              repr(closed_form_depth(s, resistance, boundary=boundary,
                                                     mapping=mapping))])
 
 
 def test_synthetic_shots_calibrate_back_to_their_parameters(capsys, tmp_path):
+    """Depths made by a model under known parameters are fitted back to them. Every third
+    shot of the file (6 of 17; f_c 32-91 MPa, V0 561-800 m/s): shots made without noise by
+    the model being fitted are fitted exactly by any set that determines the parameters, so
+    the 11 others (each a dozen flights per Jacobian) would add time, not a check."""
     truth = Mapping(lam=0.45, strength_factor=0.7)
     shots_path = tmp_path / "synthetic.csv"
-    synthetic_file(shots_path, truth)
+    synthetic_file(shots_path, truth, every=3)
     cal = tmp_path / "cal.toml"
     code, out, err = run(capsys, "calibrate", "--shots", str(shots_path), "--out", str(cal),
                          "--resistance", "derived", "--boundary", "quasi-static")
@@ -364,7 +369,7 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     assert abs(math.log(data["calibration"]["strength_factor"])) > 0.1  # it moved
     assert data["calibration"]["reference_shot"] == "F94-52"
     code, out, err = run(capsys, "penetrate", "--config", str(cal), "--boundary", "quasi-static",
-                         "--json", "--out", str(tmp_path / "pen"))
+                         "--json", "--no-figures", "--out", str(tmp_path / "pen"))
     assert (code, err) == (0, "")
     final = json.loads(out)["phases"][-1]["end_depth_m"]
     out_dir = tmp_path / "val"
@@ -403,27 +408,47 @@ def test_calibration_file_runs_in_penetrate_and_validate(capsys, tmp_path):
     for png in ("predicted_vs_measured.png", "ratio_vs_velocity.png"):
         assert (out_dir / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     first = (out_dir / "validation.json").read_text()
+    # (the rerun draws no figures: validation.json, compared, does not depend on them)
     code, out, err = run(capsys, "validate", "--shots", str(small), "--calibration", str(cal),
-                         "--out", str(out_dir))
+                         "--no-figures", "--out", str(out_dir))
     assert code == 0 and "FE tables built 0, reused 2" in out
     assert (out_dir / "validation.json").read_text() == first
 
 
-def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
+@pytest.fixture(scope="module")
+def forrestal_concrete_depths():
+    """``{shot id: depth}`` of the concrete model (its option's constants) for :data:`SHOTS`,
+    computed in this process: their 17 cavity tables (one per concrete, about 1 s each) are
+    then in :func:`~cavex.analytic.penetration.concrete_table.material_table`'s cache, where
+    the validate runs of this module find them (in this process, or in the workers it forks,
+    which inherit it), so this module computes them once."""
+    from cavex.analytic.models import get
+    from cavex.analytic.penetration.concrete_table import model_depth
+
+    return {shot.id: model_depth(shot, get("concrete").constants(shot))
+            for shot in read_shots(SHOTS).shots}
+
+
+def test_validate_models_runs_only_the_named_models(capsys, tmp_path, forrestal_concrete_depths):
     """``--models concrete li-chen-concrete forrestal-1994``: those three columns and nothing
     else, in JSON, CSV and report; the concrete model's depths are
     :func:`model_depth`'s with its option's constants (the recommended model), those of
     :mod:`cavex.analytic.models.li_chen_concrete` Li and Chen's up to 100 MPa, above the concrete
-    model's; the recommended model and its sentence are there."""
+    model's; the recommended model and its sentence are there.
+
+    The run is in this process (``--workers 1``), where the expected depths
+    (:func:`forrestal_concrete_depths`) left the cavity tables cached; the pool of workers is
+    test_validate_reports_by_regime's. No figures (``--no-figures``):
+    test_calibration_file_runs_in_penetrate_and_validate and test_validate_reports_by_regime
+    check them."""
     from cavex.analytic.empirical import li_chen_depth
-    from cavex.analytic.models import get
     from cavex.analytic.models.li_chen_concrete import SPLIT_STRENGTH
-    from cavex.analytic.penetration.concrete_table import model_depth
     from cavex.verification.report.validation_markdown import recommendation
 
     out_dir = tmp_path / "val"
     code, out, err = run(capsys, "validate", "--shots", SHOTS, "--models", "concrete",
-                         "li-chen-concrete", "forrestal-1994", "--json", "--out", str(out_dir))
+                         "li-chen-concrete", "forrestal-1994", "--json", "--workers", "1",
+                         "--no-figures", "--out", str(out_dir))
     assert code == 0 and err.startswith("cavex: validate 17 shots x 3 models = 51 predictions")
     result = json.loads(out)
     assert result["models"] == ["concrete", "li-chen-concrete", "forrestal-1994"]
@@ -438,7 +463,7 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
                  else row["predicted_m"]["concrete"])  # F94-41 and F94-46 are above
         assert row["predicted_m"]["li-chen-concrete"] == pytest.approx(split, rel=DIGITS_6)
         assert row["predicted_m"]["concrete"] == pytest.approx(
-            model_depth(shot, get("concrete").constants(shot)), rel=DIGITS_6)
+            forrestal_concrete_depths[shot.id], rel=DIGITS_6)
         assert row["predicted_m"]["forrestal-1994"] == pytest.approx(
             empirical.shot_depth(shot), rel=DIGITS_6)
     header = (out_dir / "predictions.csv").read_text().splitlines()[0].split(",")
@@ -451,11 +476,12 @@ def test_validate_models_runs_only_the_named_models(capsys, tmp_path):
     assert "| derived-dynamic |" not in report and "| table |" not in report
 
 
-def test_validate_reports_by_regime(capsys, tmp_path):
+def test_validate_reports_by_regime(capsys, tmp_path, forrestal_concrete_depths):
     """Every regime's statistics recomputed here from the per-shot JSON (the regime of a shot
     from its f_c, V0 and flag written beside it), Li and Chen's column equal to
     :func:`li_chen_depth`, the flag equal to :func:`rigid_flag`,
-    the regime table in the report and both regime figures written."""
+    the regime table in the report and both regime figures written. (The cavity tables:
+    :func:`forrestal_concrete_depths`'s, inherited by the run's forked workers.)"""
     from cavex.analytic.empirical import li_chen_depth
     from cavex.analytic.penetration.concrete_table import TableResistance
     from cavex.verification.validation.regimes import rigid_flag
