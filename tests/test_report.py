@@ -348,3 +348,38 @@ def test_failed_cell_and_renderer_failure(tmp_path, monkeypatch, capsys):
     _, rows = appendix_rows(md)
     assert [r[:2] for r in rows if r[-1] == "FE FAILED"] == [["1000", "0.5"]]
     assert "Trajectory comparison not possible" in md
+
+
+def _sections(markdown):
+    """``{heading: lines}`` of a report's ``## `` sections (the title part under ``""``)."""
+    sections, heading = {"": []}, ""
+    for line in markdown.splitlines():
+        if line.startswith("## "):
+            heading = line[3:]
+            sections[heading] = []
+        else:
+            sections[heading].append(line)
+    return sections
+
+
+def test_quick_report_without_figures(quick_report, tmp_path):
+    """``cavex verify --quick --no-figures``: no PNG; in ``report.md`` every figure's line says
+    it was not drawn (the stresses' section that line alone, its caption being the picture's
+    message) and every other line is the drawn report's."""
+    from cavex.verification.cli import main
+
+    out = quick_report[0]
+    bare = tmp_path / "bare"
+    assert main(["verify", "--quick", "--no-figures", "--workers", "2", "--no-progress",
+                 "--out", str(bare)]) == 0
+    assert sorted(p.name for p in bare.iterdir()) == ["grid.nc", "report.html", "report.md",
+                                                      "target.toml"]
+    drawn, plain = (_sections(p.read_text()) for p in (out / "report.md", bare / "report.md"))
+    assert list(plain) == list(drawn)
+    stresses = "Stresses around the cavity"
+    assert plain.pop(stresses) == ["", report.NOT_DRAWN, ""]
+    assert drawn.pop(stresses)[1].startswith("![stresses]")
+    for heading, lines in drawn.items():
+        expected = [report.NOT_DRAWN if x.startswith("![") else x for x in lines]
+        assert plain[heading] == expected, heading
+    assert sum(x.startswith("![") for lines in drawn.values() for x in lines) == len(PNGS) - 1

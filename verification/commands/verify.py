@@ -9,6 +9,7 @@ from pathlib import Path
 
 from cavex.verification.commands.shared_options import (
     add_config_option,
+    add_figures_option,
     add_parallel_options,
     scheduler_of,
 )
@@ -23,6 +24,7 @@ def add_arguments(parser):
     parser.add_argument("--quick", action="store_true", help="small grid (under a minute)")
     parser.add_argument("--out", help="report folder (default results/verification)")
     parser.add_argument("--json", action="store_true", help="print JSON")
+    add_figures_option(parser, "report.md, report.html, grid.nc and target.toml")
     add_parallel_options(parser)
 
 
@@ -33,15 +35,15 @@ def run(args, target, projectile):
     refuse_debonded(target, "verify")
     return job(target, projectile, config_path=args.config, quick=args.quick,
                out_dir=args.out, scheduler=scheduler_of(args), workers=args.workers,
-               progress=args.progress)
+               progress=args.progress, draw=args.figures)
 
 
 def job(target, projectile, *, config_path=None, quick=False, out_dir=None, scheduler=None,
-        workers=None, progress=None):
+        workers=None, progress=None, draw=True):
     """Check the output folder and the execution settings, build and write the report
     (:func:`cavex.verification.report.build.verify`, staged); return its result with the
     paths of the folder it was moved to. ``config_path``: the file the target was read from
-    (None: the default target), whose text the report quotes."""
+    (None: the default target), whose text the report quotes; ``draw``: the PNG figures."""
     from cavex.config import default_config_text
     from cavex.verification.fedata.runner import check_execution
     from cavex.verification.output.paths import check_output_dir, staged_output
@@ -55,7 +57,7 @@ def job(target, projectile, *, config_path=None, quick=False, out_dir=None, sche
     with staged_output(out_dir) as stage:
         result = build.verify(target, projectile, quick=quick, out_dir=stage,
                               scheduler=scheduler, workers=workers, config_text=config,
-                              progress=progress)
+                              progress=progress, draw=draw)
         build.remove_report_files(out_dir)  # an old report never mixes with this one
     return _moved(result, stage, out_dir)
 
@@ -85,5 +87,6 @@ def text(summary):
         f"created {summary.get('created') or '?'})",
         f"figure  {summary['picture']}",
         *(f"- {line}" for line in summary["conclusions"]),
-        f"wrote   {summary['files']['report']} (+ html, PNGs, grid.nc) in {summary['out_dir']}",
+        f"wrote   {summary['files']['report']} (+ html, "
+        f"{'PNGs, ' if 'error_maps' in summary['files'] else ''}grid.nc) in {summary['out_dir']}",
     ])

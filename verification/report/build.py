@@ -143,9 +143,13 @@ def curve_velocities(grid):
     return chosen or [v[i] for i in sorted({len(v) // 4, len(v) // 2, len(v) - 1})]
 
 
+#: the report's figures but the trajectories (with the FE-table shots) and the stresses
+FIGURES = ("error_maps", "validity", "S_depth", "states", "plastic_radius", "error_estimate")
+
+
 def figures(grid, target, out, runs=None):
-    """Write every matplotlib figure (the trajectories when ``runs`` are given); returns
-    ``{name: path}``."""
+    """Write every matplotlib figure (:data:`FIGURES`, and the trajectories when ``runs`` are
+    given); returns ``{name: path}``."""
     curves = curve_velocities(grid)
     paths = {"error_maps": plots.error_maps(grid, target, out),
              "validity": plots.validity_map(grid, target, out),
@@ -185,7 +189,7 @@ def write_grid(grid, path, extra):
 
 def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=None,
            config_text=None, velocities=None, depths=None, nu=None, numerics=None,
-           error_target=DEFAULT_ERROR_TARGET, store=None, progress=None):
+           error_target=DEFAULT_ERROR_TARGET, store=None, progress=None, draw=True):
     """Write the verification report of ``target`` into ``out_dir``; return its summary.
 
     Parameters
@@ -216,6 +220,9 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
         Case store of the runner (resumable); default: none (nothing kept on disk).
     progress : bool, optional
         Runner progress bar.
+    draw : bool
+        Draw the PNG figures (default); False (``--no-figures``): none, and the report's
+        sections say where a figure was left out.
 
     Returns
     -------
@@ -243,15 +250,19 @@ def verify(target, projectile, *, quick=False, out_dir, scheduler=None, workers=
     grid = analyse(fe, target, projectile)
     trajectory, runs = trajectories(target, projectile, fe)
     interpolation = table_interpolation_error(target, projectile, fe, runs)
-    pic = picture(target, projectile, grid, out, nu, numerics)
-    paths = figures(grid, target, out, runs)
+    if draw:
+        pic = picture(target, projectile, grid, out, nu, numerics)
+        paths = figures(grid, target, out, runs)
+    else:  # the same keys, no file
+        pic = {"path": None, "message": NOT_DRAWN}
+        paths = dict.fromkeys((*FIGURES, *(("trajectories",) if runs else ())))
     stats = all_stats(grid, target)
     lines = text.conclusions(grid, target, stats)
     if quick:  # the quick table's shot is no reference: say so, with its error estimate
         lines = [text.quick_reference_line(interpolation), *lines]
     info = {"quick": quick, "cells": int(grid["failed"].size), "failed": int(grid["failed"].sum()),
             "picture": pic["message"]}
-    files = {**{k: str(p) for k, p in paths.items()},
+    files = {**{k: str(p) for k, p in paths.items() if p is not None},
              "grid": str(write_grid(grid, out / "grid.nc",
                                     {"report": info,
                                      "trajectories": round_nested(trajectory, TRAJECTORY_DIGITS),
@@ -290,7 +301,13 @@ def _settings_lines(grid, info):
     ]
 
 
+NOT_DRAWN = "(figure not drawn: --no-figures)"
+
+
 def _image(paths, key):
+    """The markdown lines of figure ``key``, or a line saying it was not drawn."""
+    if paths[key] is None:
+        return [NOT_DRAWN, ""]
     return [f"![{key}]({Path(paths[key]).name})", ""]
 
 
