@@ -21,14 +21,22 @@ def default():
 def test_held_debonded_shot_mirrors_to_the_last_bit(default):
     """The load fractions are exchanged between mirror partners (``mirror_state``); the
     integrator sums their Jacobian blocks in mirror pairs: out of plane, spinning, with the
-    zones open, the mirror shot is the mirror image of every state at every step."""
+    zones open, the mirror shot is the mirror image of every state at every step.
+
+    A property of the arithmetic, not of the resolution: it holds at any tolerance, so the
+    shot is flown at rtol 3e-3, where it stops in the macadam after 0.04 s (1 600 steps, 3 s
+    of CPU for the pair, measured). At the default 1e-3 the same shot turns back up through
+    interface 1 and is still moving slowly at the 1 s time limit (nose tip at 0.38 m, 55 000
+    steps, 92 s for the pair: what that run spent its time on, not a property of the mirror)."""
     target, projectile = default
     debonded = target.with_interfaces("debonded")
+    options = {"contact_hold": 1e-6, "rtol": 3e-3}
     a = fly(debonded, projectile, Strike(650.0, 25.0, attack=3.0, attack_plane=50.0,
-                                         spin=200.0), contact_hold=1e-6)
+                                         spin=200.0), **options)
     b = fly(debonded, projectile, Strike(650.0, -25.0, attack=3.0, attack_plane=50.0,
-                                         spin=-200.0), contact_hold=1e-6)
+                                         spin=-200.0), **options)
     assert len(a.model.opened) >= 2
+    assert a.end["state"] == "stopped"  # a shot as flown, not a creep to the time limit
     ya = np.concatenate([s.y for s in a.solutions], axis=1)
     yb = np.concatenate([s.y for s in b.solutions], axis=1)
     assert ya.shape == yb.shape and ya.shape[0] == 14 + a.model.body.areas.size
