@@ -209,10 +209,13 @@ def test_penetrate_draws_a_crater_stop(capsys, tmp_path, drawn):
         not_blank(out / name)
 
 
+# the one-layer shot with attack at 200 m/s: at the default 1000 m/s it took 80 000
+# derivative calls (29 s of CPU; 300 m/s: 25 000), at 200 m/s 1 000 (0.4 s), and what is
+# checked here, the figures drawn and the 3-D block, does not depend on the speed
 @pytest.mark.parametrize(("case", "argv", "config"), [
     ("normal incidence", [], None),
     ("70 deg ricochet", ["--obliquity", "70"], None),
-    ("one layer, with attack", ["--attack", "3"], ONE_LAYER),
+    ("one layer, with attack", ["--attack", "3", "--velocity", "200"], ONE_LAYER),
     ("stops in the crater", [], CRATER_STOP),
 ])
 def test_trajectory_figures(capsys, tmp_path, drawn, case, argv, config):

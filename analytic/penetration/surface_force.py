@@ -253,120 +253,36 @@ def _split_stress(kind, scalars, values, tables, counts, depths, z, middle, wide
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def _element_load(i, y, rot, omega, turning, scale, points, normals, areas, spans, mu,
-                  contact_ramp, bottom, nose, open_zones, walls, wall_depths, tangency, hold,
-                  hold_time, law, radii, zones, out, damping, extra):
-    """Force, moment about the centre of mass (target frame) and power of element ``i``
-    into ``out[0:7]``, its contact damping ``kappa b a^T`` (module docstring, target frame)
-    into ``damping``; returns ``(status, V_n)``. With the held contact (``hold`` > 0)
-    :func:`_held_load` instead (``extra``: its rate and Jacobian rows). ``law``: the stress
-    law's ``(kind, scalars, values, tables, counts, depths)``; ``turning`` the body's ``|omega|``
-    (the state's, one for every element)."""
-    kind, scalars, values, tables, counts, depths = law
-    out[:] = 0.0
-    damping[:, :] = 0.0
-    p0 = rot[0, 0] * points[i, 0] + rot[0, 1] * points[i, 1] + rot[0, 2] * points[i, 2]
-    p1 = rot[1, 0] * points[i, 0] + rot[1, 1] * points[i, 1] + rot[1, 2] * points[i, 2]
-    p2 = rot[2, 0] * points[i, 0] + rot[2, 1] * points[i, 1] + rot[2, 2] * points[i, 2]
-    z = y[2] + p2
-    middle, z_wide, z_narrow = z, 0.0, 0.0  # far from every edge: steps, exact
-    if _near_edge(z, spans[i, 4, 1], bottom, open_zones if not nose[i] else _NO_ZONES,
-                  depths):
-        shift, z_wide, z_narrow = _depth_spread(i, rot, spans)
-        middle = z + shift
-    frac = wetted_fraction(middle, z_wide, z_narrow)[0]  # the part below the free surface
-    if bottom < np.inf:  # and above the bottom
-        frac = max(frac - (1.0 - wetted_fraction(bottom - middle, z_wide, z_narrow)[0]), 0.0)
-    if not nose[i] and open_zones.shape[0] > 0:  # the shank carries no load in an open
-        # zone (crater, scabbed rear zone); the zones are disjoint (merged where they touch),
-        # so the element's part inside their union is the sum of its parts in each
-        inside = 0.0
-        for k in range(open_zones.shape[0]):
-            inside += (wetted_fraction(open_zones[k, 1] - middle, z_wide, z_narrow)[0]
-                       - wetted_fraction(open_zones[k, 0] - middle, z_wide, z_narrow)[0])
-        frac = max(frac - inside, 0.0)
-    if not nose[i] and walls.shape[0] > 0:  # the tunnel-wall factor of the element's layer
-        frac *= walls[np.searchsorted(wall_depths, z, side="right")]
-    if frac <= 0.0 and hold <= 0.0:  # (a held element's fraction moves outside too)
-        return OK, 0.0
-    n0 = rot[0, 0] * normals[i, 0] + rot[0, 1] * normals[i, 1] + rot[0, 2] * normals[i, 2]
-    n1 = rot[1, 0] * normals[i, 0] + rot[1, 1] * normals[i, 1] + rot[1, 2] * normals[i, 2]
-    n2 = rot[2, 0] * normals[i, 0] + rot[2, 1] * normals[i, 1] + rot[2, 2] * normals[i, 2]
-    u0 = y[7] + omega[1] * p2 - omega[2] * p1
-    u1 = y[8] + omega[2] * p0 - omega[0] * p2
-    u2 = y[9] + omega[0] * p1 - omega[1] * p0
-    vn = u0 * n0 + u1 * n1 + u2 * n2
-    if hold > 0.0:
-        return _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, middle,
-                          z_wide, z_narrow, scale, areas, mu, hold, hold_time, law, radii,
-                          zones, out, damping, extra)
-    if abs(vn) <= scale:
-        vn = 0.0
-    ramp = contact_ramp
-    if tangency > 0.0:  # OFPM's attenuation: load x angle / psi within psi of tangency
-        ramp = max(ramp, tangency * math.sqrt(u0 * u0 + u1 * u1 + u2 * u2))
-    shift = wide = narrow = 0.0
-    speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
-    if abs(vn - 0.5 * ramp) < 0.5 * ramp + speed * spans[i, 4, 0] + turning * spans[i, 4, 1]:
-        shift, wide, narrow = _velocity_spread(i, rot, omega, u0, u1, u2, n0, n1, n2, spans)
-        if wide <= scale:  # round-off: V_n does not vary across the element
-            shift = wide = narrow = 0.0
-    wetted, slope = wetted_fraction(vn + shift - 0.5 * ramp, max(wide, ramp), narrow)
-    if wetted <= 0.0:
-        return OK, vn
-    sigma, status = _split_stress(kind, scalars, values, tables, counts, depths, z, middle,
-                                  z_wide, z_narrow, n2, max(vn, 0.0), radii, zones)
-    if status == WALK_FAILED:
-        return status, vn
-    capacity = sigma * areas[i] * frac
-    load = capacity * wetted
-    f0, f1, f2 = -load * n0, -load * n1, -load * n2
-    if mu > 0.0:
-        t0, t1, t2 = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
-        tangential = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-        if tangential > 1e-12:
-            friction = mu * load / tangential
-            f0, f1, f2 = f0 - friction * t0, f1 - friction * t1, f2 - friction * t2
-    out[0], out[1], out[2] = f0, f1, f2
-    out[3] = p1 * f2 - p2 * f1
-    out[4] = p2 * f0 - p0 * f2
-    out[5] = p0 * f1 - p1 * f0
-    out[6] = f0 * u0 + f1 * u1 + f2 * u2
-    if slope > 0.0 and load > 0.0:
-        kappa = capacity * slope  # d load / d V_n = A_i w sigma_n d(wetted)/dV_n
-        a = (n0, n1, n2, p1 * n2 - p2 * n1, p2 * n0 - p0 * n2, p0 * n1 - p1 * n0)
-        b = (-f0 / load, -f1 / load, -f2 / load, -out[3] / load, -out[4] / load,
-             -out[5] / load)
-        for r in range(6):
-            kb = kappa * b[r]
-            for c in range(6):
-                damping[r, c] = kb * a[c]
-    return status, vn
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _held_load(i, y, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z, middle, z_wide, z_narrow,
-               scale, areas, mu, hold, hold_time, law, radii, zones, out, damping, extra):
-    """Element ``i`` under the held contact (module docstring, "Held contact"). Its elastic
-    fraction ``phi = y[14 + i]`` moves at ``V_n / hold`` within ``[0, 1]`` (not at all where
-    ``V_n`` pushes out of them; ``|V_n|`` less the round-off guard ``scale``): an elastic
-    spring of ``hold`` up to the element's capacity, then plastic flow (the wall is cut).
-    With the dashpot of time constant ``hold_time`` the load is
-    ``A_i w sigma_n(z, n_3, max(V_n, 0)) clip(phi + hold_time dphi/dt, 0, 1)``. Writes the
-    force, moment and power into ``out``, ``extra = (dphi/dt, capacity b (6), a / hold (6),
-    0)`` (target frame; rows zero unless the element is elastic: neither its rate nor its
-    fraction clipped) and the dashpot's damping ``capacity hold_time / hold b a^T`` into
-    ``damping``."""
-    extra[:] = 0.0
-    phi = y[14 + i]
+def _held_fraction(phi, vn, scale, hold, hold_time):
+    """``(dphi/dt, load fraction, elastic)`` of an element under the held contact (module
+    docstring, "Held contact"). Its elastic fraction ``phi`` moves at ``V_n / hold`` within
+    ``[0, 1]`` (not at all where ``V_n`` pushes out of them; ``|V_n|`` less the round-off
+    guard ``scale``): an elastic spring of ``hold`` up to the element's capacity, then plastic
+    flow (the wall is cut). With the dashpot of time constant ``hold_time`` its load fraction
+    is ``clip(phi + hold_time dphi/dt, 0, 1)``; elastic: neither the rate nor the fraction
+    clipped."""
     rate = 0.0
     if abs(vn) > scale and not ((phi >= 1.0 and vn > 0.0) or (phi <= 0.0 and vn < 0.0)):
         rate = (vn - scale if vn > 0.0 else vn + scale) / hold  # continuous at the guard
-    extra[0] = rate
     raw = phi + hold_time * rate
     fraction = min(max(raw, 0.0), 1.0)
     elastic = rate != 0.0 and 0.0 < raw < 1.0
-    if frac <= 0.0 or not (fraction > 0.0 or elastic):
-        return OK, 0.0
+    return rate, fraction, elastic
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _held_load(i, rate, fraction, elastic, frac, p0, p1, p2, n0, n1, n2, u0, u1, u2, vn, z,
+               middle, z_wide, z_narrow, areas, mu, hold, hold_time, law, radii, zones, out,
+               damping, extra):
+    """Element ``i`` under the held contact (module docstring, "Held contact"), a loaded one
+    (its ``rate``, ``fraction`` and whether it is ``elastic``: :func:`_held_fraction`).
+    The load is ``A_i w sigma_n(z, n_3, max(V_n, 0)) fraction``. Writes the force, moment
+    and power into ``out``, ``extra = (dphi/dt, capacity b (6), a / hold (6), 0)`` (target
+    frame; rows zero unless the element is elastic: neither its rate nor its fraction
+    clipped) and the dashpot's damping ``capacity hold_time / hold b a^T`` into
+    ``damping``."""
+    extra[:] = 0.0
+    extra[0] = rate
     kind, scalars, values, tables, counts, depths = law
     sigma, status = _split_stress(kind, scalars, values, tables, counts, depths, z, middle,
                                   z_wide, z_narrow, n2, max(vn, 0.0), radii, zones)
@@ -438,18 +354,123 @@ def surface_loads(y, points, normals, areas, spans, partners, length, mu, contac
         if j < i:
             continue
         for second in range(2 if j != i else 1):
+            # element k's force, moment about the centre of mass (target frame) and power
+            # into out[0:7], its contact damping kappa b a^T (module docstring, target frame)
+            # into out_damping, with the held contact its rate and Jacobian rows into extra
+            # (_held_load). Written out here, not called: numba binds a called function's
+            # twenty arrays anew for every element, reference counted, which took 60 % of a
+            # derivative call (issue 30). ``break`` ends the element.
             k = j if second else i
-            result = other if second else one
-            result_damping = other_damping if second else one_damping
-            status, vn = _element_load(k, y, rot, omega, turning, scale, points, normals, areas,
-                                       spans,
-                                       mu, contact_ramp, bottom, nose, open_zones, walls,
-                                       wall_depths, tangency, hold, hold_time, law, radii,
-                                       zones, result, result_damping, extra)
+            out = other if second else one
+            out_damping = other_damping if second else one_damping
+            status, vn = OK, 0.0
+            for _ in range(1):
+                for r in range(7):
+                    out[r] = 0.0
+                for r in range(6):
+                    for c in range(6):
+                        out_damping[r, c] = 0.0
+                x0, x1, x2 = points[k, 0], points[k, 1], points[k, 2]
+                p0 = rot[0, 0] * x0 + rot[0, 1] * x1 + rot[0, 2] * x2
+                p1 = rot[1, 0] * x0 + rot[1, 1] * x1 + rot[1, 2] * x2
+                p2 = rot[2, 0] * x0 + rot[2, 1] * x1 + rot[2, 2] * x2
+                z = y[2] + p2
+                middle, z_wide, z_narrow = z, 0.0, 0.0  # far from every edge: steps, exact
+                if _near_edge(z, spans[k, 4, 1], bottom,
+                              open_zones if not nose[k] else _NO_ZONES, depths):
+                    shift, z_wide, z_narrow = _depth_spread(k, rot, spans)
+                    middle = z + shift
+                # the part below the free surface
+                frac = wetted_fraction(middle, z_wide, z_narrow)[0]
+                if bottom < np.inf:  # and above the bottom
+                    frac = max(frac - (1.0 - wetted_fraction(bottom - middle, z_wide,
+                                                             z_narrow)[0]), 0.0)
+                if not nose[k] and open_zones.shape[0] > 0:  # the shank carries no load in
+                    # an open zone (crater, scabbed rear zone); the zones are disjoint (merged
+                    # where they touch), so the element's part inside their union is the sum
+                    # of its parts in each
+                    inside = 0.0
+                    for zone in range(open_zones.shape[0]):
+                        inside += (wetted_fraction(open_zones[zone, 1] - middle, z_wide,
+                                                   z_narrow)[0]
+                                   - wetted_fraction(open_zones[zone, 0] - middle, z_wide,
+                                                     z_narrow)[0])
+                    frac = max(frac - inside, 0.0)
+                if not nose[k] and walls.shape[0] > 0:  # the tunnel-wall factor of its layer
+                    frac *= walls[np.searchsorted(wall_depths, z, side="right")]
+                if frac <= 0.0 and hold <= 0.0:  # (a held element's fraction moves outside)
+                    break
+                x0, x1, x2 = normals[k, 0], normals[k, 1], normals[k, 2]
+                n0 = rot[0, 0] * x0 + rot[0, 1] * x1 + rot[0, 2] * x2
+                n1 = rot[1, 0] * x0 + rot[1, 1] * x1 + rot[1, 2] * x2
+                n2 = rot[2, 0] * x0 + rot[2, 1] * x1 + rot[2, 2] * x2
+                u0 = y[7] + omega[1] * p2 - omega[2] * p1
+                u1 = y[8] + omega[2] * p0 - omega[0] * p2
+                u2 = y[9] + omega[0] * p1 - omega[1] * p0
+                vn = u0 * n0 + u1 * n1 + u2 * n2
+                if hold > 0.0:
+                    rate, fraction, elastic = _held_fraction(y[14 + k], vn, scale, hold,
+                                                             hold_time)
+                    if frac <= 0.0 or not (fraction > 0.0 or elastic):  # carries nothing
+                        for r in range(14):
+                            extra[r] = 0.0
+                        extra[0] = rate
+                        vn = 0.0
+                        break
+                    status, vn = _held_load(k, rate, fraction, elastic, frac, p0, p1, p2, n0,
+                                            n1, n2, u0, u1, u2, vn, z, middle, z_wide,
+                                            z_narrow, areas, mu, hold, hold_time, law, radii,
+                                            zones, out, out_damping, extra)
+                    break
+                if abs(vn) <= scale:
+                    vn = 0.0
+                ramp = contact_ramp
+                if tangency > 0.0:  # OFPM's attenuation: load x angle / psi within psi of
+                    # tangency
+                    ramp = max(ramp, tangency * math.sqrt(u0 * u0 + u1 * u1 + u2 * u2))
+                shift = wide = narrow = 0.0
+                speed = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+                if abs(vn - 0.5 * ramp) < (0.5 * ramp + speed * spans[k, 4, 0]
+                                           + turning * spans[k, 4, 1]):
+                    shift, wide, narrow = _velocity_spread(k, rot, omega, u0, u1, u2, n0, n1,
+                                                           n2, spans)
+                    if wide <= scale:  # round-off: V_n does not vary across the element
+                        shift = wide = narrow = 0.0
+                wetted, slope = wetted_fraction(vn + shift - 0.5 * ramp, max(wide, ramp),
+                                                narrow)
+                if wetted <= 0.0:
+                    break
+                sigma, status = _split_stress(kind, scalars, values, tables, counts, depths, z,
+                                              middle, z_wide, z_narrow, n2, max(vn, 0.0),
+                                              radii, zones)
+                if status == WALK_FAILED:
+                    break
+                capacity = sigma * areas[k] * frac
+                load = capacity * wetted
+                f0, f1, f2 = -load * n0, -load * n1, -load * n2
+                if mu > 0.0:
+                    t0, t1, t2 = u0 - vn * n0, u1 - vn * n1, u2 - vn * n2
+                    tangential = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+                    if tangential > 1e-12:
+                        friction = mu * load / tangential
+                        f0, f1, f2 = f0 - friction * t0, f1 - friction * t1, f2 - friction * t2
+                out[0], out[1], out[2] = f0, f1, f2
+                out[3] = p1 * f2 - p2 * f1
+                out[4] = p2 * f0 - p0 * f2
+                out[5] = p0 * f1 - p1 * f0
+                out[6] = f0 * u0 + f1 * u1 + f2 * u2
+                if slope > 0.0 and load > 0.0:
+                    kappa = capacity * slope  # d load / d V_n = A_i w sigma_n d(wetted)/dV_n
+                    a = (n0, n1, n2, p1 * n2 - p2 * n1, p2 * n0 - p0 * n2, p0 * n1 - p1 * n0)
+                    b = (-f0 / load, -f1 / load, -f2 / load, -out[3] / load, -out[4] / load,
+                         -out[5] / load)
+                    for r in range(6):
+                        kb = kappa * b[r]
+                        for c in range(6):
+                            out_damping[r, c] = kb * a[c]
             if hold > 0.0:  # the rate and the Jacobian rows, turned to the state's frames
-                held[k, 0:7] = extra[0:7]
-                held[k, 7:10] = extra[7:10]
-                held[k, 13] = extra[13]
+                for r in range(14):
+                    held[k, r] = extra[r]
                 for r in range(3):
                     held[k, 4 + r] = (rot[0, r] * extra[4] + rot[1, r] * extra[5]
                                       + rot[2, r] * extra[6])
@@ -460,10 +481,16 @@ def surface_loads(y, points, normals, areas, spans, partners, length, mu, contac
             elif status != OK:
                 return total[0:3], total[3:6], total[6], status, vn, damping, held
         if j != i:
-            one += other
-            one_damping += other_damping
-        total += one
-        damping += one_damping
+            for r in range(7):
+                one[r] += other[r]
+            for r in range(6):
+                for c in range(6):
+                    one_damping[r, c] += other_damping[r, c]
+        for r in range(7):
+            total[r] += one[r]
+        for r in range(6):
+            for c in range(6):
+                damping[r, c] += one_damping[r, c]
     moment = rot.T @ total[3:6]
     # to the state's frames: omega_t = R omega, body moment R^T M
     turned = damping.copy()
