@@ -11,6 +11,7 @@ temporary cache covers the fixtures of wider scope.
 
 import os
 import shutil
+import signal
 import tempfile
 
 import pytest
@@ -45,6 +46,18 @@ def pytest_collection_modifyitems(items):
     within a module and of the other modules is kept)."""
     rank = {name: k for k, name in enumerate(HEAVY_FIRST)}
     items.sort(key=lambda item: rank.get(item.path.name, len(rank)))
+
+
+@pytest.fixture(autouse=True, scope="session")
+def interruptible():
+    """Ctrl-C reaches the suite's processes as it reaches a user's. A suite started where SIGINT
+    is ignored (a background job of a shell without job control) passes the ignore on to every
+    process it starts, and cavex keeps an ignored signal ignored (``staged_output``), so the
+    tests that interrupt a run could not: the default handler is restored (its children then
+    start with SIGINT at its default)."""
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
 
 
 @pytest.fixture(autouse=True)
