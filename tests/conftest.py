@@ -27,18 +27,20 @@ def pytest_unconfigure(config):
     shutil.rmtree(_SESSION_CACHE, ignore_errors=True)
 
 
-# The modules with the largest summed durations (measured 2026-11-27, largest first: the held
-# contact's 3-D runs, the concrete solver's 10 100-point sweep, the edge cases, the signal
-# faults). They run first, so that on two workers (pyproject addopts: each module on one
-# worker, taken in collection order, --no-loadscope-reorder) no long module starts last while
-# the other worker idles. The concrete sweep comes second so that the second worker does not
-# compile the held contact's 3-D kernel at the same time as the first (46 s of CPU on a cold
-# numba cache, measured): by the time it reaches the balances the first has cached it.
-HEAVY_FIRST = ("test_contact_hold.py", "test_concrete_cavity_sweep.py",
-               "test_contact_hold_balances.py", "test_edges.py",
-               "test_faults_signals.py", "test_interfaces.py", "test_validation.py",
-               "test_entry_crater.py", "test_command_figures.py", "test_adversarial.py",
-               "test_oblique.py")
+# The modules with the largest summed durations (measured 2026-11-27, fourth session, warm
+# caches, largest first: the concrete solver's 10 100-point sweep about 120 s, the held
+# contact's added-turn series about 35 s, the signal faults about 45 s in 13 runs, the edge
+# cases, the documentation site with its notebooks, the 3-D integrator's checks). They run
+# first, so that on two workers (pyproject addopts: each module on one worker, taken in
+# collection order, --no-loadscope-reorder) no long module starts last while the other worker
+# idles. The held contact comes second, so that the 3-D kernel is compiled by one worker (46 s
+# of CPU on a cold numba cache, measured) while the other runs the sweep.
+HEAVY_FIRST = ("test_concrete_cavity_sweep.py", "test_contact_hold.py",
+               "test_faults_signals.py", "test_edges.py", "test_docs_site.py",
+               "test_oblique.py", "test_plain_law_1d.py", "test_validation.py",
+               "test_notebooks.py", "test_interfaces.py", "test_adversarial.py",
+               "test_contact_hold_balances.py", "test_entry_crater.py",
+               "test_command_figures.py")
 
 
 def pytest_collection_modifyitems(items):
