@@ -150,7 +150,8 @@ def test_verify(capsys, tmp_path, monkeypatch):
 
     monkeypatch.setattr(report, "verify", functools.partial(
         report.verify, velocities=[0.0, 1000.0], depths=[0.3, 0.8]))
-    document = run_json(capsys, "verify", "--quick", "--out", str(tmp_path), "--workers", "1")
+    document = run_json(capsys, "verify", "--quick", "--no-figures", "--out", str(tmp_path),
+                        "--workers", "1")
     assert document["cells"] > 0 and offending_keys(document) == []
 
 

@@ -134,7 +134,7 @@ def test_quick_report_names_its_reference_and_brackets_the_default_grid(tmp_path
 
     target, projectile = runway
     summary = report.verify(target, projectile, quick=True, out_dir=tmp_path, workers=2,
-                            config_text=default_config_text())
+                            config_text=default_config_text(), draw=False)  # text only
     line = summary["conclusions"][0]
     assert line.startswith("**Quick report**")
     assert "the full `cavex verify` is the reference" in line
