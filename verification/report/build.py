@@ -151,12 +151,12 @@ def figures(grid, target, out, runs=None):
     """Write every matplotlib figure (:data:`FIGURES`, and the trajectories when ``runs`` are
     given); returns ``{name: path}``."""
     curves = curve_velocities(grid)
-    paths = {"error_maps": plots.error_maps(grid, target, out),
-             "validity": plots.validity_map(grid, target, out),
-             "S_depth": plots.s_curves(grid, target, out, curves),
-             "states": plots.state_map(grid, target, out),
-             "plastic_radius": plots.plastic_radius_plot(grid, target, out, curves),
-             "error_estimate": plots.error_estimate_map(grid, target, out)}
+    paths = dict(zip(FIGURES, (plots.error_maps(grid, target, out),
+                               plots.validity_map(grid, target, out),
+                               plots.s_curves(grid, target, out, curves),
+                               plots.state_map(grid, target, out),
+                               plots.plastic_radius_plot(grid, target, out, curves),
+                               plots.error_estimate_map(grid, target, out)), strict=True))
     if runs:
         paths["trajectories"] = plots.trajectory_plot(runs, target, out)
     return paths
