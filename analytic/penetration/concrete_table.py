@@ -18,7 +18,9 @@ From a shot's columns (``f_c``, ``rho``, projectile mass, diameter, CRH, ``V0``)
 2. **Resistance** (:class:`TableResistance`): the wall stress ``sigma_r(V) = f_c S(rho V^2/f_c)``
    of :mod:`cavex.analytic.concrete_cavity`, tabulated once per concrete (``f_c``, ``rho``) at
    33 velocities uniform in ``V`` up to ``phi = 16 2^n`` (:func:`material_table`, shared by all
-   the shots into that concrete) and interpolated (PCHIP in ``V``), integrated over the tangent
+   the shots into that concrete), the smallest such top above the fastest wall the nose
+   meets (:func:`fastest_wall`, ``V0 cos phi_1``: the wall stress at ``V0`` itself is never
+   asked) and interpolated (PCHIP in ``V``), integrated over the tangent
    ogive by cavex's nose quadrature (:func:`cavex.analytic.penetration.nose.nose_rule`); the
    fitted ``A, B`` (:func:`cavex.analytic.concrete_cavity.fit_AB`) are reported, the depth uses
    the table. Reused: the table per (concrete, top) here, the cavity solution per
@@ -46,7 +48,7 @@ from scipy.interpolate import PchipInterpolator
 from cavex.analytic.concrete_cavity import ConcreteCavity, fit_AB, wall_stress
 from cavex.analytic.empirical import crater_calibres
 from cavex.analytic.penetration.integrator import crater_exit, penetrate
-from cavex.analytic.penetration.nose import nose_rule
+from cavex.analytic.penetration.nose import QUADRATURE_POINTS, nose_rule
 from cavex.concrete import Concrete, Constants
 from cavex.errors import CavexNumericalError
 from cavex.materials import Material, Projectile, Target
@@ -61,6 +63,24 @@ def concrete_cavity(fc, rho, constants=None):
     return ConcreteCavity(**Concrete(fc, rho, constants or Constants()).cavity_parameters())
 
 
+def _ogive(shot):
+    return Projectile.tangent_ogive(shot.mass, shot.diameter, shot.crh, shot.V0)
+
+
+def fastest_wall(shot):
+    """The fastest cavity wall the nose can meet (m/s): the normal velocity at the tip of the
+    tangent ogive at ``V0``, ``V0 cos phi_0``, ``sin phi_0 = (R - r)/R = 1 - 1/(2 psi)``
+    (0.661 ``V0`` at CRH 2). Every element of the nose rule is less steep, so its table
+    reaches every wall velocity the flight asks for, at any number of nose points."""
+    return shot.V0 * math.sqrt(1.0 - (1.0 - 0.5 / shot.crh) ** 2)
+
+
+def shot_table_top(shot):
+    """The table top ``shot`` uses (:func:`table_top` of ``rho`` :func:`fastest_wall`
+    ``^2/f_c``)."""
+    return table_top(shot.rho * fastest_wall(shot) ** 2 / shot.fc)
+
+
 def table_top(phi):
     """Top of the table that covers ``phi``: ``PHI_TOP 2^n``, the smallest such >= ``phi``
     (so that shots into one concrete share a few tables)."""
@@ -68,10 +88,10 @@ def table_top(phi):
 
 
 @lru_cache(maxsize=4096)
-def material_table(material, top):
-    """``(phi, S)`` of ``material`` at ``phi = top (i/(TABLE_POINTS - 1))^2`` (uniform in
-    ``V``), computed once per material and top and shared by every shot that uses it."""
-    phi = top * np.linspace(0.0, 1.0, TABLE_POINTS) ** 2
+def material_table(material, top, points=TABLE_POINTS):
+    """``(phi, S)`` of ``material`` at ``phi = top (i/(points - 1))^2`` (uniform in ``V``),
+    computed once per material and top and shared by every shot that uses it."""
+    phi = top * np.linspace(0.0, 1.0, points) ** 2
     S = wall_stress(material, phi)
     phi.setflags(write=False)
     S.setflags(write=False)
@@ -83,15 +103,19 @@ class TableResistance:
 
     Has the integrator's interface (``force``, ``label``, ``crater_force``); the force does not
     depend on the depth (thick target). ``A, B`` are :func:`fit_AB` over the table up to the
-    shot's ``phi_0 = rho V0^2/f_c`` (at least its first three points).
+    fastest wall the nose meets, ``phi_max = rho`` :func:`fastest_wall` ``^2/f_c`` (at least
+    its first three points).
     """
 
-    def __init__(self, shot, constants=None):
+    def __init__(self, shot, constants=None, *, table_points=TABLE_POINTS,
+                 nose_points=QUADRATURE_POINTS):
         self.shot = shot
         self.material = concrete_cavity(shot.fc, shot.rho, constants)
-        self.phi_max = shot.rho * shot.V0 ** 2 / shot.fc
+        self._cosines, self._weights = nose_rule(_ogive(shot), nose_points)
+        self.top_velocity = fastest_wall(shot)
+        self.phi_max = shot.rho * self.top_velocity ** 2 / shot.fc
         try:
-            phi, self.S = material_table(self.material, table_top(self.phi_max))
+            phi, self.S = material_table(self.material, table_top(self.phi_max), table_points)
         except CavexNumericalError as exc:  # a failed node: every shot into this concrete
             raise CavexNumericalError(
                 f"concrete f_c = {shot.fc / 1e6:g} MPa, rho = {shot.rho:g} kg/m^3: its cavity "
@@ -99,12 +123,11 @@ class TableResistance:
         used = max(3, int(np.searchsorted(phi, self.phi_max, side="right")))
         self.A, self.B = fit_AB(phi[:used], self.S[:used])
         self._stress = PchipInterpolator(np.sqrt(phi * shot.fc / shot.rho), shot.fc * self.S)
-        self._cosines, self._weights = nose_rule(
-            Projectile.tangent_ogive(shot.mass, shot.diameter, shot.crh, shot.V0))
 
     def wall_stress(self, velocity):
-        """``sigma_r`` (Pa) at expansion velocity ``velocity`` (<= V0; clipped to it)."""
-        return self._stress(np.minimum(velocity, self.shot.V0))
+        """``sigma_r`` (Pa) at expansion velocity ``velocity`` (<= :attr:`top_velocity`, the
+        fastest the nose meets; clipped to it)."""
+        return self._stress(np.minimum(velocity, self.top_velocity))
 
     def force(self, depth, velocity):
         return float(np.dot(self._weights, self.wall_stress(velocity * self._cosines)))

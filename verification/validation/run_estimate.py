@@ -155,11 +155,11 @@ def concrete_seconds(clock, shots, erosion):
 
 def cavity_tables(shots):
     """``n_c``: the concrete model's cavity tables ``shots`` need, one per concrete and table
-    top (:func:`~cavex.analytic.penetration.concrete_table.table_top` of each shot's
-    ``rho V0^2/f_c``: shots into one concrete at different speeds need several)."""
-    from cavex.analytic.penetration.concrete_table import table_top
+    top (:func:`~cavex.analytic.penetration.concrete_table.shot_table_top`: shots into one
+    concrete at different speeds need several)."""
+    from cavex.analytic.penetration.concrete_table import shot_table_top
 
-    return len({(s.fc, s.rho, table_top(s.rho * s.V0 ** 2 / s.fc)) for s in shots})
+    return len({(s.fc, s.rho, shot_table_top(s)) for s in shots})
 
 
 def cases_per_table(target, projectile, velocities):
