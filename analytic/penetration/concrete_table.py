@@ -14,7 +14,9 @@ From a shot's columns (``f_c``, ``rho``, projectile mass, diameter, CRH, ``V0``)
      ``S_max = 7`` (Holmquist, Johnson and Cook 1993, HJC);
    - hydrostat of HJC (1993): compaction linear to the locking strain ``mu_l = 0.1``
      (``eta_l = mu_l/(1 + mu_l)``) at the locking pressure ``p_l = 0.8`` GPa, so ``K = p_l/eta_l``;
-     then the solid's ``K_1 = 85`` GPa.
+     then the solid's ``K_1 = 85`` GPa (the ``concrete`` model of ``cavex validate`` takes the
+     locking strain from the porosity law instead, its option chosen on the development shots:
+     :mod:`cavex.analytic.models.concrete`).
 2. **Resistance** (:class:`TableResistance`): the wall stress ``sigma_r(V) = f_c S(rho V^2/f_c)``
    of :mod:`cavex.analytic.concrete_cavity`, tabulated once per concrete (``f_c``, ``rho``) at
    33 velocities uniform in ``V`` up to ``phi = 16 2^n`` (:func:`material_table`, shared by all
@@ -194,5 +196,7 @@ def eroding_nose(law, shot, projectile):
 
 def model_depth(shot, constants=None, erosion=None):
     """Predicted depth (m) of the concrete cavity-expansion model for ``shot`` (``erosion``:
-    :func:`table_depth`)."""
+    :func:`table_depth`). ``constants`` default to :class:`~cavex.concrete.Constants`, HJC's
+    lock strain; the registry's ``concrete`` model (``cavex validate``) passes those of its
+    chosen option, the porosity lock strain (:mod:`cavex.analytic.models.concrete`)."""
     return table_depth(shot, TableResistance(shot, constants), erosion)
