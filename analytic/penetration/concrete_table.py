@@ -49,7 +49,7 @@ from scipy.interpolate import PchipInterpolator
 
 from cavex.analytic.concrete_cavity import ConcreteCavity, fit_AB, wall_stress
 from cavex.analytic.empirical import crater_calibres
-from cavex.analytic.penetration.integrator import crater_exit, penetrate
+from cavex.analytic.penetration.integrator import ATOL, RTOL, crater_exit, penetrate
 from cavex.analytic.penetration.nose import QUADRATURE_POINTS, nose_rule
 from cavex.concrete import Concrete, Constants
 from cavex.errors import CavexNumericalError
@@ -146,18 +146,19 @@ def _target(shot):
     return Target((Material(E=1.0, nu=0.2, rho=shot.rho, lam=0.0, tau=1.0),), ())
 
 
-def table_depth(shot, resistance, erosion=None):
-    """Depth (m) with the crater of :func:`crater_calibres` and cavex's tunnel integrator.
+def table_depth(shot, resistance, erosion=None, *, rtol=RTOL, atol=ATOL):
+    """Depth (m) with the crater of :func:`crater_calibres` and cavex's tunnel integrator
+    (its tolerances ``rtol``, ``atol``).
 
     ``erosion``: an :class:`~cavex.analytic.penetration.erosion.ErosionLaw` (None: rigid).
     Where it is on for the shot, the crater's loss
     (:meth:`~cavex.analytic.penetration.erosion.ErodingNose.crater_loss`) is taken at the
     crater's end and the tunnel flies the eroding nose; the depth is then the eroded nose
     tip's (:func:`table_flight`)."""
-    return table_flight(shot, resistance, erosion)[0]
+    return table_flight(shot, resistance, erosion, rtol=rtol, atol=atol)[0]
 
 
-def table_flight(shot, resistance, erosion=None):
+def table_flight(shot, resistance, erosion=None, *, rtol=RTOL, atol=ATOL):
     """``(depth, eroded)``: :func:`table_depth` and the flight's erosion summary
     (:meth:`~cavex.analytic.penetration.erosion.ErodingNose.summary`; None where the
     projectile flew rigid: no law, a law off at ``V0``, or a crater that stops it)."""
@@ -171,10 +172,11 @@ def table_flight(shot, resistance, erosion=None):
     tunnel = Projectile(r=projectile.r, l=projectile.l, m=projectile.m, V0=v1, R=projectile.R)
     nose = eroding_nose(erosion, shot, projectile)
     if nose is None:
-        return crater + float(penetrate(_target(shot), tunnel, resistance, crater=None)
-                              .depth[-1]), None
+        return crater + float(penetrate(_target(shot), tunnel, resistance, crater=None,
+                                        rtol=rtol, atol=atol).depth[-1]), None
     nose.lost = nose.crater_loss(projectile, 0.5 * shot.mass * (shot.V0 ** 2 - v1 ** 2))
-    eroded = penetrate(_target(shot), tunnel, resistance, crater=None, erosion=nose).erosion
+    eroded = penetrate(_target(shot), tunnel, resistance, crater=None, erosion=nose,
+                       rtol=rtol, atol=atol).erosion
     return crater + eroded["tip_depth_m"], eroded
 
 
