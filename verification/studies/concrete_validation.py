@@ -53,6 +53,12 @@ DEFAULT_OUT = ROOT / "results" / "concrete"
 # ~2e-10), so at 4 digits a flip on another CPU is ~100 times less likely than one unit of
 # the 6th was; a measured depth has 2-3 digits
 DIGITS = 4
+# the integrator's tolerances of the study's flights, tighter than the model's 1e-9 (whose
+# share of a depth is at most 6e-7, docs/concrete.md "Discretisation of the flight"): at 1e-9
+# two CPUs' depths differ by up to 5e-8 where a step is taken differently, enough to flip a
+# 4th digit that lies at a rounding boundary (C380 at S_max = 7, p_l = 0.3 GPa: 0.670950004
+# and 0.670949969 m under the emulation of results/regenerate.sh); at 1e-12 by about 1e-9
+RTOL, ATOL = 1e-12, 1e-15
 FITTED = ("cap", "lock_pressure")
 # the grid of the fitted constants: S_max = tau_max/f_c and the locking pressure p_l (Pa)
 GRID = tuple(itertools.product((4.0, 5.5, 7.0, 10.0, 14.0), (0.3e9, 0.5e9, 0.8e9, 1.2e9)))
@@ -87,7 +93,8 @@ def grid_depths(shots, point):
     out = []
     for s in shots:
         try:
-            out.append(round_significant(table_depth(s, TableResistance(s, constants)), DIGITS))
+            out.append(round_significant(table_depth(s, TableResistance(s, constants),
+                                                     rtol=RTOL, atol=ATOL), DIGITS))
         except (CavexInputError, CavexNumericalError):
             out.append(math.nan)
     return out
