@@ -193,3 +193,44 @@ def test_no_root_reasons():
     assert "lags" in cc._reason([-0.9, -0.2])
     assert "outruns" in cc._reason([0.1, 0.3])
     assert "numerical failure" in cc._reason([-0.2, 0.3])
+
+
+@pytest.mark.parametrize("fc, rho, below, gap, above", [
+    (40.4e6, 2356.0, 255.0, 256.0, 258.0),  # Liu [33]'s concrete
+    (200e6, 2200.0, 97.2, 98.0, 98.8),
+])
+def test_no_solution_band_where_the_front_reaches_the_elastic_wave(fc, rho, below, gap, above):
+    """A known gap of the model, pinned (docs/concrete.md "What is left"): with the porosity
+    lock strain there is a narrow band of phi with no self-similar solution, where the
+    elastic-comminuted structure's front reaches the elastic wave front 1/w (its residual
+    peaks just below zero) and the comminuted shock into undisturbed concrete does not yet
+    exist. On either side S continues the other side's line to 0.13 % (the jump over the
+    band against the linear continuation: 0.02 % and 0.11 % measured here)."""
+    from types import SimpleNamespace
+
+    from cavex.analytic.models import get
+
+    constants = get("concrete").constants(SimpleNamespace(fc=fc, rho=rho), "porosity lock")
+    material = concrete_cavity(fc, rho, constants)
+    with pytest.raises(NoSolution):
+        solve(material, gap)
+    left = [solve(material, phi) for phi in (below - 0.8, below)]
+    right = solve(material, above)
+    assert [s.name for s in left] == ["elastic-comminuted"] * 2
+    assert right.name == "comminuted shock into undisturbed concrete"
+    assert left[1].plastic_front * material.parameters(below)[cc.W] > 0.99  # near 1/w
+    slope = (left[1].S - left[0].S) / 0.8
+    continued = left[1].S + slope * (above - below)
+    assert abs(right.S / continued - 1.0) < 1.3e-3
+
+
+def test_committed_band_table_is_the_code():
+    """One row of results/concrete/no_solution_band.md (the recommended model's lock strain,
+    the development shots' typical concrete) computed again: the same digits."""
+    from pathlib import Path
+
+    from cavex.verification.studies import concrete_band
+
+    table = (Path(__file__).resolve().parents[1] / "results" / "concrete"
+             / "no_solution_band.md").read_text()
+    assert concrete_band.row("porosity lock", 40e6, 2400.0) in table.splitlines()

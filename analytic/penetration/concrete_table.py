@@ -47,7 +47,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.interpolate import PchipInterpolator
 
-from cavex.analytic.concrete_cavity import ConcreteCavity, fit_AB, wall_stress
+from cavex.analytic.concrete_cavity import ConcreteCavity, NoSolution, fit_AB, wall_stress
 from cavex.analytic.empirical import crater_calibres
 from cavex.analytic.penetration.integrator import ATOL, RTOL, crater_exit, penetrate
 from cavex.analytic.penetration.nose import QUADRATURE_POINTS, nose_rule
@@ -89,15 +89,51 @@ def table_top(phi):
     return PHI_TOP * 2.0 ** max(0, math.ceil(math.log2(max(phi, 1e-300) / PHI_TOP)))
 
 
+#: a table node in the band without a self-similar solution moves up by this fraction of its
+#: phi at a time, at most BAND_STEPS times (the bands are 0.9-1.5 % of phi wide:
+#: results/concrete/no_solution_band.md)
+BAND_STEP = 0.0025
+BAND_STEPS = 20
+
+
 @lru_cache(maxsize=4096)
 def material_table(material, top, points=TABLE_POINTS):
     """``(phi, S)`` of ``material`` at ``phi = top (i/(points - 1))^2`` (uniform in ``V``),
-    computed once per material and top and shared by every shot that uses it."""
+    computed once per material and top and shared by every shot that uses it.
+
+    A node that falls in the narrow band of ``phi`` where the cavity has no self-similar
+    solution (where the comminution front reaches the elastic wave: docs/concrete.md "What is
+    left") moves up past it, to the first ``phi (1 + k BAND_STEP)`` that has one (still below
+    the next node; the top node may move above ``top``, so the table still covers it); the
+    interpolant then bridges the band, across which ``S`` continues its line to 0.11 %
+    (``results/concrete/no_solution_band.md``). A node that cannot move past it raises
+    :class:`~cavex.analytic.concrete_cavity.NoSolution`."""
     phi = top * np.linspace(0.0, 1.0, points) ** 2
-    S = wall_stress(material, phi)
+    S = np.empty_like(phi)
+    for i, node in enumerate(phi):
+        phi[i], S[i] = _solved_node(material, float(node),
+                                    phi[i + 1] if i + 1 < points else np.inf)
     phi.setflags(write=False)
     S.setflags(write=False)
     return phi, S
+
+
+def _solved_node(material, node, below):
+    """``(phi, S)`` at ``node``, or at the first ``node (1 + k BAND_STEP) < below`` with a
+    self-similar solution (:func:`material_table`)."""
+    try:
+        return node, wall_stress(material, node)
+    except NoSolution as exc:
+        first = exc
+    for k in range(1, BAND_STEPS + 1):
+        moved = node * (1.0 + k * BAND_STEP)
+        if moved >= below:
+            break
+        try:
+            return moved, wall_stress(material, moved)
+        except NoSolution:
+            continue
+    raise first
 
 
 class TableResistance:
