@@ -21,7 +21,7 @@ From a shot's columns (``f_c``, ``rho``, projectile mass, diameter, CRH, ``V0``)
    of :mod:`cavex.analytic.concrete_cavity`, tabulated once per concrete (``f_c``, ``rho``) at
    33 velocities uniform in ``V`` up to ``phi = 16 2^n`` (:func:`material_table`, shared by all
    the shots into that concrete), the smallest such top above the fastest wall the nose
-   meets (:func:`fastest_wall`, ``V0 cos phi_1``: the wall stress at ``V0`` itself is never
+   meets (:func:`fastest_wall`, ``V0 cos phi_0``: the wall stress at ``V0`` itself is never
    asked) and interpolated (PCHIP in ``V``), integrated over the tangent
    ogive by cavex's nose quadrature (:func:`cavex.analytic.penetration.nose.nose_rule`); the
    fitted ``A, B`` (:func:`cavex.analytic.concrete_cavity.fit_AB`) are reported, the depth uses
