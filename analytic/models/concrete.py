@@ -47,8 +47,8 @@ class Concrete(Model):
     report_words = ("the concrete cavity-expansion model (docs/concrete.md): Mohr-Coulomb "
                     "capped at 7 f_c, radial cracking, compaction to lock-up, every constant "
                     "published (none fitted to shots), its own crater (Li and Chen 2003); the "
-                    "lock strain chosen between two published ones on the development shots; "
-                    "it does not use the mapping below")
+                    "lock strain chosen between two published ones on the development shots "
+                    "(here '{option}'); it does not use the mapping below")
     recommendation_reason = ("one physical model in every regime, every constant published, "
                              "none fitted to shots; the lock strain of its hydrostat chosen "
                              "between two published ones on the development shots")

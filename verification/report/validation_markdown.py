@@ -44,7 +44,7 @@ def model_lines(mapping):
     groups = []  # [labels, words, recommended]
     for model in models(predicts_shots=True):
         words = (model.report_words or model.help or "a registered model").format(
-            nu=mapping["nu"])
+            nu=mapping["nu"], option=model.option)
         if groups and groups[-1][1] == words:
             groups[-1][0].extend(model.labels())
         else:
