@@ -159,7 +159,8 @@ def read_depths(path):
     """``(ids, depths)`` of a written ``table_convergence.csv``."""
     with open(path, newline="") as handle:
         rows = list(csv.reader(handle))
-    assert rows[0][1:] == [column(s) for s in SETTINGS], rows[0]
+    if rows[0][1:] != [column(s) for s in SETTINGS]:
+        raise ValueError(f"{path}: columns {rows[0][1:]} are not this study's settings")
     return [r[0] for r in rows[1:]], np.array([[float(x) for x in r[1:]] for r in rows[1:]])
 
 
