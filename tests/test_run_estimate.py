@@ -1,11 +1,11 @@
 """``cavex validate``'s run estimate (issue 32, item 6): measured by a probe on the run's own
-shots, within 2x of the time the predictions take, naming the models that dominate.
+shots, naming the models that dominate.
 
-The whole-command figures (1000 and 20 000 shots, each model set, on the loaded machine) are
-benchmarks/estimate_accuracy.py's; here a small run in this process."""
+How close it comes to the time taken (within 2x: 1000 and 20 000 shots, each model set, on the
+loaded machine) is benchmarks/estimate_accuracy.py's figure (docs/validation.md); here its
+arithmetic and its naming."""
 
 import re
-import time
 
 import pytest
 
@@ -49,18 +49,35 @@ def test_a_table_counts_its_first_layer_row():
                            velocities) == 9 * 3  # depths 0 and 1 m, and the first layer
 
 
-def test_the_estimate_is_within_a_factor_2_of_the_predictions_and_names_them():
+def test_the_estimate_is_the_probed_costs_times_the_shots(monkeypatch):
+    """The estimate's arithmetic, with the probe's costs fixed: ``T = f sum_m n t_m`` for
+    models flown per shot, the models named by their share. (How close the estimate comes to
+    the time a run takes is a speed figure: benchmarks/estimate_accuracy.py measures it
+    through the whole command, every model set at 1000 and 20 000 shots, docs/validation.md;
+    a timed unit test here would depend on the machine's load.)"""
+    from cavex.verification.validation import run_estimate as estimate
+
+    costs = {"derived-quasi-static": 2e-3, "paper": 3e-3, "forrestal-1994": 1e-6}
+    monkeypatch.setattr(estimate, "prediction_seconds",
+                        lambda clock, model, *args: costs[model])
+    monkeypatch.setattr(estimate.Clock, "slowdown", lambda self, cpus=None, load=None: 1.5)
+    shots = synthetic(120)
+    columns = {label: (label, Mapping()) for label in costs}
+    line = run_estimate(shots, columns, TableCache(), workers=1)
+    seconds = float(re.search(r"\[~([0-9.e+-]+) s\]", line).group(1))
+    assert seconds == pytest.approx(1.5 * 120 * sum(costs.values()), rel=1e-3)
+    assert line.endswith("mostly paper 60 %, derived-quasi-static 40 %"), line
+
+
+def test_the_probe_names_the_models_that_take_the_time():
+    """The real probe on a small run: the flown closed forms take the time, the empirical
+    formula next to none (their costs differ by about a thousand times)."""
     shots = synthetic(120)
     columns = {label: (label, Mapping()) for label in ("derived-quasi-static", "paper",
                                                        "forrestal-1994")}
     tables = TableCache()
     line = run_estimate(shots, columns, tables, workers=1)
-    estimated = float(re.search(r"\[~([0-9.e+-]+) s\]", line).group(1))
-    start = time.perf_counter()
     depths, failures = predictions(shots, columns, tables)
-    actual = time.perf_counter() - start
-    assert not failures
-    assert 0.5 <= actual / estimated <= 2.0, (line, actual)
-    # the flown closed forms take the time, the empirical formula next to none
+    assert not failures and all(d is not None for c in depths.values() for d in c)
     assert re.search(r"mostly (derived-quasi-static|paper) \d+ %, (derived-quasi-static|paper)"
                      r" \d+ %$", line), line
