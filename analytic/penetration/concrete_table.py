@@ -66,6 +66,8 @@ def concrete_cavity(fc, rho, constants=None):
 
 
 def _ogive(shot):
+    """The shot's tangent-ogive projectile (``cavex.analytic.models.shots.shot_projectile``,
+    one floor up)."""
     return Projectile.tangent_ogive(shot.mass, shot.diameter, shot.crh, shot.V0)
 
 
@@ -199,7 +201,7 @@ def table_flight(shot, resistance, erosion=None, *, rtol=RTOL, atol=ATOL):
     (:meth:`~cavex.analytic.penetration.erosion.ErodingNose.summary`; None where the
     projectile flew rigid: no law, a law off at ``V0``, or a crater that stops it)."""
     crater = crater_calibres(shot.crh) * shot.diameter
-    projectile = Projectile.tangent_ogive(shot.mass, shot.diameter, shot.crh, shot.V0)
+    projectile = _ogive(shot)
     energy = shot.mass * shot.V0 ** 2
     static = resistance.force(0.0, 0.0)
     if energy <= crater * static:

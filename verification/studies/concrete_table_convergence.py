@@ -30,21 +30,19 @@ import numpy as np
 
 from cavex.analytic.penetration.concrete_table import TABLE_POINTS, TableResistance, table_depth
 from cavex.analytic.penetration.nose import QUADRATURE_POINTS
-from cavex.errors import CavexInputError
 from cavex.verification.output.files import write_text_atomic
-from cavex.verification.output.paths import check_output_dir
-from cavex.verification.validation.shots import read_shots
+
+# the integrator's tolerances of the concrete studies' flights, and their --out/--shots
+# reader: at the model's rtol 1e-9 the depths of one shot differ by up to 5e-8 between two
+# CPUs' vector maths (7 of this study's 1430 depths, written with 7 digits, then read one unit
+# differently under the emulation of results/regenerate.sh); at 1e-12 by about 1e-9, and the
+# emulation wrote the same CSV byte for byte
+from cavex.verification.studies.concrete_validation import ATOL, RTOL, study_inputs
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_SHOTS = ROOT / "examples" / "shots_compilation_dev.csv"
 DEFAULT_OUT = ROOT / "results" / "concrete"
 DIGITS = 7  # the depths' changes go down to ~1e-7: 7 digits resolve them
-# the integrator's tolerances here, tighter than the model's 1e-9 (whose share of the depth,
-# up to 6e-7, is measured apart: docs/concrete.md): at 1e-9 the depths of one shot differ by
-# up to 5e-8 between two CPUs' vector maths (measured under the emulation of
-# results/regenerate.sh: 7 of the 1430 depths written then read one unit differently), at
-# 1e-12 by about 1e-9, and the emulation wrote the same CSV byte for byte
-RTOL, ATOL = 1e-12, 1e-15
 TABLE_SERIES = (TABLE_POINTS, 2 * TABLE_POINTS - 1, 4 * TABLE_POINTS - 3)  # 33, 65, 129
 NOSE_SERIES = (QUADRATURE_POINTS, 2 * QUADRATURE_POINTS, 4 * QUADRATURE_POINTS)  # 8, 16, 32
 #: the settings flown, ``(table points, nose points)``; the two series share the finest table
@@ -170,12 +168,10 @@ def main(argv=None):
     parser.add_argument("--out", default=str(DEFAULT_OUT))
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args(argv)
-    try:
-        out = check_output_dir(args.out, "out")
-        shots = list(read_shots(args.shots).shots)
-    except CavexInputError as exc:
-        print(f"cavex: {exc}", file=sys.stderr)
+    inputs = study_inputs(args)
+    if inputs is None:
         return 2
+    out, shots = inputs[0], list(inputs[1])
     out.mkdir(parents=True, exist_ok=True)
     depths = all_depths(shots, args.workers)
     if not np.all(np.isfinite(depths)):
