@@ -176,17 +176,41 @@ def test_committed_report_is_what_the_study_writes():
     assert committed == report_md()
 
 
-def test_the_option_is_chosen_on_the_other_groups_among_those_that_predict_them_all():
-    """The selection rule of the shot study on a made-up table: a group left out gets the
-    option best on the others among the options with a depth for every other shot."""
-    from cavex.verification.studies.confinement_selection import cross_validated_choice
+SELECTION = ROOT / "results" / "concrete" / "confinement_selection"
 
-    measured = [1.0, 1.0, 1.0, 1.0]
-    depths = {"a": [1.1, 1.1, 2.0, 2.0],           # good on groups x, poor on y
-              "b": [1.5, 1.5, 1.05, 1.05],         # good on y
-              "c": [1.0, 1.0, 1.0, math.nan]}      # perfect, but misses a shot of y
-    out = cross_validated_choice(depths, measured, {"x": [0, 1], "y": [2, 3]})
-    assert out["x"][0] == "b"  # c misses a shot of y, the group it is chosen on
-    assert out["x"][2] == pytest.approx(math.log(1.5))
-    assert out["y"][0] == "c"  # on x, c is admissible and best
-    assert out["y"][2] == math.inf  # and it gives no depth for one shot of y
+
+def _selection():
+    from cavex.verification.studies import confinement_selection as cs
+    from cavex.verification.validation.shots import read_shots
+
+    shots = list(read_shots(cs.DEFAULT_SHOTS).shots)
+    depths = cs.read_depths_csv(SELECTION.with_suffix(".csv").read_text(encoding="utf-8"))
+    return cs, shots, depths
+
+
+def test_committed_selection_report_is_the_study_s_of_its_depths():
+    """results/concrete/confinement_selection.md is what the study writes from the committed
+    depths (every statistic and choice in it follows from the CSV and the shot file), and the
+    CSV holds every option of the study for every development shot."""
+    cs, shots, depths = _selection()
+    assert list(depths) == list(cs.OPTIONS)
+    assert all(len(d) == len(shots) for d in depths.values())
+    committed = SELECTION.with_suffix(".md").read_text(encoding="utf-8")
+    assert committed == cs.report_md(depths, shots)
+
+
+@pytest.mark.parametrize("shot_id", ["C4", "C969"])
+def test_committed_selection_depths_are_the_code_s(shot_id):
+    """Two shots' depths under every option computed again (a 14.8 MPa one and a 293 MPa one
+    that the HJC meridian leaves without a depth): within the 4 significant digits written
+    (half a unit of the 4th digit is at most 5e-4 of the value; two CPUs' flights differ by
+    about 1e-9 at the study's rtol 1e-12), and missing where the file has none."""
+    cs, shots, depths = _selection()
+    index = [s.id for s in shots].index(shot_id)
+    for option in cs.OPTIONS:
+        _, (depth,) = cs.option_depths((option, [shots[index]]))
+        written = depths[option][index]
+        if written is None:
+            assert depth is None, option
+        else:
+            assert depth is not None and abs(depth / written - 1.0) <= 5e-4, option

@@ -1,27 +1,33 @@
-r"""The published options of :mod:`cavex.concrete_confinement` on the development shots, chosen
-by leaving out one reference and one kind of shot (issue 31, item 2's rule).
+r"""The published options of the concrete model's shear limit and lock strain on the
+development shots, chosen by leaving out one reference and one kind of shot (issue 31, item
+2's rule).
 
 ``python -m cavex.verification.studies.confinement_selection [--shots FILE] [--workers N]
 [--out DIR]`` writes ``DIR/confinement_selection.csv`` (each shot's depth under each option,
-empty where the cavity expansion has no self-similar solution) and prints the tables; default
-shots ``examples/shots_compilation_dev.csv``, no default output (nothing committed: the choice
-is to be made again once the hydrostat has landed in the closed form, docs/concrete.md).
+empty where the cavity expansion has no self-similar solution) and
+``DIR/confinement_selection.md`` (the tables); default shots
+``examples/shots_compilation_dev.csv``, default ``--out results/concrete``.
 
-Options (:data:`OPTIONS`), each the concrete cavity model (:mod:`cavex.concrete`) with one
-change and every other constant at its published value:
+Options (:data:`OPTIONS`), each the concrete cavity model (:mod:`cavex.concrete`) with every
+other constant at its published value:
 
-- ``today``: Richart's line capped at ``7 f_c``, HJC's hydrostat;
-- ``hjc``, ``rht``: the comminuted strength the power law of that meridian normalised by
-  ``f_c`` (:func:`cavex.concrete_confinement.cavity_power_law`);
-- ``rht unscaled``: RHT's meridian of its 46 MPa concrete for every ``f_c``;
-- ``porosity lock``: today's strength with ``mu_lock`` from the porosity law
-  (:func:`cavex.concrete_confinement.hydrostat`).
+- ``hjc lock``, ``porosity lock``: the concrete model's two options
+  (:func:`cavex.analytic.models.concrete.option_constants`): Richart's line capped at
+  ``7 f_c``, the lock strain HJC's 0.1 or from the porosity law;
+- ``hjc meridian``, ``rht meridian``: the porosity lock with the comminuted strength the power
+  law of that flattening meridian normalised by ``f_c``
+  (:func:`cavex.concrete_confinement.cavity_power_law`; HJC's keeps its cap ``7 f_c``, RHT's
+  has none);
+- ``hjc meridian unscaled``, ``rht meridian unscaled``: the same meridians of their reference
+  concretes (48 and 46 MPa) for every ``f_c`` (the high-confinement strength independent of
+  ``f_c``, as Malecot et al. 2009 report for 21-57 MPa).
 
-Choice (:func:`cross_validated_choice`): an option is admissible on a set of shots if it gives
-every one of them a depth; of the admissible ones, the one with the smallest mean
-``|ln(predicted/measured)|`` on the other groups is chosen for each group left out, and scored on
-it. Groups: the references, then the kinds of shot :data:`KINDS` (each left out against the
-rest).
+The choice and the folds are ``cavex validate``'s (:mod:`cavex.verification.validation.
+cross_validation`: ``choose``, the fewest shots without a depth, then the smallest mean
+``|ln(predicted/measured)|``, on the shots not left out; ``fold_indices``, each reference,
+and each kind of shot against the rest). Depths flown at the concrete study's
+tolerances (:data:`cavex.verification.studies.concrete_validation.RTOL`), written to
+:data:`DIGITS` significant digits.
 """
 
 import argparse
@@ -34,105 +40,155 @@ from pathlib import Path
 
 import numpy as np
 
+from cavex.analytic.empirical import li_chen_depth
+from cavex.analytic.models.concrete import option_constants
 from cavex.analytic.penetration.concrete_table import TableResistance, table_depth
-from cavex.concrete import Constants
-from cavex.concrete_confinement import cavity_power_law, hydrostat
+from cavex.concrete_confinement import cavity_power_law
 from cavex.errors import CavexInputError, CavexNumericalError
 from cavex.verification.output.files import write_text_atomic
-from cavex.verification.output.paths import check_output_dir
-from cavex.verification.validation.shots import read_shots
+from cavex.verification.output.number_format import round_significant
+from cavex.verification.studies.concrete_validation import ATOL, RTOL, study_inputs
+from cavex.verification.validation.cross_validation import FOLDS, choose, fold_indices
+from cavex.verification.validation.regimes import (
+    DEPTH_DIGITS,
+    REGIME_TITLES,
+    REGIMES,
+    log_statistics,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_SHOTS = ROOT / "examples" / "shots_compilation_dev.csv"
+DEFAULT_OUT = ROOT / "results" / "concrete"
+DIGITS = 4
+SHOWN = ("all", "normal_strength", "fast", "high_strength")  # the regimes of the tables
 POWER = ("cap", "power_B", "power_N")
+LI_CHEN = "li-chen-2003 (not an option)"
 
 
-def _power(meridian, scaling):
+def _meridian(meridian, scaling):
     def constants(shot):
         B, N, cap = cavity_power_law(shot.fc, meridian, scaling)
-        return Constants().with_values(POWER, (cap, B, N))
+        return option_constants(shot, "porosity lock").with_values(POWER, (cap, B, N))
     return constants
 
 
 OPTIONS = {
-    "today": lambda shot: Constants(),
-    "hjc": _power("hjc", "fc"),
-    "rht": _power("rht", "fc"),
-    "rht unscaled": _power("rht", "none"),
-    "porosity lock": lambda shot: Constants().with_values(
-        ("lock_strain",), (hydrostat(shot.fc, shot.rho).mu_lock,)),
-}
-KINDS = {
-    "calibre <= 13 mm": lambda s: s.diameter <= 0.013,
-    "projectile yield < 1 GPa": lambda s: float(s.extra.get("proj_yield_MPa") or "inf") < 1000.0,
-    "V0 > 1000 m/s": lambda s: s.V0 > 1000.0,
+    "hjc lock": lambda shot: option_constants(shot, "hjc"),
+    "porosity lock": lambda shot: option_constants(shot, "porosity lock"),
+    "hjc meridian": _meridian("hjc", "fc"),
+    "rht meridian": _meridian("rht", "fc"),
+    "hjc meridian unscaled": _meridian("hjc", "none"),
+    "rht meridian unscaled": _meridian("rht", "none"),
 }
 
 
 def option_depths(args):
-    """``(option, [depth or nan])`` of ``shots`` under ``option`` (``args = (option, shots)``)."""
+    """``(option, [depth or None])`` of ``shots`` under ``option`` (``args = (option, shots)``),
+    each depth to :data:`DIGITS` significant digits; None where the cavity expansion has no
+    self-similar solution, or where the option gives the concrete no admissible material (the
+    unscaled HJC meridian's cap ``7 x 48`` MPa below ``f_c`` above 336 MPa)."""
     option, shots = args
     out = []
     for s in shots:
         try:
-            out.append(table_depth(s, TableResistance(s, OPTIONS[option](s))))
-        except CavexNumericalError:
-            out.append(math.nan)
+            depth = table_depth(s, TableResistance(s, OPTIONS[option](s)), rtol=RTOL, atol=ATOL)
+            out.append(round_significant(depth, DIGITS))
+        except (CavexInputError, CavexNumericalError):
+            out.append(None)
     return option, out
 
 
-def mean_abs_log(depths, measured, indices):
-    """Mean ``|ln(depth/measured)|`` over ``indices``; inf if a depth there is missing."""
-    logs = [math.log(depths[i] / measured[i]) for i in indices]
-    return float(np.mean(np.abs(logs))) if all(map(math.isfinite, logs)) else math.inf
+def all_option_depths(shots, workers=1):
+    """``{option: [depth or None]}`` over :data:`OPTIONS` (``workers`` processes)."""
+    tasks = [(option, shots) for option in OPTIONS]
+    if workers <= 1:
+        return dict(map(option_depths, tasks))
+    with ProcessPoolExecutor(workers) as pool:
+        return dict(pool.map(option_depths, tasks))
 
 
-def cross_validated_choice(depths, measured, groups):
-    """For each group (``{name: [shot indices]}``) left out: ``(option chosen on the others,
-    its mean |ln ratio| there, on the group left out)``; ``depths`` is ``{option: [depth]}``.
-    Admissible: a finite depth for every shot of the others (None if no option is)."""
-    out = {}
-    everyone = set(range(len(measured)))
-    for name, held in groups.items():
-        rest = sorted(everyone - set(held))
-        admissible = [o for o in depths if all(math.isfinite(depths[o][i]) for i in rest)]
-        if not admissible:
-            out[name] = None
-            continue
-        chosen = min(admissible, key=lambda o: mean_abs_log(depths[o], measured, rest))
-        out[name] = (chosen, mean_abs_log(depths[chosen], measured, rest),
-                     mean_abs_log(depths[chosen], measured, held))
-    return out
+def _in_regime(shot, regime):
+    return REGIMES[regime](shot.fc, shot.V0, None)
 
 
-def groups_of(shots):
-    """``(references, kinds)``: ``{name: [indices]}`` of each reference and each kind."""
-    refs = {}
-    for i, s in enumerate(shots):
-        refs.setdefault(s.extra.get("source", s.id), []).append(i)
-    kinds = {k: [i for i, s in enumerate(shots) if member(s)] for k, member in KINDS.items()}
-    return refs, kinds
+def _cell(depths, shots, indices):
+    """``"mean |ln| / bias (missing)"`` of ``depths`` over ``indices``."""
+    stats = log_statistics([None if depths[i] is None else depths[i] / shots[i].depth
+                            for i in indices], DEPTH_DIGITS)
+    missing = len(indices) - stats["n"]
+    if stats["n"] == 0:
+        return f"- ({missing} missing)"
+    text = f"{stats['mean_abs_log_ratio']:.3f} / {stats['mean_log_ratio']:+.3f}"
+    return text + (f" ({missing} missing)" if missing else "")
 
 
-def report(depths, shots):
+def _spread(depths, shots, indices):
+    """Mean ``|ln ratio - bias|`` over ``indices`` (the bias the mean ``ln ratio`` there): the
+    score a correct level would leave, the shape's share of the error."""
+    logs = [math.log(depths[i] / shots[i].depth) for i in indices if depths[i] is not None]
+    return f"{sum(abs(x - sum(logs) / len(logs)) for x in logs) / len(logs):.3f}"
+
+
+def strength_slope(depths, shots, indices):
+    """The slope of ``ln(depth/measured)`` in ``ln f_c`` over ``indices`` (the shots with a
+    depth), least squares on ``1, ln f_c, ln V0, ln d, ln CRH`` together: how much faster
+    than the measured depths the predicted ones fall with the concrete's strength."""
+    have = [i for i in indices if depths[i] is not None]
+    columns = [[1.0, math.log(shots[i].fc), math.log(shots[i].V0), math.log(shots[i].diameter),
+                math.log(shots[i].crh)] for i in have]
+    logs = [math.log(depths[i] / shots[i].depth) for i in have]
+    return float(np.linalg.lstsq(np.array(columns), np.array(logs), rcond=None)[0][1])
+
+
+def report_md(depths, shots):
+    """The report of ``depths`` (``{option: [depth or None]}``) on ``shots``: each option by
+    regime (Li and Chen's 2003 formula beside them, not an option), and the choice without
+    each fold."""
     measured = [s.depth for s in shots]
-    everyone = range(len(shots))
-    refs, kinds = groups_of(shots)
-    lines = ["| option | shots without a depth | mean |ln ratio| (shots with a depth) |",
-             "|---|---:|---:|"]
-    for o, d in depths.items():
-        have = [i for i in everyone if math.isfinite(d[i])]
-        lines.append(f"| {o} | {len(shots) - len(have)} | "
-                     f"{mean_abs_log(d, measured, have):.3f} |")
-    loro = cross_validated_choice(depths, measured, refs)
-    chosen = [v[0] for v in loro.values() if v]
-    lines += ["", "Leaving out one reference: chosen " + ", ".join(
-        f"{o} {chosen.count(o)} times" for o in depths if chosen.count(o)), ""]
-    for kind, v in cross_validated_choice(depths, measured, kinds).items():
-        lines.append(f"Leaving out {kind}: " + ("no option gives every other shot a depth"
-                     if v is None else f"{v[0]} chosen ({v[1]:.3f} on the rest, "
-                     f"{v[2]:.3f} on the kind)"))
-    return "\n".join(lines)
+    everyone = list(range(len(shots)))
+    regimes = {r: [i for i in everyone if _in_regime(shots[i], r)] for r in SHOWN}
+    shown = {**depths, LI_CHEN: [round_significant(li_chen_depth(s), DEPTH_DIGITS)
+                                 for s in shots]}  # as validate writes them
+    lines = ["# The concrete model's published options on the development shots",
+             "", "Written by `python -m cavex.verification.studies.confinement_selection` "
+             "(module docstring: the options). Mean |ln(predicted/measured)| / bias over the "
+             "shots with a depth, the shots without one in brackets.", "",
+             "| option | " + " | ".join(f"{REGIME_TITLES[r]} ({len(regimes[r])})"
+                                       for r in SHOWN) + " |",
+             "|---|" + "---:|" * len(SHOWN)]
+    for option, d in shown.items():
+        lines.append(f"| {option} | " + " | ".join(_cell(d, shots, regimes[r]) for r in SHOWN)
+                     + " |")
+    lines += ["", "The shape's share: mean |ln ratio - bias| in each regime over the shots with "
+              "a depth (the score if each option's level were right in that regime; a level no "
+              "published constant sets).", "",
+              "| option | " + " | ".join(REGIME_TITLES[r] for r in SHOWN) + " |",
+              "|---|" + "---:|" * len(SHOWN)]
+    for option, d in shown.items():
+        lines.append(f"| {option} | " + " | ".join(_spread(d, shots, regimes[r]) for r in SHOWN)
+                     + " |")
+    normal = regimes["normal_strength"]
+    lines += ["", "Slope of ln(predicted/measured) in ln f_c over the "
+              f"{REGIME_TITLES['normal_strength']} shots (least squares on 1, ln f_c, ln V0, "
+              "ln d, ln CRH): "
+              + ", ".join(f"{o} {strength_slope(d, shots, normal):+.2f}" for o, d in shown.items())
+              + "."]
+    folds = fold_indices(shots, FOLDS)
+    chosen_all = choose(depths, measured, everyone)
+    lines += ["", f"Chosen on all shots: **{chosen_all}**.", "",
+              "| fold left out | n | chosen on the others | on the fold |", "|---|---:|---|---:|"]
+    held_out = [None] * len(shots)
+    for name, (family, held) in folds.items():
+        rest = sorted(set(everyone) - set(held))
+        option = choose(depths, measured, rest)
+        lines.append(f"| {name} | {len(held)} | {option} | {_cell(depths[option], shots, held)} |")
+        if family == "reference":
+            for i in held:
+                held_out[i] = depths[option][i]
+    lines += ["", "Each shot predicted by the option chosen without its reference: "
+              + "; ".join(f"{REGIME_TITLES[r]} {_cell(held_out, shots, regimes[r])}"
+                          for r in SHOWN) + "."]
+    return "\n".join(lines) + "\n"
 
 
 def depths_csv(depths, shots):
@@ -141,9 +197,15 @@ def depths_csv(depths, shots):
     writer.writerow(["id", "source", "measured_m", *depths])
     for i, s in enumerate(shots):
         writer.writerow([s.id, s.extra.get("source", ""), s.depth,
-                         *("" if not math.isfinite(d[i]) else f"{d[i]:.4g}"
-                           for d in depths.values())])
+                         *("" if d[i] is None else repr(d[i]) for d in depths.values())])
     return buf.getvalue()
+
+
+def read_depths_csv(text):
+    """``{option: [depth or None]}`` of a :func:`depths_csv` text."""
+    rows = list(csv.DictReader(io.StringIO(text)))
+    options = [k for k in rows[0] if k not in ("id", "source", "measured_m")]
+    return {o: [float(r[o]) if r[o] else None for r in rows] for o in options}
 
 
 def main(argv=None):
@@ -152,24 +214,17 @@ def main(argv=None):
         description=__doc__.splitlines()[0])
     parser.add_argument("--shots", default=str(DEFAULT_SHOTS))
     parser.add_argument("--workers", type=int, default=1)
-    parser.add_argument("--out", default=None)
+    parser.add_argument("--out", default=str(DEFAULT_OUT))
     args = parser.parse_args(argv)
-    try:
-        folder = None if args.out is None else check_output_dir(args.out, "out")
-        shots = list(read_shots(args.shots).shots)
-    except CavexInputError as exc:
-        print(f"cavex: {exc}", file=sys.stderr)
+    inputs = study_inputs(args)
+    if inputs is None:
         return 2
-    tasks = [(o, shots) for o in OPTIONS]
-    if args.workers > 1:
-        with ProcessPoolExecutor(args.workers) as pool:
-            depths = dict(pool.map(option_depths, tasks))
-    else:
-        depths = dict(map(option_depths, tasks))
-    if folder is not None:
-        folder.mkdir(parents=True, exist_ok=True)
-        write_text_atomic(folder / "confinement_selection.csv", depths_csv(depths, shots))
-    print(report(depths, shots))
+    folder, shots = inputs
+    depths = all_option_depths(list(shots), max(1, args.workers))
+    folder.mkdir(parents=True, exist_ok=True)
+    write_text_atomic(folder / "confinement_selection.csv", depths_csv(depths, shots))
+    write_text_atomic(folder / "confinement_selection.md", report_md(depths, list(shots)))
+    print(report_md(depths, list(shots)))
     return 0
 
 
