@@ -54,6 +54,7 @@ python -m cavex.verification.studies.rigid_form > /dev/null
 python -m cavex.verification.studies.erosion_study > /dev/null
 python -m cavex.verification.studies.concrete_table_convergence --workers 2 > /dev/null
 python -m cavex.verification.studies.concrete_band > /dev/null
+python -m cavex.verification.studies.confinement_selection --workers 2 > /dev/null
 # Table 2 under the Mohr-Coulomb layers and the realistic concrete (FE tables through the
 # FE-table cache: 7.3 min on two shared cores when built, ~25 s when cached; docs/table2.md)
 python -m cavex.verification.studies.table2_realistic --workers 2 > /dev/null
