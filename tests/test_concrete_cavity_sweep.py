@@ -95,11 +95,6 @@ def test_sweep_time(sweep):
     print(f"concrete cavity sweep: {sweep[0].size} points in {sweep[2]:.1f} s")
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "issue 31: with the FE's hydrostat the wall residual at this point takes one of two values "
-    "by step count (U(1) - 1 ~ 1e-7 at 128, 256, 384, 768 steps; <= 1e-10 at 512, 1024, 2048 "
-    "at the same gamma), so S differs by 2.4e-8 between 256 and 512 steps (tolerance 1e-8): "
-    "a discrete event after the lock kink, not found"))
 def test_issue_point_is_solved_at_every_step_count():
     """The node of issue 30: 180 MPa, rho = 2540 kg/m^3, phi = 14.0625 (node 30 of the table to
     16), lost at 256 RK4 steps by the old solver; now cracked at 128, 256 and 512 steps, the same
@@ -129,18 +124,8 @@ def test_no_spurious_sign_change_near_the_cap():
         assert changes.size == 1
 
 
-ISSUE_31_STEPS = pytest.mark.xfail(strict=True, reason=(
-    "issue 31, with the FE's hydrostat: at 180 MPa, phi = 14.0625 S takes one of two values by "
-    "step count (2.4e-8 apart: no order); at 60 MPa, phi = 50 the errors against 2048 steps are "
-    "1.9e-8, 1.4e-9, 2.1e-10, 1.5e-11 at 64 ... 512 steps, fitted order 3.38 (asserted > 3.5; "
-    "3.3-4.4 measured over the sweep before), the default 256 steps within 1e-8"))
-
-
-@pytest.mark.parametrize("fc, rho, phi", [(10e6, RHO, 0.0),
-                                          pytest.param(180e6, 2540.0, 14.0625,
-                                                       marks=ISSUE_31_STEPS),
-                                          (180e6, RHO, 37.0),
-                                          pytest.param(60e6, RHO, 50.0, marks=ISSUE_31_STEPS)])
+@pytest.mark.parametrize("fc, rho, phi", [(10e6, RHO, 0.0), (180e6, 2540.0, 14.0625),
+                                          (180e6, RHO, 37.0), (60e6, RHO, 50.0)])
 def test_step_count_refinement(fc, rho, phi):
     """RK4 at 64 ... 512 steps against 2048: the structure is the same, the fitted order 4
     (np.polyfit; measured 3.85-3.98 here; 3.3-4.4 on 32 ... 512 steps over 30 points of the
