@@ -54,7 +54,8 @@ def test_every_point_is_solved(sweep):
     assert np.all(np.isfinite(S)) and np.all(structure >= 0)
     assert np.all(S > 0.0)
     # the wall condition holds to Brent's 1e-13 but where the residual jumps by a little across
-    # zero (docs/concrete.md, "Root finding"; measured: 29 points, |U(1) - 1| <= 0.016)
+    # zero (docs/concrete.md, "Root finding"; measured: 46 points, |U(1) - 1| <= 0.013; 29
+    # points, <= 0.016 with the integration in ln xi)
     jumps = np.abs(residual) > 1e-9
     print(f"wall condition: {jumps.sum()} point(s) at a small jump, |U(1) - 1| <= "
           f"{np.abs(residual).max():.2g}")
@@ -98,7 +99,10 @@ def test_sweep_time(sweep):
 def test_issue_point_is_solved_at_every_step_count():
     """The node of issue 30: 180 MPa, rho = 2540 kg/m^3, phi = 14.0625 (node 30 of the table to
     16), lost at 256 RK4 steps by the old solver; now cracked at 128, 256 and 512 steps, the same
-    S within the step tolerance."""
+    S within the step tolerance (measured 1.3e-10, 8.4e-12 against 512 steps with the
+    integration in tau; 2.4e-8 in ln xi: there the cap and the lock kink, 3e-4 apart in ln xi
+    with the flow near sonic between them, fell in one step at 128 and 256 steps, in two at 512,
+    and one RK4 step over that piece was off by 2.4e-8 whatever the step count)."""
     material = concrete_cavity(180e6, 2540.0)
     solutions = [solve(material, 14.0625, steps) for steps in (128, 256, 512)]
     assert all(s.structure == CRACKED for s in solutions)
@@ -128,9 +132,10 @@ def test_no_spurious_sign_change_near_the_cap():
                                           (180e6, RHO, 37.0), (60e6, RHO, 50.0)])
 def test_step_count_refinement(fc, rho, phi):
     """RK4 at 64 ... 512 steps against 2048: the structure is the same, the fitted order 4
-    (np.polyfit; measured 3.85-3.98 here; 3.3-4.4 on 32 ... 512 steps over 30 points of the
-    sweep), and the default 256 steps
-    within STEP_TOLERANCE (worst measured 3.5e-10). Below 64 steps the structure can change
+    (np.polyfit; measured 3.94-4.06 here; 3.92-4.02 on 64 ... 512 steps over 30 points of the
+    sweep, 3.3-4.4 with the integration in ln xi, which lost the order at 180 MPa, phi =
+    14.0625 and 60 MPa, phi = 50: 3.38), and the default 256 steps
+    within STEP_TOLERANCE (worst measured 4.7e-10). Below 64 steps the structure can change
     (180 MPa, phi = 37: 16 and 32 steps find another structure, S off by 77 %), so the default
     stays 256: 4 times the smallest safe count, 1e-9 at most."""
     material = concrete_cavity(fc, rho)
