@@ -60,10 +60,12 @@ Fronts:
 
 The wall condition ``U(1) = 1`` closes the problem: one unknown front speed (``beta`` without
 cracking, ``gamma`` with it) is found by bracketing and Brent's method; every evaluation
-integrates the comminuted zone inward from ``beta`` with classical Runge-Kutta (RK4) at a fixed
-number of steps in ``ln xi``, a step that crosses a kink of the constitutive law (the cap
-``tau_max``, the locking pressure) split at the crossing so that the order stays 4
-(``tests/test_concrete_cavity.py`` measures it).
+integrates the comminuted zone inward from ``beta`` with classical Runge-Kutta (RK4) at steps
+of fixed length in ``tau``, ``d ln xi = m d tau`` (``m = 1 - phi R_s (xi - U)^2`` the subsonic
+margin: no singularity where the flow turns sonic, short steps in ``ln xi`` near it), a step
+split where it meets a kink of the constitutive law (the cap ``tau_max``, the crush and lock
+points), a sonic point (a compaction shock there) or the wall, so that the order stays 4
+(``tests/test_concrete_cavity.py`` and ``tests/test_concrete_cavity_sweep.py`` measure it).
 
 Which structure (:data:`STRUCTURES`): the elastic-comminuted solution when its hoop tension at
 ``beta`` stays within ``f_t``; else the cracked one (crack front slower than the bar wave
@@ -1102,9 +1104,10 @@ def solve(material, phi, steps=DEFAULT_STEPS):
     except NoSolution:
         raise
     except CavexNumericalError as failure:
-        # a root inside a NaN pocket of the residual: the pockets (a sonic point the integration
-        # cannot place, next to the cap) move with the step count, the root does not (within
-        # the step tolerance, docs/concrete.md "Root finding"): the finer counts are tried
+        # a root inside a NaN pocket of the residual (front speeds without an admissible state
+        # or integration, issue 30: a sonic point placed by the step's finiteness, before the
+        # integration in tau): such pockets move with the step count, the root does not
+        # (within the step tolerance, docs/concrete.md "Root finding"): finer counts are tried
         for finer in (2 * int(steps), 4 * int(steps)):
             try:
                 return _solve(material, float(phi), finer)
