@@ -54,8 +54,8 @@ def test_every_point_is_solved(sweep):
     assert np.all(np.isfinite(S)) and np.all(structure >= 0)
     assert np.all(S > 0.0)
     # the wall condition holds to Brent's 1e-13 but where the residual jumps by a little across
-    # zero (docs/concrete.md, "Root finding"; measured: 46 points, |U(1) - 1| <= 0.013; 29
-    # points, <= 0.016 with the integration in ln xi)
+    # zero (docs/concrete.md, "Root finding"; measured: 46 points, |U(1) - 1| <= 0.013, the
+    # same points and sizes with the integration in ln xi and at 512, 1024 steps)
     jumps = np.abs(residual) > 1e-9
     print(f"wall condition: {jumps.sum()} point(s) at a small jump, |U(1) - 1| <= "
           f"{np.abs(residual).max():.2g}")
