@@ -60,10 +60,12 @@ Fronts:
 
 The wall condition ``U(1) = 1`` closes the problem: one unknown front speed (``beta`` without
 cracking, ``gamma`` with it) is found by bracketing and Brent's method; every evaluation
-integrates the comminuted zone inward from ``beta`` with classical Runge-Kutta (RK4) at a fixed
-number of steps in ``ln xi``, a step that crosses a kink of the constitutive law (the cap
-``tau_max``, the locking pressure) split at the crossing so that the order stays 4
-(``tests/test_concrete_cavity.py`` measures it).
+integrates the comminuted zone inward from ``beta`` with classical Runge-Kutta (RK4) at steps
+of fixed length in ``tau``, ``d ln xi = m d tau`` (``m = 1 - phi R_s (xi - U)^2`` the subsonic
+margin: no singularity where the flow turns sonic, short steps in ``ln xi`` near it), a step
+split where it meets a kink of the constitutive law (the cap ``tau_max``, the crush and lock
+points), a sonic point (a compaction shock there) or the wall, so that the order stays 4
+(``tests/test_concrete_cavity.py`` and ``tests/test_concrete_cavity_sweep.py`` measure it).
 
 Which structure (:data:`STRUCTURES`): the elastic-comminuted solution when its hoop tension at
 ``beta`` stays within ``f_t``; else the cracked one (crack front slower than the bar wave
@@ -481,33 +483,6 @@ def hydrostat(p, pressure, branch):
 
 
 @njit(cache=True, error_model="numpy")
-def _rhs(p, x, s, U, floor, ceiling):
-    """``(ds/d ln xi, dU/d ln xi)`` of the comminuted zone; NaN where the flow is sonic. The
-    law's pieces are chosen at ``s`` clamped to ``[floor, ceiling]``."""
-    D, R, Rs = constitutive(p, s, min(max(s, floor), ceiling))
-    phi = p[PHI]
-    gap = x - U
-    den = R * (1.0 - phi * Rs * gap * gap)
-    if not den > 0.0:
-        return np.nan, np.nan
-    dU = -(2.0 * R * U + 2.0 * gap * Rs * D) / (x * den)
-    ds = -2.0 * D / x + phi * R * gap * dU
-    return x * ds, x * dU
-
-
-@njit(cache=True, error_model="numpy")
-def _rk4(p, t, s, U, h, floor=-np.inf, ceiling=np.inf):
-    x = math.exp(t)
-    k1s, k1u = _rhs(p, x, s, U, floor, ceiling)
-    x2 = math.exp(t + 0.5 * h)
-    k2s, k2u = _rhs(p, x2, s + 0.5 * h * k1s, U + 0.5 * h * k1u, floor, ceiling)
-    k3s, k3u = _rhs(p, x2, s + 0.5 * h * k2s, U + 0.5 * h * k2u, floor, ceiling)
-    k4s, k4u = _rhs(p, math.exp(t + h), s + h * k3s, U + h * k3u, floor, ceiling)
-    return (s + h * (k1s + 2.0 * k2s + 2.0 * k3s + k4s) / 6.0,
-            U + h * (k1u + 2.0 * k2u + 2.0 * k3u + k4u) / 6.0)
-
-
-@njit(cache=True, error_model="numpy")
 def kink_stresses(p):
     """Radial stresses of the comminuted zone's kinks: where the strength below the cap
     (``tau_0 + lam p`` or ``B p^N``) reaches ``tau_max``, where the compaction hydrostat
@@ -538,45 +513,92 @@ def _radial_stress(p, pressure):
 
 
 @njit(cache=True, error_model="numpy")
-def _split_step(p, t, s, U, h, s_kink, floor):
-    """The part of the RK4 step from ``t`` (length ``h``) that ends where ``s`` reaches
-    ``s_kink`` (``s`` below it), with the law's pieces kept below the kink; returns
-    ``(length, s, U)`` there.
+def _flow(p, t, s, U, floor, ceiling):
+    """``(dt, ds, dU)/d tau`` of the comminuted zone at ``t = ln xi``, in the variable ``tau``
+    with ``d/d tau = m d/d ln xi``, ``m = 1 - phi R_s (xi - U)^2`` the subsonic margin (the
+    Sundman transformation that takes the sonic singularity out of the equations):
 
-    The length ``l`` solves ``s_l = s_kink``, ``s_l`` the RK4 update over the length ``l`` (a
-    polynomial in ``l`` where the law is smooth): Illinois regula falsi on the bracket
-    ``(0, h)``, the end past the kink kept (``s_l >= s_kink``, or not finite: a stage turned
-    sonic, then a bisection step), to ``|bracket| <= 4 eps |h|``; the state is the one at that
-    end. (A bisection to the last bit took 65 RK4 updates; this takes about 8.)"""
-    ceiling = s_kink - 1e-12 * (1.0 + abs(s_kink))
+    .. math:: \\frac{dU}{d\\tau} = -2 \\left(U + \\frac{(\\xi - U) R_s D}{R}\\right), \\qquad
+              \\frac{ds}{d\\tau} = -2 D m + \\phi R (\\xi - U) \\frac{dU}{d\\tau}, \\qquad
+              \\frac{dt}{d\\tau} = m,
+
+    smooth where the flow turns sonic (``m = 0``: an event, :func:`integrate`). The law's pieces
+    are chosen at ``s`` clamped to ``[floor, ceiling]``."""
+    D, R, Rs = constitutive(p, s, min(max(s, floor), ceiling))
+    gap = math.exp(t) - U
+    margin = 1.0 - p[PHI] * Rs * gap * gap
+    dU = -2.0 * (U + gap * Rs * D / R)
+    return margin, -2.0 * D * margin + p[PHI] * R * gap * dU, dU
+
+
+@njit(cache=True, error_model="numpy")
+def _rk4(p, t, s, U, h, floor=-np.inf, ceiling=np.inf):
+    """One classical RK4 step of length ``h`` in ``tau`` (:func:`_flow`); ``(t, s, U)`` after."""
+    k1t, k1s, k1u = _flow(p, t, s, U, floor, ceiling)
+    k2t, k2s, k2u = _flow(p, t + 0.5 * h * k1t, s + 0.5 * h * k1s, U + 0.5 * h * k1u, floor,
+                          ceiling)
+    k3t, k3s, k3u = _flow(p, t + 0.5 * h * k2t, s + 0.5 * h * k2s, U + 0.5 * h * k2u, floor,
+                          ceiling)
+    k4t, k4s, k4u = _flow(p, t + h * k3t, s + h * k3s, U + h * k3u, floor, ceiling)
+    return (t + h * (k1t + 2.0 * k2t + 2.0 * k3t + k4t) / 6.0,
+            s + h * (k1s + 2.0 * k2s + 2.0 * k3s + k4s) / 6.0,
+            U + h * (k1u + 2.0 * k2u + 2.0 * k3u + k4u) / 6.0)
+
+
+# the events of the integration (:func:`_event`)
+KINK, SONIC, WALL = 0, 1, 2
+
+
+@njit(cache=True, error_model="numpy")
+def _event(p, kind, level, t, s, U, floor, ceiling):
+    """The event function, negative before the event and ``>= 0`` at and past it: ``s -
+    s_kink`` (a kink at ``level``), ``-m`` (the flow turns sonic, the piece's law), ``-t`` (the
+    wall ``xi = 1``)."""
+    if kind == KINK:
+        return s - level
+    if kind == SONIC:
+        return -_flow(p, t, s, U, floor, ceiling)[0]
+    return -t
+
+
+@njit(cache=True, error_model="numpy")
+def _locate(p, t, s, U, h, kind, level, floor, ceiling):
+    """The part of the RK4 step from ``(t, s, U)`` (length ``h`` in ``tau``) that ends at the
+    event ``kind`` (:func:`_event`, negative at the start, ``>= 0`` at the step's end); returns
+    ``(length, t, s, U)`` there.
+
+    The length ``l`` solves ``g(y_l) = 0``, ``y_l`` the RK4 update over the length ``l`` (a
+    polynomial in ``l`` where the law is smooth, so the event is placed to the order of the
+    step): Illinois regula falsi on the bracket ``(0, h)``, the end past the event kept
+    (``g >= 0``), to ``|bracket| <= 4 eps |h|``; the state is the one at that end."""
     lo, hi = 0.0, h
-    f_lo = s - s_kink
-    s_hi, U_hi = _rk4(p, t, s, U, h, floor, ceiling)
-    f_hi = s_hi - s_kink  # NaN where a stage turned sonic
+    f_lo = _event(p, kind, level, t, s, U, floor, ceiling)
+    t_hi, s_hi, U_hi = _rk4(p, t, s, U, h, floor, ceiling)
+    f_hi = _event(p, kind, level, t_hi, s_hi, U_hi, floor, ceiling)
     kept = 0  # the end kept by the last update: -1 lo, +1 hi
     for _ in range(200):
         if abs(hi - lo) <= 4.0 * EPS * abs(h):
             break
         mid = 0.5 * (lo + hi)
-        if math.isfinite(f_hi) and f_hi > f_lo:
+        if f_hi > f_lo:
             secant = hi - f_hi * (hi - lo) / (f_hi - f_lo)
             if min(lo, hi) < secant < max(lo, hi):
                 mid = secant
-        s_mid, U_mid = _rk4(p, t, s, U, mid, floor, ceiling)
-        f_mid = s_mid - s_kink
-        if f_mid < 0.0:  # below the kink (False for NaN)
+        t_mid, s_mid, U_mid = _rk4(p, t, s, U, mid, floor, ceiling)
+        f_mid = _event(p, kind, level, t_mid, s_mid, U_mid, floor, ceiling)
+        if f_mid < 0.0:  # before the event (False for NaN)
             lo, f_lo = mid, f_mid
             if kept == 1:
                 f_hi *= 0.5
             kept = 1
         else:
-            hi, s_hi, U_hi, f_hi = mid, s_mid, U_mid, f_mid
+            hi, t_hi, s_hi, U_hi, f_hi = mid, t_mid, s_mid, U_mid, f_mid
             if f_mid == 0.0:
                 break
             if kept == -1:
                 f_lo *= 0.5
             kept = -1
-    return hi, s_hi, U_hi
+    return hi, t_hi, s_hi, U_hi
 
 
 @njit(cache=True, error_model="numpy")
@@ -592,62 +614,80 @@ def _ceiling(kinks, branch):
     return kink - 1e-12 * (1.0 + abs(kink)) if math.isfinite(kink) else np.inf
 
 
+MAX_SHOCKS = 4  # compaction shocks inside the comminuted zone at most
+MAX_STEP_FACTOR = 64  # RK4 steps in tau at most, in units of ``steps`` (then no solution)
+
+
 @njit(cache=True, error_model="numpy")
 def integrate(p, beta, s, U, steps):
-    """RK4 from ``xi = beta`` to the wall ``xi = 1`` in ``ln xi``; returns ``(s, U)`` there.
+    """RK4 from ``xi = beta`` to the wall ``xi = 1``; returns ``(s, U)`` there.
 
-    ``s`` grows inward. A step that crosses a kink (:func:`kink_stresses`) is split where ``s``
-    reaches it, the part before computed with the law's pieces below the kink and the rest with
-    those above, so that RK4 never differentiates across a kink (order 4 kept). Where the flow
-    turns sonic (``phi R_s (xi - U)^2 = 1``: the compaction cannot keep up continuously), the
-    sonic point is located by bisection on the step length and a compaction shock is put there
-    (:func:`jump`, strong root); at most a few such shocks.
+    The steps are uniform in ``tau`` (:func:`_flow`: ``d ln xi = m d tau``, ``m`` the subsonic
+    margin), of length ``h = -ln(beta)/steps``: ``steps`` steps where the flow is far from sonic
+    (``m`` near 1), shorter in ``ln xi`` as it nears sonic, where the solution in ``ln xi``
+    turns singular (``s`` like the square root of the distance to the sonic point) or stiff
+    (eigenvalues of the Jacobian like ``1/m``) and a step of fixed length in ``ln xi`` loses
+    the order. The count is ``int d ln xi / (m |h|)``, finite at a sonic point (``m`` like a
+    square root there).
+
+    Events, each located in its step by :func:`_locate` (regula falsi on the step length, to
+    the order of the step), the step split there and continued from it:
+
+    - ``s`` reaches a kink (:func:`kink_stresses`): the part before with the law's pieces below
+      the kink, the rest with those above, so that RK4 never differentiates across a kink;
+    - the flow turns sonic (``m = 0``: the compaction cannot keep up continuously): a
+      compaction shock is put there (:func:`jump`, strong root), also where ``m <= 0`` at the
+      start of a piece (past a kink whose pieces above are supersonic); at most
+      :data:`MAX_SHOCKS`;
+    - the wall ``ln xi = 0``: the end.
+
+    NaN where a step is not finite (no admissible state) or the wall is not reached within
+    :data:`MAX_STEP_FACTOR` ``steps``.
     """
-    t0 = math.log(beta)
-    h = -t0 / steps
-    t = t0
+    t = math.log(beta)
+    h = -t / steps
     kinks = (p[S_CAP], p[S_OPEN], p[S_CRUSH], p[S_LOCK])
     ordered = np.sort(np.array(kinks))
     shocks = 0
-    for k in range(steps):
-        t_end = t0 + (k + 1) * h
+    for _ in range(MAX_STEP_FACTOR * steps):
+        rest = h
         floor = -np.inf
         for _ in range(16):  # pieces of this step: kinks, sonic points
-            rest = t_end - t
             if rest >= -1e-15 * abs(h):
                 break
             ceiling = _ceiling(kinks, max(s, floor))
-            s_new, U_new = _rk4(p, t, s, U, rest, floor, ceiling)
-            if not (math.isfinite(s_new) and math.isfinite(U_new)):
-                lo, hi = 0.0, rest
-                for _ in range(60):
-                    mid = 0.5 * (lo + hi)
-                    if math.isfinite(_rk4(p, t, s, U, mid, floor, ceiling)[0]):
-                        lo = mid
-                    else:
-                        hi = mid
-                if lo != 0.0:
-                    s, U = _rk4(p, t, s, U, lo, floor, ceiling)
-                    t += lo
+            if _flow(p, t, s, U, floor, ceiling)[0] <= 0.0:  # sonic: a compaction shock
                 shocks += 1
-                if shocks > 4:
+                if shocks > MAX_SHOCKS:
                     return np.nan, np.nan
                 s, U = jump(p, math.exp(t), s, U, constitutive(p, s, max(s, floor))[1], True)
                 if not math.isfinite(s):
                     return np.nan, np.nan
                 continue
-            crossed = False
-            for s_kink in ordered:  # in the order met
+            t_new, s_new, U_new = _rk4(p, t, s, U, rest, floor, ceiling)
+            if not (math.isfinite(t_new) and math.isfinite(s_new) and math.isfinite(U_new)):
+                return np.nan, np.nan
+            part, kind, level = rest, -1, 0.0
+            end = (t_new, s_new, U_new)
+            for s_kink in ordered:  # the first kink met
                 if s < s_kink < s_new:
-                    part, s, U = _split_step(p, t, s, U, rest, s_kink, floor)
-                    t += part
-                    floor = s_kink + 1e-12 * (1.0 + abs(s_kink))
-                    crossed = True
+                    part, t_e, s_e, U_e = _locate(p, t, s, U, rest, KINK, s_kink, floor,
+                                                  ceiling)
+                    kind, level, end = KINK, s_kink, (t_e, s_e, U_e)
                     break
-            if not crossed:
-                s, U = s_new, U_new
-                t = t_end
-    return s, U
+            for other in (SONIC, WALL):  # the sonic point or the wall, if met first
+                if _event(p, other, 0.0, t_new, s_new, U_new, floor, ceiling) >= 0.0:
+                    length, t_e, s_e, U_e = _locate(p, t, s, U, rest, other, 0.0, floor,
+                                                    ceiling)
+                    if abs(length) < abs(part) or kind < 0:
+                        part, kind, end = length, other, (t_e, s_e, U_e)
+            t, s, U = end
+            rest -= part
+            if kind == WALL:
+                return s, U
+            if kind == KINK:
+                floor = level + 1e-12 * (1.0 + abs(level))
+    return np.nan, np.nan
 
 
 @njit(cache=True, error_model="numpy")
@@ -1064,9 +1104,10 @@ def solve(material, phi, steps=DEFAULT_STEPS):
     except NoSolution:
         raise
     except CavexNumericalError as failure:
-        # a root inside a NaN pocket of the residual: the pockets (a sonic point the integration
-        # cannot place, next to the cap) move with the step count, the root does not (within
-        # the step tolerance, docs/concrete.md "Root finding"): the finer counts are tried
+        # a root inside a NaN pocket of the residual (front speeds without an admissible state
+        # or integration, issue 30: a sonic point placed by the step's finiteness, before the
+        # integration in tau): such pockets move with the step count, the root does not
+        # (within the step tolerance, docs/concrete.md "Root finding"): finer counts are tried
         for finer in (2 * int(steps), 4 * int(steps)):
             try:
                 return _solve(material, float(phi), finer)
