@@ -4,8 +4,9 @@ source (issue 31, item 2; docs/concrete.md "Strength and hydrostat at high confi
 The data used are in ``core/data/concrete_confinement.csv`` (:func:`load_data`), one row a
 datum with its citation. Nothing here is fitted to penetration shots. The porosity lock strain
 (:func:`hydrostat`) is an option of the concrete model (``"porosity lock"``,
-:mod:`cavex.analytic.models.concrete`), cross-validated on the development shots and not chosen
-there; the meridians are not wired into a model.
+:mod:`cavex.analytic.models.concrete`), cross-validated on the development shots and chosen
+there; the meridians are cross-validated beside it
+(:mod:`cavex.verification.studies.confinement_selection`) and are not options of a model.
 
 Stresses in Pa, compression positive. On the compressive meridian (one principal stress above
 two equal ones: a triaxial compression test, and the comminuted zone of a spherical cavity,
