@@ -96,8 +96,8 @@ def quaternion_from_matrix(m):
 
 def omega_tolerance(atol, speed, length):
     r"""Absolute tolerance (rad/s) of the body-frame angular velocity ``omega`` in the
-    integrators' error norm: ``atol V0 / (L/2)`` (``atol`` the run's absolute tolerance,
-    ``V0`` the striking speed ``speed``, ``L`` the body length ``length``).
+    integrators' error norm: ``atol max(V0, 1 m/s) / (L/2)`` (``atol`` the run's absolute
+    tolerance, ``V0`` the striking speed ``speed`` in m/s, ``L`` the body length ``length``).
 
     Derivation. ``atol`` is given in the state's SI units (m, m/s); as such it has no meaning
     for ``omega`` (rad/s). Scale the rotation by the body's half length and the striking speed:
@@ -109,15 +109,19 @@ def omega_tolerance(atol, speed, length):
               \delta\omega_{tol}\, (L/2) = \mathrm{atol}\, V_0 :
 
     the tolerated error of ``omega`` moves the body's ends at ``atol V0``, ``atol`` of the
-    striking speed. This is not the velocity's absolute floor (``atol`` m/s, ``atol / V0`` of
-    the striking speed), which would be ``atol / (L/2)`` and leaves ``omega``'s floor at the
-    round-off chatter of the contact ramp (docs/oblique.md, "Integrator tolerance of
-    omega"); it compares with the velocity's whole tolerance ``atol + rtol |v|``, about
-    ``rtol V0`` in flight: at the default ``atol = 1e-3 rtol`` the end velocity error tolerated
-    through ``omega`` is 1e-3 of the error tolerated in the velocity itself (0.013 rad/s at
-    1000 m/s for the default 0.15 m body). It is proportional to ``atol``, so a refinement that
-    tightens ``atol`` with ``rtol`` tightens it too."""
-    return atol * speed / (0.5 * length)
+    striking speed. That is not the velocity's own absolute floor (``atol`` m/s, ``atol / V0``
+    of the striking speed), which would give ``atol / (L/2)``, only 2/L (13 for the default
+    body) looser than the former ``atol`` rad/s, whose floor the contact ramp's round-off
+    chatter of ``omega`` met (docs/oblique.md "Integrator tolerance of omega"). It compares
+    instead with the velocity's whole tolerance ``atol + rtol |v|``, about ``rtol V0`` in
+    flight: at the default ``atol = 1e-3 rtol`` the end speed tolerated through ``omega`` is
+    1e-3 of the error tolerated in the velocity itself (0.0133 rad/s at 1000 m/s for the
+    default 0.150 m body). Below 1 m/s the velocity's floor ``atol`` (m/s) is the larger end
+    speed and is taken (``max(V0, 1 m/s)``): ``omega`` is not held tighter than the velocity
+    (a body touching at rest, 1e-9 m/s, would otherwise ask for 1e-14 rad/s, below the
+    round-off of its moment). It is proportional to ``atol``, so a refinement that tightens
+    ``atol`` with ``rtol`` tightens it too."""
+    return atol * max(speed, 1.0) / (0.5 * length)
 
 
 def pitch_yaw(axis):
