@@ -94,6 +94,61 @@ def quaternion_from_matrix(m):
     return q / np.linalg.norm(q)
 
 
+OMEGA_TOLERANCE_FRACTION = 1.0 / 30.0
+"""Measured safety factor of :func:`omega_tolerance`: the fraction of ``atol V0 / (L/2)``
+taken as omega's absolute tolerance (derivation and measurement in its docstring)."""
+
+
+def omega_tolerance(atol, speed, length):
+    r"""Absolute tolerance (rad/s) of the body-frame angular velocity ``omega`` in the
+    integrators' error norm: ``f atol max(V0, 1 m/s) / (L/2)`` (``atol`` the run's absolute
+    tolerance, ``V0`` the striking speed ``speed`` in m/s, ``L`` the body length ``length``,
+    ``f`` = :data:`OMEGA_TOLERANCE_FRACTION` = 1/30).
+
+    Scale. ``atol`` is given in the state's SI units (m, m/s); as such it has no meaning for
+    ``omega`` (rad/s). Scale the rotation by the body's half length and the striking speed:
+    ``omega* = omega (L/2) / V0`` is the velocity the rotation gives the body's ends, as a
+    fraction of the striking speed. Reading ``atol`` as the dimensionless absolute tolerance of
+    ``omega*`` gives
+
+    .. math:: \delta\omega_{tol} = f\, \mathrm{atol}\, V_0 / (L/2), \qquad
+              \delta\omega_{tol}\, (L/2) = f\, \mathrm{atol}\, V_0 :
+
+    with ``f = 1`` the tolerated error of ``omega`` moves the body's ends at ``atol V0``,
+    ``atol`` of the striking speed. The former tolerance, ``atol`` rad/s, is ``atol / (L/2)``
+    at the ends: at that floor the contact ramp's round-off chatter of ``omega`` set the step
+    of a body sliding down its own tunnel (80 305 right-hand sides for Table 1's concrete at
+    1000 m/s, attack 3 deg; docs/oblique.md "Integrator tolerance of omega").
+
+    The fraction ``f`` is not derived: it is a measured safety factor. With ``f = 1`` that
+    sliding shot takes 771 right-hand sides, but an open zone of a debonded interface leaves
+    the body unsupported and its turn amplifies omega's error: the default's final pitch
+    against ``rtol`` 1e-5 went from +0.065 to +0.709 deg (20 deg, 800 m/s, debonded) and from
+    +0.017 to +0.136 deg (30 deg, 600 m/s), and concrete alone's lateral overload peak at 10-20
+    deg, 800-1000 m/s was no longer resolved by the refined run. ``f`` is the largest of 1/10,
+    1/30, 1/100, 1/300 for which, at the default settings, the final pitch error against
+    ``rtol`` 1e-5 is no larger than with ``atol`` rad/s plus max(10 %, 0.005 deg) and the
+    lateral peaks stay resolved. Measured on the worst shots: 1/10 fails (30 deg, 600 m/s,
+    debonded: +0.126 deg against +0.017); at 1/30 the debonded 20 deg 800 m/s, 30 deg 600 m/s
+    and 30 deg 800 m/s shots are +0.063, +0.018, +0.369 deg (former +0.065, +0.017, +0.360),
+    the lateral peak of concrete alone at 20 deg, 1000 m/s 2.14e4 g, refined 1.86e4 g (former
+    2.12e4, 1.87e4). The final depth's error is 1e-4 relative of the former's or less except
+    at 300 m/s, 45 deg (bonded +1.7e-4, debonded +1.2e-4) and 30 deg, 800 m/s debonded
+    (+1.03e-4); no fraction in the set keeps all within 1e-4 (1/100: +2.3e-4, 1/300: +2.1e-4
+    at 30 deg, 800 m/s), and the former tolerance's own depth moves by 2.7e-4 to 9.5e-4
+    relative on those shots under a 2 % change of ``rtol``: that margin is below the
+    integrator's spread and does not decide. The studies (results/oblique, both interface
+    settings) and the convergence study confirm the choice over all their shots
+    (docs/oblique.md "Integrator tolerance of omega"). The sliding shot takes 2 828
+    right-hand sides.
+
+    Below 1 m/s the velocity's floor ``atol`` (m/s) is the larger end speed and is taken
+    (``max(V0, 1 m/s)``): a body touching at rest, 1e-9 m/s, would otherwise ask for 1e-14
+    rad/s, below the round-off of its moment. It is proportional to ``atol``, so a refinement
+    that tightens ``atol`` with ``rtol`` tightens it too."""
+    return OMEGA_TOLERANCE_FRACTION * atol * max(speed, 1.0) / (0.5 * length)
+
+
 def pitch_yaw(axis):
     """Pitch (deg): angle of the axis from +z in the x-z plane, positive toward +x; yaw (deg):
     angle of the axis out of the x-z plane, positive toward +y."""
@@ -325,6 +380,16 @@ class ObliqueModel:
         return event_values(y, self.body.mass, self._inertia, args,
                             np.empty(args[2].size + 4))
 
+    def absolute_tolerances(self, strike, size=14):
+        """The absolute tolerances of the integrators' error norm, one per component of a
+        state of ``size`` components in its unit: ``atol`` for all but the body-frame angular
+        velocity ``omega`` (``y[10:13]``), whose tolerance is :func:`omega_tolerance` of the
+        striking speed and the body length (the compiled integrator reads the first 14, the
+        rigid body's: :func:`cavex.analytic.penetration.rosenbrock.scaled_rms`)."""
+        atol = np.full(size, self.atol)
+        atol[10:13] = omega_tolerance(self.atol, strike.speed, self.body.length)
+        return atol
+
     def run(self, strike, max_phases=50, progress=None):
         """Integrate ``strike`` to a final event; returns a :class:`Result`. ``progress``:
         optional ``callable(t, y)`` called after every integrator step."""
@@ -333,6 +398,7 @@ class ObliqueModel:
         self._open_zones(0.0)
         surfaces = []  # the surface arguments (open zones) of each phase
         self._min_step = MIN_STEP * self.body.length / strike.speed
+        self._atol = self.absolute_tolerances(strike, y.shape[0])
         directions, described, args = self._events(y)
         g = self.event_values(y, args)
         for k, (_, crossing, _) in enumerate(described):  # the next crossing is away from
@@ -380,14 +446,14 @@ class ObliqueModel:
         self.evaluations += 1
         if status != OK:
             raise_for(status, vn)
-        h = self._step or initial_step(y, f, self.rtol, self.atol, MAX_TIME)
+        h = self._step or initial_step(y, f, self.rtol, self._atol, MAX_TIME)
         size = y.shape[0]
         ts, ys, fs = (np.empty(CHUNK + 1), np.empty((CHUNK + 1, size)),
                       np.empty((CHUNK + 1, size)))
         parts = []
         while True:
             status, steps, h, evaluations, event, vn = integrate(
-                t0, y, f, jac, h, MAX_TIME, self._min_step, self.rtol, self.atol, CHUNK,
+                t0, y, f, jac, h, MAX_TIME, self._min_step, self.rtol, self._atol, CHUNK,
                 directions, args, ts, ys, fs, mass, inertia, self._surface)
             self.evaluations += evaluations
             parts.append((ts[1:steps + 1].copy(), ys[1:steps + 1].copy(), fs[1:steps + 1].copy())
@@ -423,7 +489,7 @@ class ObliqueModel:
                 return 1.0
             events.append(step)
         sol = solve_ivp(self.rhs, (t0, MAX_TIME), y, method=self.method, rtol=self.rtol,
-                        atol=self.atol, events=events, dense_output=True)
+                        atol=self._atol, events=events, dense_output=True)
         if sol.status == -1:
             raise CavexNumericalError(f"trajectory integration failed at t = {sol.t[-1]} "
                                       f"s: {sol.message}")

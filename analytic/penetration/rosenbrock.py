@@ -20,7 +20,9 @@ Heun's method.
 
 Step control: the embedded first-order solution ``y_n + h k_1`` gives the estimate
 ``e = h (k_1 + k_2) / 2``; a step is accepted when
-``||e_i / (atol + rtol max(|y_n,i|, |y_n+1,i|))||_rms <= 1`` and the next step is
+``||e_i / (atol_i + rtol max(|y_n,i|, |y_n+1,i|))||_rms <= 1`` over the 14 rigid-body
+components (``atol_i``: each component's absolute tolerance, in its own unit; the caller's,
+:meth:`cavex.analytic.penetration.oblique.ObliqueModel.absolute_tolerances`) and the next step is
 ``h min(5, max(0.2, 0.9 err^(-1/2)))`` (at most ``h`` after a rejection). A step whose
 stage state has non-finite equations of motion (a stiff contact overshot by too long a step)
 is rejected with the largest shrink, not fatal.
@@ -87,13 +89,15 @@ def event_values(y, mass, inertia, event_args, out):
 
 @njit(cache=True, error_model="numpy")
 def scaled_rms(x, y0, y1, rtol, atol):
-    """``||x_i / (atol + rtol max(|y0_i|, |y1_i|))||_rms`` over the 14 state components. The
+    """``||x_i / (atol_i + rtol max(|y0_i|, |y1_i|))||_rms`` over the 14 rigid-body state
+    components (``atol``: an array of absolute tolerances, one per state component in its
+    unit, of which the first 14 are read; a held contact's load fractions are left out). The
     quaternion's four terms are summed as ``(q_0^2 + q_1^2) + (q_2^2 + q_3^2)`` after the
     others, so that the mirror shot (which permutes them, :func:`cavex.analytic.
     surface_force.mirror_state`) gets the same bits."""
     e = np.empty(14)
     for k in range(14):
-        e[k] = x[k] / (atol + rtol * max(abs(y0[k]), abs(y1[k])))
+        e[k] = x[k] / (atol[k] + rtol * max(abs(y0[k]), abs(y1[k])))
     total = 0.0
     for k in range(14):
         if k < 3 or k > 6:
