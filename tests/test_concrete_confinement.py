@@ -176,14 +176,14 @@ def test_committed_report_is_what_the_study_writes():
     assert committed == report_md()
 
 
-SELECTION = ROOT / "results" / "concrete" / "confinement_selection"
+SELECTION = ROOT / "results" / "concrete" / "confinement_selection"  # the checkout's files
 
 
 def _selection():
     from cavex.verification.studies import confinement_selection as cs
     from cavex.verification.validation.shots import read_shots
 
-    shots = list(read_shots(cs.DEFAULT_SHOTS).shots)
+    shots = list(read_shots(ROOT / "examples" / "shots_compilation_dev.csv").shots)
     depths = cs.read_depths_csv(SELECTION.with_suffix(".csv").read_text(encoding="utf-8"))
     return cs, shots, depths
 
