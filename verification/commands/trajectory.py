@@ -282,7 +282,7 @@ def run(args, target, projectile):
     folder = check_output_dir(args.out, "out")
     speed = projectile.V0 if args.velocity is None else args.velocity  # Strike checks it
     strike = Strike(speed, args.obliquity, args.attack, args.attack_plane, args.spin)
-    # rifling turns the shank's surface at 0.1-0.5 of the speed; each turn costs ~180 steps
+    # rifling turns the shank's surface at 0.1-0.5 of the speed; each turn costs ~170 steps
     top = strike.speed / projectile.r  # the shank's surface speed <= the striking speed
     require(abs(strike.spin) <= top, "spin",
             f"in [-{top:.6g}, {top:.6g}] rad/s (shank surface speed |spin| r <= the striking "
