@@ -40,10 +40,10 @@ HELP = ("oblique shot with attitude: the rigid projectile in 3-D through the lay
         "(docs/oblique.md)")
 DEFAULT_DIR = "results/trajectory"
 # m/s: below it the damping Jacobian frozen over a ROS2 step misjudges the switching contact
-# and the steps explode (1e-4 m/s: 241 823 steps against 419 at 1e-3, docs/oblique.md)
+# and the steps explode (1e-4 m/s: 14 894 steps against 298 at 1e-3, docs/oblique.md)
 MIN_CONTACT_RAMP = 0.001
 # m/s: up to it the final depth is within the stated 0.1 % of its V_r -> 0 limit (docs/oblique.md
-# convergence table: +1.3e-4 at 0.03, +1.0e-3 at 0.1, +1.7e-3 at 0.3; 100 m/s gave 3x the depth;
+# convergence table: +1.3e-4 at 0.03, +4.0e-4 at 0.1, +1.3e-3 at 0.3; 100 m/s gave 3x the depth;
 # tests/test_edges.py measures 0.03 against 0.001)
 MAX_CONTACT_RAMP = 0.03
 # m: the held contact's depth (--contact-hold, docs/oblique.md "Held contact"): over it the
@@ -282,7 +282,7 @@ def run(args, target, projectile):
     folder = check_output_dir(args.out, "out")
     speed = projectile.V0 if args.velocity is None else args.velocity  # Strike checks it
     strike = Strike(speed, args.obliquity, args.attack, args.attack_plane, args.spin)
-    # rifling turns the shank's surface at 0.1-0.5 of the speed; each turn costs ~1 600 steps
+    # rifling turns the shank's surface at 0.1-0.5 of the speed; each turn costs ~170 steps
     top = strike.speed / projectile.r  # the shank's surface speed <= the striking speed
     require(abs(strike.spin) <= top, "spin",
             f"in [-{top:.6g}, {top:.6g}] rad/s (shank surface speed |spin| r <= the striking "
