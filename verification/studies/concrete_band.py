@@ -22,9 +22,8 @@ from cavex.analytic.concrete_cavity import SUPERSEISMIC, NoSolution, solve
 from cavex.analytic.models import get
 from cavex.analytic.models.concrete import OPTIONS
 from cavex.analytic.penetration.concrete_table import concrete_cavity
-from cavex.errors import CavexInputError
 from cavex.verification.output.files import write_text_atomic
-from cavex.verification.output.paths import check_output_dir
+from cavex.verification.studies.inputs import output_folder
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_OUT = ROOT / "results" / "concrete"
@@ -111,10 +110,8 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default=str(DEFAULT_OUT))
     args = parser.parse_args(argv)
-    try:
-        out = check_output_dir(args.out, "out")
-    except CavexInputError as exc:
-        print(f"cavex: {exc}", file=sys.stderr)
+    out = output_folder(args)
+    if out is None:
         return 2
     out.mkdir(parents=True, exist_ok=True)
     text = report()

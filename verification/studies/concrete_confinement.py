@@ -33,9 +33,8 @@ from cavex.concrete_confinement import (
     shear_limit,
     triaxial_strength,
 )
-from cavex.errors import CavexInputError
 from cavex.verification.output.files import agg_figure, save_figure, write_text_atomic
-from cavex.verification.output.paths import check_output_dir
+from cavex.verification.studies.inputs import output_folder
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_OUT = ROOT / "results" / "concrete"
@@ -178,10 +177,8 @@ def main(argv=None):
         description=__doc__.splitlines()[0])
     parser.add_argument("--out", default=str(DEFAULT_OUT))
     args = parser.parse_args(argv)
-    try:
-        folder = check_output_dir(args.out, "out")
-    except CavexInputError as exc:
-        print(f"cavex: {exc}", file=sys.stderr)
+    folder = output_folder(args)
+    if folder is None:
         return 2
     folder.mkdir(parents=True, exist_ok=True)
     text = report_md()

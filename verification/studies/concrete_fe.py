@@ -45,12 +45,11 @@ import numpy as np
 
 from cavex.analytic.concrete_cavity import ConcreteCavity, solve
 from cavex.concrete import Concrete
-from cavex.errors import CavexInputError
 from cavex.fem import expand_cavity
 from cavex.fem.estimate import richardson_error
 from cavex.verification.output.files import save_figure, write_text_atomic
 from cavex.verification.output.number_format import round_significant
-from cavex.verification.output.paths import check_output_dir
+from cavex.verification.studies.inputs import output_folder
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_OUT = ROOT / "results" / "concrete"
@@ -181,10 +180,8 @@ def main(argv=None):
     parser.add_argument("--out", default=str(DEFAULT_OUT))
     parser.add_argument("--workers", type=int, default=1)
     args = parser.parse_args(argv)
-    try:
-        folder = check_output_dir(args.out, "out")
-    except CavexInputError as exc:
-        print(f"cavex: {exc}", file=sys.stderr)
+    folder = output_folder(args)
+    if folder is None:
         return 2
     if not 1 <= args.workers <= 64:
         print(f"cavex: workers must be in [1, 64], got {args.workers}", file=sys.stderr)

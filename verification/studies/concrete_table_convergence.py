@@ -32,12 +32,13 @@ from cavex.analytic.penetration.concrete_table import TABLE_POINTS, TableResista
 from cavex.analytic.penetration.nose import QUADRATURE_POINTS
 from cavex.verification.output.files import write_text_atomic
 
-# the integrator's tolerances of the concrete studies' flights, and their --out/--shots
-# reader: at the model's rtol 1e-9 the depths of one shot differ by up to 5e-8 between two
-# CPUs' vector maths (7 of this study's 1430 depths, written with 7 digits, then read one unit
-# differently under the emulation of results/regenerate.sh); at 1e-12 by about 1e-9, and the
-# emulation wrote the same CSV byte for byte
-from cavex.verification.studies.concrete_validation import ATOL, RTOL, study_inputs
+# the integrator's tolerances of the concrete studies' flights: at the model's rtol 1e-9 the
+# depths of one shot differ by up to 5e-8 between two CPUs' vector maths (7 of this study's
+# 1430 depths, written with 7 digits, then read one unit differently under the emulation of
+# results/regenerate.sh); at 1e-12 by about 1e-9, and the emulation wrote the same CSV byte
+# for byte
+from cavex.verification.studies.concrete_validation import ATOL, RTOL
+from cavex.verification.studies.inputs import study_inputs
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_SHOTS = ROOT / "examples" / "shots_compilation_dev.csv"

@@ -39,10 +39,9 @@ from cavex.concrete import Constants
 from cavex.errors import CavexInputError, CavexNumericalError
 from cavex.verification.output.files import write_text_atomic
 from cavex.verification.output.number_format import round_significant
-from cavex.verification.output.paths import check_output_dir
+from cavex.verification.studies.inputs import study_inputs
 from cavex.verification.validation.predict import predict
 from cavex.verification.validation.regimes import rigid_flag
-from cavex.verification.validation.shots import read_shots
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_SHOTS = ROOT / "examples" / "shots_compilation_dev.csv"
@@ -240,16 +239,6 @@ def report_md(result, shots_file):
     lines += ["", f"Shots flagged non-rigid (mean nose pressure at impact above the projectile's "
               f"yield strength, published constants): {flagged}.", ""]
     return "\n".join(lines)
-
-
-def study_inputs(args):
-    """``(output folder, shots)`` from a shot study's ``--out`` and ``--shots``; None, with
-    one line on stderr, when either is bad (the study then exits 2, writing nothing)."""
-    try:
-        return check_output_dir(args.out, "out"), read_shots(args.shots).shots
-    except CavexInputError as exc:
-        print(f"cavex: {exc}", file=sys.stderr)
-        return None
 
 
 def main(argv=None):

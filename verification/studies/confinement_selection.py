@@ -47,7 +47,8 @@ from cavex.concrete_confinement import cavity_power_law
 from cavex.errors import CavexInputError, CavexNumericalError
 from cavex.verification.output.files import write_text_atomic
 from cavex.verification.output.number_format import round_significant
-from cavex.verification.studies.concrete_validation import ATOL, RTOL, study_inputs
+from cavex.verification.studies.concrete_validation import ATOL, RTOL
+from cavex.verification.studies.inputs import study_inputs
 from cavex.verification.validation.cross_validation import FOLDS, choose, fold_indices
 from cavex.verification.validation.regimes import (
     DEPTH_DIGITS,
@@ -219,12 +220,13 @@ def main(argv=None):
     inputs = study_inputs(args)
     if inputs is None:
         return 2
-    folder, shots = inputs
-    depths = all_option_depths(list(shots), max(1, args.workers))
+    folder, shots = inputs[0], list(inputs[1])
+    depths = all_option_depths(shots, max(1, args.workers))
     folder.mkdir(parents=True, exist_ok=True)
+    text = report_md(depths, shots)
     write_text_atomic(folder / "confinement_selection.csv", depths_csv(depths, shots))
-    write_text_atomic(folder / "confinement_selection.md", report_md(depths, list(shots)))
-    print(report_md(depths, list(shots)))
+    write_text_atomic(folder / "confinement_selection.md", text)
+    print(text)
     return 0
 
 

@@ -44,7 +44,8 @@ from scipy.optimize import minimize
 from cavex.analytic.empirical import LI_CHEN_COEFFICIENT, crater_calibres, penetration_calibres
 from cavex.verification.output.files import write_text_atomic
 from cavex.verification.output.number_format import round_significant
-from cavex.verification.studies.concrete_validation import source, study_inputs
+from cavex.verification.studies.concrete_validation import source
+from cavex.verification.studies.inputs import study_inputs
 from cavex.verification.validation.regimes import REGIME_TITLES, REGIMES
 
 ROOT = Path(__file__).resolve().parents[2]
