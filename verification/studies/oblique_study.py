@@ -42,7 +42,7 @@ from cavex.config import load_config
 from cavex.verification.fedata.runner import run_cases
 from cavex.verification.output.files import save_figure, write_text_atomic
 from cavex.verification.output.number_format import format_number
-from cavex.verification.output.paths import check_output_dir
+from cavex.verification.studies.inputs import output_folder
 from cavex.verification.studies.study_axes import broken_axes, symlog_axis
 
 OBLIQUITIES = (0.0, 10.0, 20.0, 30.0, 45.0, 60.0)
@@ -711,7 +711,9 @@ def main(argv=None):
     parser.add_argument("--store", help="folder keeping every finished shot (resumable)")
     args = parser.parse_args(argv)
     grid = ((0.0, 20.0), (400.0, 800.0)) if args.quick else (OBLIQUITIES, VELOCITIES)
-    folder = check_output_dir(args.out, "out")
+    folder = output_folder(args)
+    if folder is None:
+        return 2
     folder.mkdir(parents=True, exist_ok=True)
     cases = study_cases(*grid, interfaces=args.interfaces)
     results = run_cases(study_chunk, cases, workers=args.workers, store=args.store,

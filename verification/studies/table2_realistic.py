@@ -64,6 +64,7 @@ from cavex.config import load_config
 from cavex.verification.output.files import save_figure, write_text_atomic
 from cavex.verification.output.number_format import Decimals, format_number
 from cavex.verification.output.paths import check_output_dir
+from cavex.verification.studies.inputs import output_folder
 from cavex.verification.studies.table2 import PAPER_TABLE2, ROW_KEYS, table2_rows
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -461,12 +462,16 @@ def main(argv=None):
     parser.add_argument("--out", default=str(DEFAULT_OUT))
     parser.add_argument("--workers", type=int, default=None)
     args = parser.parse_args(argv)
-    results, cols = run_study(args.out, args.workers)
+    folder = output_folder(args)
+    if folder is None:
+        return 2
+    results, cols = run_study(folder, args.workers)
     print(markdown(cols))
     for name in TARGETS:
         f = results[name]
         print(name, {k: round(v["final_depth_m"], 6) for k, v in f.items()})
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
