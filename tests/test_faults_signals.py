@@ -121,7 +121,10 @@ def test_a_signal_leaves_out_untouched_or_complete(tmp_path, sig, moment, capsys
                 process.kill()
                 process.wait()
     state = check_untouched_or_complete(out)
-    assert (state == "complete") == (code == 0), (state, code, err_path.read_text())
+    if sig == "SIGKILL":  # no clean-up: a kill just after the moves leaves them complete
+        assert code in (0, -9) and (state == "complete" or code != 0), (state, code)
+    else:  # the exit code says what --out holds (the program ignores a signal once moved)
+        assert (state == "complete") == (code == 0), (state, code, err_path.read_text())
     # the staged write lasts milliseconds: it may be over before the poll sees it
     assert reached or moment == "staged write begun"
     if moment in ("estimate printed", "first table cached"):  # a table still to build

@@ -561,6 +561,51 @@ def test_an_interrupt_while_writing_leaves_no_files(tmp_path):
     assert sorted(p.name for p in kept.iterdir()) == ["new.txt", "old.txt"]
 
 
+@pytest.mark.parametrize("program", [False, True])
+def test_an_interrupt_during_the_moves_leaves_every_file(tmp_path, monkeypatch, program):
+    """A signal while the staged files are moved (the commit) never leaves a part of them: one
+    the main thread receives is held back, and one Python's handler runs for mid-commit (as it
+    does when another thread, numba's or dask's, received it) is only recorded (it raised
+    between two moves). After the moves a library caller gets the interrupt, the cavex program
+    (``program_ends_at_commit``) ignores it and every later one (CI saw 'complete' with exit
+    130 when Ctrl-C came at the commit)."""
+    import signal
+
+    from cavex.verification.output import paths
+
+    handlers = [signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)]
+    monkeypatch.setattr(paths, "_ENDS_AT_COMMIT", [True] if program else [])
+    replace, moved = os.replace, []
+
+    def interrupted_replace(source, destination):
+        if not moved:  # at the first move: one signal pending, one run by Python's handler
+            os.kill(os.getpid(), signal.SIGTERM)
+            signal.getsignal(signal.SIGINT)(signal.SIGINT, None)
+        replace(source, destination)
+        moved.append(destination)
+
+    monkeypatch.setattr(paths.os, "replace", interrupted_replace)
+    out = tmp_path / "out"
+    try:
+        if program:
+            with paths.staged_output(out) as stage:
+                for name in ("a.csv", "b.csv", "c.csv"):
+                    (stage / name).write_text(name)
+            assert [signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)] == [
+                signal.SIG_IGN, signal.SIG_IGN]
+            os.kill(os.getpid(), signal.SIGINT)  # after the commit: ignored
+        else:
+            with pytest.raises(KeyboardInterrupt), paths.staged_output(out) as stage:
+                for name in ("a.csv", "b.csv", "c.csv"):
+                    (stage / name).write_text(name)
+            assert [signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)] == handlers
+    finally:
+        for s, handler in zip((signal.SIGINT, signal.SIGTERM), handlers, strict=True):
+            signal.signal(s, handler)
+    assert len(moved) == 3
+    assert sorted(p.name for p in out.iterdir()) == ["a.csv", "b.csv", "c.csv"]
+
+
 def test_ctrl_c_during_a_trajectory_run(tmp_path):
     """Ctrl-C while the files are being written: one line, exit 130, and no --out folder (it
     was a traceback, or a SystemError out of the compiled kernel, and a partial set of files)."""

@@ -265,9 +265,16 @@ def console():
     --no-figures``, benchmarks/commands.md). Functions registered with ``atexit`` or
     ``weakref.finalize`` still run, except after an interrupt (exit code 130), where the
     process ends at once (``os._exit``) once the command has cleaned up; the tests call
-    :func:`main`, which leaves the collector as it is."""
+    :func:`main`, which leaves the collector as it is.
+
+    A command's outputs are its last work: once they are moved into ``--out``, SIGINT and
+    SIGTERM are ignored (:func:`cavex.verification.output.paths.program_ends_at_commit`), so
+    exit code 0 means every new file is there and 130 (or death by SIGTERM) that none is."""
+    from cavex.verification.output.paths import program_ends_at_commit
+
     gc.set_threshold(*GC_THRESHOLDS)
     announce_in_the_program(sys.argv[1:])
+    program_ends_at_commit()
     try:
         code = main()
     except KeyboardInterrupt:  # raised again after main's report: reported once

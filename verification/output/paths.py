@@ -93,6 +93,22 @@ def remove_stale_stages(folder):
             shutil.rmtree(stage, ignore_errors=True)
 
 
+#: Set by the cavex program (:func:`program_ends_at_commit`): its command ends when a staged
+#: write has moved its files in, and SIGINT and SIGTERM are ignored from then on.
+_ENDS_AT_COMMIT = []
+
+
+def program_ends_at_commit():
+    """Called by the cavex program before its command runs. Every command's staged write is the
+    last of its work (what follows prints its summary), so once :func:`staged_output` has moved
+    the files in, SIGINT and SIGTERM are ignored for the rest of the process, and one that
+    arrived during the moves is discarded: the exit code then says what ``--out`` holds, 0
+    every new file, 130 (or death by the signal) none of them. Without this call (a library
+    caller, the tests' in-process ``main``) an interrupt during the moves is raised as
+    :class:`KeyboardInterrupt` once they are done, and handlers are restored."""
+    _ENDS_AT_COMMIT.append(True)
+
+
 @contextmanager
 def staged_output(folder, option="out"):
     """Write a command's files into a hidden folder inside ``folder`` (the ``with`` target);
@@ -106,6 +122,12 @@ def staged_output(folder, option="out"):
     (named by host and process id) is removed by the next staged write into ``folder``
     (:func:`remove_stale_stages`).
 
+    The moves are the commit. Blocking the signals holds back only those delivered to the main
+    thread: a signal another thread (numba's, dask's) receives still runs Python's handler in
+    the main thread, so the handler only records a signal once the commit has begun, and the
+    commit raises nothing midway. What happens to such a signal after the moves:
+    :func:`program_ends_at_commit`.
+
     A clash (a staged file whose name is a folder in ``folder``, a staged folder whose name
     is a file or a symlink) is found before anything is moved (:func:`planned_moves`): the
     run is refused (:class:`CavexInputError` naming ``option``) and ``folder`` is left as it
@@ -117,11 +139,12 @@ def staged_output(folder, option="out"):
     remove_stale_stages(folder)
     stage = Path(tempfile.mkdtemp(prefix=f"{STAGE_PREFIX}{socket.gethostname()}-{os.getpid()}-",
                                   dir=folder))
-    received = []
+    received, record_only = [], []
 
     def interrupt(signum, frame):
         received.append(signum)
-        raise KeyboardInterrupt(f"signal {signum}")
+        if not record_only:
+            raise KeyboardInterrupt(f"signal {signum}")
 
     caught = ()  # handlers are set in the main thread only; an ignored signal stays ignored
     if threading.current_thread() is threading.main_thread():
@@ -138,18 +161,26 @@ def staged_output(folder, option="out"):
             unraisable(report)
 
     sys.unraisablehook = quiet
+    committed = False
     try:
         with output_refusals(option, folder):
             yield stage
+        record_only.append(True)  # the commit begins
         held = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
         try:
-            if received:  # interrupted, but the exception was swallowed on its way
+            if received:  # interrupted before the commit (the exception swallowed on its way)
                 raise KeyboardInterrupt(f"signal {received[0]}")
             for source, destination in planned_moves(stage, folder, option):
                 os.replace(source, destination)
+            committed = True
+            if _ENDS_AT_COMMIT:  # ignoring a blocked signal discards it if pending (POSIX)
+                previous = [signal.SIG_IGN] * len(caught)
+                for s in caught:
+                    signal.signal(s, signal.SIG_IGN)
         finally:
             signal.pthread_sigmask(signal.SIG_SETMASK, held)
     finally:
+        record_only.append(True)  # the clean-up is not cut short either
         sys.unraisablehook = unraisable
         for s, handler in zip(caught, previous, strict=True):
             signal.signal(s, signal.SIG_DFL if handler is None else handler)
@@ -159,6 +190,8 @@ def staged_output(folder, option="out"):
                 folder.rmdir()  # only if empty: nothing was moved in
             except OSError:
                 pass
+    if committed and received and not _ENDS_AT_COMMIT:  # every file is in: then the interrupt
+        raise KeyboardInterrupt(f"signal {received[0]}")
 
 
 @contextmanager
