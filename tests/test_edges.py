@@ -213,6 +213,17 @@ def test_a_body_sliding_tail_first_is_a_numerical_failure(tmp_path, capsys, argv
     assert not (tmp_path / "t").exists()
 
 
+def test_a_strike_slower_than_the_contact_ramp_is_named_as_such(tmp_path, capsys):
+    """At 1e-7 m/s the whole strike lies in the contact ramp (0.01 m/s), whose stress is scaled
+    by the speed into the target: the body is slowed ever less (2.5e-8 m/s, 7.8e-8 m deep at
+    the 1 s limit). The failure says so; it said "a body this heavy", which misleads."""
+    code, out, err = run(capsys, "trajectory", "--velocity", "1e-7", "--no-figures", "--out",
+                         tmp_path / "t")
+    assert code == 1 and out == "" and err.count("\n") == 1
+    assert "slower than the contact ramp (0.01 m/s)" in err and "heavy" not in err
+    assert not (tmp_path / "t").exists()
+
+
 def test_a_run_past_the_step_budget_stops_with_a_message(tmp_path, capsys, monkeypatch):
     from cavex.verification.commands import trajectory
 

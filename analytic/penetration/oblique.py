@@ -183,8 +183,11 @@ class Result:
         """A run that reached the 1 s time limit still moving is no answer (a numerical
         failure naming the run ``name``): either the body has turned tail-first and slides
         through the target, which resists only surfaces moving into it and has no tail face to
-        plough (a large attack, or one against the obliquity, gets there), or it is too heavy
-        for the target to stop within the time limit."""
+        plough (a large attack, or one against the obliquity, gets there), or it moves into the
+        target slower than the contact ramp (``contact_ramp``: there the stress is scaled by the
+        element's speed into the target, so a strike of micrometres per second is slowed ever
+        less and does not stop within the limit: the regularisation's answer, not the
+        target's), or it is too heavy for the target to stop within the time limit."""
         end = self.end
         if end["state"] != "time limit":
             return
@@ -195,6 +198,10 @@ class Result:
             why = ("the body turned tail-first and slid " + where + "; the model loads only "
                    "surfaces moving into the target (no tail face): use a smaller --attack or "
                    "one toward the obliquity")
+        elif not self.model.contact_hold and end["speed_m_s"] < self.model.contact_ramp:
+            why = (f"the body was still moving nose-first {where}, slower than the contact "
+                   f"ramp ({self.model.contact_ramp:g} m/s), within which the target's stress is "
+                   "scaled by the speed into it: a strike this slow is beyond the model")
         else:
             why = (f"the body was still moving nose-first {where}: a body this heavy for the "
                    "target is beyond the model's time")
