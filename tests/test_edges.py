@@ -341,3 +341,17 @@ def test_penetrate_gives_the_depth_where_the_crater_stops_the_projectile(tmp_pat
     assert code == 0, err
     assert json.loads(out)["phases"][-1]["end_depth_m"] == pytest.approx(
         math.sqrt(projectile.m * lc / f0), rel=1e-12)
+
+
+def test_a_table_with_a_failed_cell_is_a_numerical_failure(tmp_path, capsys):
+    """A failed FE cell makes a table no penetration can use (``--resistance table`` refuses
+    it): ``cavex table`` exits 1 naming the cell and writes no table (it wrote the table, said
+    "failed 4" and "largest FE error estimate nan%", and exited 0). The cells here are the
+    switch depths themselves, where the upper layer is a shell of zero thickness on which the
+    FE mesh degenerates (docs/verification.md "Depths")."""
+    out = tmp_path / "t.nc"
+    code, stdout, err = run(capsys, "table", "--no-figures", "-o", out, "--workers", "1",
+                            "--velocities", "0", "500", "--depths", "0.6975", "1.1475")
+    assert code == 1 and stdout == "" and err.count("\n") == 1, err
+    assert "FE cells failed (first at V = 0 m/s, L = 0.6975 m" in err and "nan" not in err
+    assert not out.exists() and (tmp_path / "t.nc.cases").is_dir()

@@ -48,8 +48,27 @@ def run(args, target, projectile):
     refuse_debonded(target, "table")
     result = job(target, projectile, args.velocities, args.depths, args.out, nu=args.nu,
                  workers=args.workers, scheduler=scheduler_of(args), progress=args.progress)
+    refuse_failed_cells(result)
     result["outputs"] = write_outputs(result, result["output"], draw=args.figures)
     return result
+
+
+def refuse_failed_cells(job):
+    """A table with a failed FE cell answers no penetration (``--resistance table`` refuses
+    it): a numerical failure naming the count and the first failed cell, before anything is
+    written; the finished cells stay in the case store, which a rerun resumes."""
+    import json
+
+    from cavex.errors import CavexNumericalError
+
+    failures = json.loads(job["table"].attrs["failures"])
+    if not failures:
+        return
+    first = failures[0]
+    raise CavexNumericalError(
+        f"{len(failures)} of {summary(job)['cases']} FE cells failed (first at V = "
+        f"{first['velocity']:g} m/s, L = {first['depth']:g} m: {first['reason']}); no table "
+        f"written (the finished cells are kept in '{job['store']}' for a rerun)")
 
 
 def job(target, projectile, velocities=None, depths=None, out_path="results/table.nc", *,
