@@ -56,7 +56,8 @@ def run(args, target, projectile):
 def refuse_failed_cells(job):
     """A table with a failed FE cell answers no penetration (``--resistance table`` refuses
     it): a numerical failure naming the count and the first failed cell, before anything is
-    written; the finished cells stay in the case store, which a rerun resumes."""
+    written; the cells stay in the case store, which a rerun loads (a failed cell too: a
+    deterministic failure is not retried, docs/verification.md)."""
     import json
 
     from cavex.errors import CavexNumericalError
@@ -68,7 +69,8 @@ def refuse_failed_cells(job):
     raise CavexNumericalError(
         f"{len(failures)} of {summary(job)['cases']} FE cells failed (first at V = "
         f"{first['velocity']:g} m/s, L = {first['depth']:g} m: {first['reason']}); no table "
-        f"written (the finished cells are kept in '{job['store']}' for a rerun)")
+        f"written (the cells are kept in '{job['store']}', which a rerun loads; delete a failed "
+        "cell's file there to run it again)")
 
 
 def job(target, projectile, velocities=None, depths=None, out_path="results/table.nc", *,
