@@ -29,6 +29,7 @@ from cavex.analytic.penetration.erosion import (
 from cavex.analytic.penetration.integrator import penetrate
 from cavex.analytic.penetration.nose import angle_rule
 from cavex.config import load_config
+from cavex.errors import CavexNumericalError
 from cavex.materials import Material, Projectile, Target
 from cavex.verification.cli import main
 from cavex.verification.validation.shots import read_shots
@@ -92,6 +93,41 @@ def test_the_nose_blunts_as_it_loses_mass():
     for dm, psi in zip(lost[:11], psis[:11], strict=True):  # the lost volume is the nose's
         assert nose_volume(p.r, psi) == pytest.approx(
             nose.volume0 - dm / nose.density, rel=1e-10)
+
+
+def test_past_the_hemisphere_the_nose_recedes_into_the_shank():
+    """Mass lost beyond the hemisphere moves the hemispherical nose back by its volume over the
+    shank's section; the set-back is continuous at the hemisphere. (It stayed at the
+    hemisphere's, so a 1.5-10 km/s shot reported 12-99 % of the mass lost with the tip 0.029 m
+    back.) A body left with less than its hemispherical nose's mass is eroded through: a
+    numerical failure, not a depth."""
+    p = projectile(1000.0)
+    nose = ErodingNose(SILLING_FORRESTAL, p)
+    at_hemisphere = p.m - (nose.volume0 - nose.blunt_volume) * nose.density
+    ogive_only = nose_length(p.r, p.psi) - nose_length(p.r, HEMISPHERE)
+    assert nose.tip_setback(at_hemisphere) == pytest.approx(ogive_only, rel=1e-12)
+    assert nose.tip_setback(at_hemisphere * (1 + 1e-12)) == pytest.approx(ogive_only, rel=1e-9)
+    for beyond in (1e-6, 1e-3, 0.1):  # kg
+        assert nose.tip_setback(at_hemisphere - beyond) == pytest.approx(
+            ogive_only + beyond / nose.density / (math.pi * p.r ** 2), rel=1e-12)
+    cap = nose.density * nose.blunt_volume
+    assert nose.summary(cap * 1.01, 1.0)["tip_depth_m"] < 1.0
+    with pytest.raises(CavexNumericalError, match="eroded through the whole body"):
+        nose.summary(cap * 0.99, 1.0)
+
+
+def test_a_shot_that_erodes_its_body_through_exits_1(tmp_path, capsys):
+    """Table 1's projectile at 10 km/s into the runway with erosion loses 0.501 of 0.505 kg:
+    one line, exit 1, nothing written."""
+    text = (Path(__file__).resolve().parents[1] / "core" / "data" / "runway.toml").read_text()
+    assert "V0 = 1000.0" in text
+    config = tmp_path / "fast.toml"
+    config.write_text(text.replace("V0 = 1000.0", "V0 = 10000.0"))
+    code = main(["penetrate", "--config", str(config), "--erosion", "silling-forrestal",
+                 "--no-figures", "--out", str(tmp_path / "o")])
+    out, err = capsys.readouterr()
+    assert code == 1 and out == "" and err.count("\n") == 1, err
+    assert "eroded through the whole body" in err and not (tmp_path / "o").exists()
 
 
 @pytest.mark.parametrize("A, B", [(2e5, 0.0), (2e5, 0.5)])

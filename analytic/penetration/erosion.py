@@ -43,13 +43,16 @@ not added to the axial force (the rigid models it erodes are frictionless).
 **Blunting.** The mass lost comes off the nose, which stays a tangent ogive of the shank
 radius ``r`` with a smaller CRH: ``psi`` solves ``v(psi) = v(psi_0) - Delta m / rho_p``
 (:func:`nose_volume`), down to a hemisphere (``psi = 1/2``), after which the shape stays
-hemispherical. The nose tip recedes by ``l(psi_0) - l(psi)``, ``l = r sqrt(4 psi - 1)``.
+hemispherical. The nose tip recedes by ``l(psi_0) - l(psi)``, ``l = r sqrt(4 psi - 1)``, and
+past the hemisphere by the further lost volume over the shank's section, ``(v(1/2) - v)/(pi
+r^2)``: the hemispherical nose moves back into the shank. A body that loses all but the
+hemisphere's own mass ``rho_p v(1/2)`` is eroded through: a numerical failure, not a depth.
 """
 
 import math
 from dataclasses import dataclass
 
-from cavex.errors import require
+from cavex.errors import CavexNumericalError, require
 from cavex.materials import DEFAULT_DENSITY
 
 HEMISPHERE = 0.5  # the bluntest tangent ogive (CRH 1/2)
@@ -187,8 +190,13 @@ class ErodingNose:
                       xtol=1e-14, rtol=1e-14)
 
     def tip_setback(self, mass):
-        """How far (m) the eroded nose tip sits behind the original one."""
-        return nose_length(self.r, self.psi0) - nose_length(self.r, self.psi(mass))
+        """How far (m) the eroded nose tip sits behind the original one: the shorter ogive,
+        and past the hemisphere the volume lost beyond it over the shank's section."""
+        setback = nose_length(self.r, self.psi0) - nose_length(self.r, self.psi(mass))
+        if not self.law.blunting or mass >= self.m0:
+            return setback
+        beyond = self.blunt_volume - (self.volume0 - (self.m0 - mass) / self.density)
+        return setback + max(beyond, 0.0) / (math.pi * self.r * self.r)
 
     def forces(self, resistance, depth, velocity, mass):
         """``(F, F_f)``: the axial force on the current nose and the sliding friction (N)."""
@@ -213,6 +221,11 @@ class ErodingNose:
         """What a run reports: the mass lost, the nose's CRH and length, the eroded tip's
         depth given the integrator's (original-tip) ``depth``."""
         psi = self.psi(mass)
+        if mass < self.m0 and mass <= self.density * self.blunt_volume:
+            raise CavexNumericalError(
+                f"the nose eroded through the whole body ({self.m0 - mass:.4g} of "
+                f"{self.m0:.4g} kg lost, {mass:.3g} kg left, less than its hemispherical nose):"
+                " a projectile eroded this far is beyond the erosion model")
         return {"law": self.law.name, "mass_lost_kg": self.m0 - mass,
                 "mass_loss_fraction": (self.m0 - mass) / self.m0, "crh_final": psi,
                 "nose_length_final_m": nose_length(self.r, psi),
