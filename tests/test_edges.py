@@ -355,3 +355,17 @@ def test_a_table_with_a_failed_cell_is_a_numerical_failure(tmp_path, capsys):
     assert code == 1 and stdout == "" and err.count("\n") == 1, err
     assert "FE cells failed (first at V = 0 m/s, L = 0.6975 m" in err and "nan" not in err
     assert not out.exists() and (tmp_path / "t.nc.cases").is_dir()
+
+
+def test_a_full_standard_output_is_one_line_and_exit_2():
+    """Standard output that refuses the text (here /dev/full) is one line on stderr and exit 2,
+    as every other refusal of the file system (it was a ten-line traceback, exit 1)."""
+    import subprocess
+    import sys
+
+    with open("/dev/full", "w") as full:
+        done = subprocess.run([sys.executable, "-m", "cavex", "config"], stdout=full,
+                              stderr=subprocess.PIPE, text=True, timeout=120)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert done.stderr == ("cavex: error: cannot write the standard output: No space left on "
+                           "device\n")

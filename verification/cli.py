@@ -241,6 +241,11 @@ def main(argv=None):
         sys.stdout.flush()
     except BrokenPipeError:  # the reader (e.g. `| head`) stopped: not an error of cavex
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except OSError as exc:  # standard output refused (a full disk, /dev/full): one line
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        print(f"cavex: error: cannot write the standard output: {exc.strerror or exc}",
+              file=sys.stderr)
+        return 2
     return 0
 
 
