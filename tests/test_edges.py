@@ -369,3 +369,18 @@ def test_a_full_standard_output_is_one_line_and_exit_2():
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert done.stderr == ("cavex: error: cannot write the standard output: No space left on "
                            "device\n")
+
+
+@pytest.mark.parametrize("argv, said", [
+    (["--no-free-surface"], "option '--no-free-surface' goes with '--resistance derived'"),
+    (["--boundary", "quasi-static"], "it goes with '--compare-homogeneous'")])
+def test_trajectory_refuses_what_a_table_run_would_ignore(tmp_path, capsys, argv, said):
+    """The table's 3-D law has no free-surface reduction, and ``--boundary`` is the convention of
+    the first layer alone, which only ``--compare-homogeneous`` flies: both were accepted,
+    recorded in summary.json and changed nothing (byte-identical histories)."""
+    table = tmp_path / "t.nc"
+    table.write_bytes(b"")  # refused before the table is read
+    code, out, err = run(capsys, "trajectory", "--resistance", "table", "--table", table,
+                         *argv, "--no-figures", "--out", tmp_path / "o")
+    assert code == 2 and out == "" and err.count("\n") == 1 and said in err, err
+    assert not (tmp_path / "o").exists()

@@ -18,7 +18,9 @@ class Table(Model):
     erodes = True
     takes_table = True
     first_layer = "derived"
-    free_surface_option = True  # its 3-D law (derived: its own; table: the FE's)
+    # its 3-D law is the FE's sigma_r at L = z + l - r, with no free-surface reduction
+    # (docs/oblique.md): --no-free-surface would change nothing
+    free_surface_option = False
     prediction_seconds = 3e-2  # a prediction with an FE table (docs/validation.md)
     compared_with_fe = True  # the reference the closed forms are flown against
     line_styles, line_width = (("k", "-"),), 2.2

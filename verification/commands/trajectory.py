@@ -155,7 +155,9 @@ def trajectory_job(target, projectile, strike, resistance="derived", *, boundary
     settings = {"speed_m_s": strike.speed, "obliquity_deg": strike.obliquity,
                 "attack_deg": strike.attack, "attack_plane_deg": strike.attack_plane,
                 "spin_rad_s": strike.spin, "resistance": resistance, "boundary": boundary,
-                "epsilon": epsilon, "free_surface": free_surface,
+                "epsilon": epsilon,
+                # whether the free-surface reduction applied (a law without one: False)
+                "free_surface": bool(free_surface and get(resistance).free_surface_option),
                 "contact_ramp_m_s": contact_ramp}
     if target.debonded:  # a bonded target's settings (and committed results) are unchanged
         settings["interfaces"] = list(target.bottoms)
@@ -270,9 +272,13 @@ def run(args, target, projectile):
             "tangency-psi", "in [0, 30] degrees", args.tangency_psi)
     laws = law_settings(args, target)
     if args.no_free_surface and not get(args.resistance).free_surface_option:
-        raise CavexInputError(f"option '--no-free-surface' goes with '--resistance derived' (or "
-                              f"table); '--resistance {args.resistance}' has no free-surface "
-                              "reduction")
+        raise CavexInputError(f"option '--no-free-surface' goes with '--resistance derived'; "
+                              f"'--resistance {args.resistance}' has no free-surface reduction")
+    if (args.boundary is not None and get(args.resistance).first_layer
+            and not args.compare_homogeneous):
+        raise CavexInputError(f"option '--boundary' with '--resistance {args.resistance}' is the "
+                              "convention of the first layer alone's closed form: it goes with "
+                              "'--compare-homogeneous'")
     if args.compare_homogeneous and len(target.layers) < 2:
         raise CavexInputError("option '--compare-homogeneous' needs a target of two or more "
                               "layers (this one is its first layer alone already)")
