@@ -340,7 +340,10 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
     stop_depth : float, optional
         Nose-tip depth (m) at which the integration ends (None: not watched), with the reason
         ``stop_reason``; a state change at that depth (to 1e-12 relative) is reported as
-        reaching it.
+        reaching it, and a phase that reaches it ends at it exactly (the next stage starts
+        there: from the event's located depth, 1e-12 m on either side, a rear zone 1e-8 or
+        1e-13 m deep gave the next layer's crater the upper layer's material, and 1e-15 m lost
+        the debonded interface).
     label : str, optional
         The response-state label of the start; the integration ends where
         ``resistance.label`` differs from it (None: the state is not watched).
@@ -389,6 +392,8 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
         reason = stop_reason  # a state change at the stop depth itself (nose-tip switch)
     if reason == STOPPED:
         v_end = 0.0
+    if reason == stop_reason:  # at the stop's depth exactly: the event lands within its
+        depth_end = stop_depth  # tolerance on either side, and the next stage starts there
     if erosion is not None:
         return Phase(label, depth_end, v_end, t_end, reason,
                      end_mass=float(sol.y_events[which][0][2])), sol
@@ -466,6 +471,7 @@ def _append_solution(columns, sol, phase_end, resistance, mass, phase, erosion=N
                     (np.linspace(sol.t[0], t_end, ROWS_PER_PHASE + 1), True)):
         t[-1] = t_end
         y = sol.sol(t)
+        y[0, -1] = phase_end.end_depth  # a stop depth exactly (:func:`integrate`)
         if phase_end.end_reason == STOPPED:
             y[1, -1] = 0.0
         depth = y[0].copy()
