@@ -2,7 +2,6 @@
 
 import sys
 
-from cavex.materials import fe_only_parameters
 from cavex.verification.commands.shared_options import add_config_option
 
 HELP = "FE against analytic wall stress at a nose depth"
@@ -51,14 +50,25 @@ def range_warnings(velocity, wall_stress):
             "constitutive law"]
 
 
+def estimate_warnings(result):
+    """A sentence if the FE's estimated error is still above the target the commands promise
+    (:data:`cavex.fem.estimate.DEFAULT_ERROR_TARGET`) after the refinements allowed."""
+    from cavex.fem.estimate import DEFAULT_ERROR_TARGET
+
+    estimate = result["error_estimate"]
+    if estimate is None or estimate <= DEFAULT_ERROR_TARGET:
+        return []
+    return [f"the FE's estimated error {estimate:.3%} is above the {DEFAULT_ERROR_TARGET:.1%} "
+            f"target after {result['refinements']} refinement(s), the most allowed: the wall "
+            "stress is resolved only to that estimate"]
+
+
 def material_warnings(target):
     """A sentence if a layer has FE-only keys (``tau_max``, ``tensile_strength``): the closed
     forms ignore them, so the comparison is between different materials."""
-    named = []
-    for i, material in enumerate(target.layers):
-        keys = [k for k in fe_only_parameters() if getattr(material, k) is not None]
-        if keys:
-            named.append(f"{target.layer_name(i)} ({', '.join(keys)})")
+    from cavex.verification.commands.options import fe_only_layers
+
+    named = fe_only_layers(target)
     if not named:
         return []
     return ["FE-only keys in " + "; ".join(named) + ": the closed forms ignore them, so "
@@ -78,7 +88,7 @@ def job(target, projectile, depth, velocity, *, nu=None, fields=None):
 
     result = compare_at_depth(target, projectile, depth, velocity, nu=nu, fields=fields)
     return {**result, "warnings": range_warnings(result["velocity_m_s"], result["fe_sigma_r_Pa"])
-            + material_warnings(target)}
+            + material_warnings(target) + estimate_warnings(result)}
 
 
 def summary(result):

@@ -18,7 +18,7 @@ import argparse
 from cavex.analytic.models import DEFAULT_BOUNDARY, OLD_LABELS, get, label_options, labels, names
 from cavex.analytic.paper_model import EPSILON_READINGS
 from cavex.errors import CavexInputError
-from cavex.materials import BONDINGS
+from cavex.materials import BONDINGS, fe_only_parameters
 from cavex.problem import BOUNDARIES
 
 # the models a command offers, as the capabilities it selects from the registry (read when the
@@ -194,3 +194,15 @@ def refuse_debonded(target, command):
         raise CavexInputError(f"is \"debonded\", which `cavex {command}` does not model (the "
                               "spherical problem is one bonded continuum): remove the key, or "
                               "use penetrate or trajectory", f"layers[{j}].bottom")
+
+
+def fe_only_layers(target):
+    """``"name (key, key)"`` of every layer with FE-only keys (``tau_max``,
+    ``tensile_strength``, the hydrostat: the realistic concrete), which the closed forms
+    ignore."""
+    named = []
+    for i, material in enumerate(target.layers):
+        keys = [k for k in fe_only_parameters() if getattr(material, k) is not None]
+        if keys:
+            named.append(f"{target.layer_name(i)} ({', '.join(keys)})")
+    return named

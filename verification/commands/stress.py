@@ -9,6 +9,7 @@ from cavex.materials import MAX_VELOCITY
 from cavex.verification.commands.options import (
     CLOSED_FORMS,
     add_resistance_options,
+    fe_only_layers,
     refuse_debonded,
     resistance_settings,
 )
@@ -31,9 +32,15 @@ def run(args, target, projectile):
     refused)."""
     refuse_debonded(target, "stress")
     settings = resistance_settings(args, CLOSED_FORMS)
-    return stress_at_depth(target, projectile, args.depth, args.velocity,
-                           resistance=settings["resistance"], boundary=settings["boundary"],
-                           epsilon=settings["epsilon"])
+    result = stress_at_depth(target, projectile, args.depth, args.velocity,
+                             resistance=settings["resistance"], boundary=settings["boundary"],
+                             epsilon=settings["epsilon"])
+    named = fe_only_layers(target)
+    if named:  # the realistic concrete: the closed form answers for another material
+        result["notes"] = [f"the closed form ignores the FE-only keys of {'; '.join(named)}: "
+                           "the wall stress of another material than the FE's (`cavex fem` "
+                           "carries them; docs/fem.md 'Concrete')"]
+    return result
 
 
 def stress_at_depth(target, projectile, depth, velocity, *, resistance="derived", boundary=None,
@@ -83,10 +90,11 @@ def text(result):
                      else "none (one layer around the cavity)", ""))
         zones = "; ".join(f"{z['layer']} {g(z['r_inner_m'] * 1e3)}-{g(z['r_outer_m'] * 1e3)}"
                           for z in s["plastic_zones"]) or "none"
-        rows.append(("plastic zones", zones, "mm"))
+        rows.append(("plastic zones", zones, "mm" if s["plastic_zones"] else ""))
     width = max(len(name) for name, _, _ in rows)
-    return "\n".join(f"{name:<{width}}  {value}" + (f" {unit}" if unit else "")
-                     for name, value, unit in rows)
+    return "\n".join([f"{name:<{width}}  {value}" + (f" {unit}" if unit else "")
+                      for name, value, unit in rows]
+                     + [f"note: {note}" for note in s.get("notes", ())])
 
 
 def _digits(x):
