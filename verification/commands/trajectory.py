@@ -66,7 +66,9 @@ def add_arguments(parser):
     parser.add_argument("--attack", type=float, default=0.0,
                         help="angle of attack, axis from velocity (deg)")
     parser.add_argument("--attack-plane", type=float, default=0.0, help="plane of the angle of "
-                        "attack about the velocity (deg; 0: in the plane of obliquity toward +x)")
+                        "attack about the velocity (deg; 0: in the plane of obliquity, nose "
+                        "toward the surface, +x, or -x for a negative obliquity, the mirror "
+                        "shot; 90: toward +y)")
     parser.add_argument("--spin", type=float, default=0.0, help="spin about the axis (rad/s)")
     add_resistance_options(parser, FLOWN_3D)
     add_interface_option(parser)
