@@ -21,8 +21,9 @@ class Strike:
     between the velocity and the target normal (+z; negative: the mirror shot, velocity toward
     -x), ``attack`` between the axis and the velocity, turned in the plane at ``attack_plane``
     about the velocity (0: in the plane of obliquity, nose toward the surface, +x, and -x for
-    a negative obliquity, whose shot is the mirror image; 90: toward +y). ``spin`` (rad/s) about the axis. ``tip_depth``: initial nose-tip depth (m); None: the
-    body's deepest point just touches the surface."""
+    a negative obliquity, whose shot is the mirror image; 90: toward +y). ``spin`` (rad/s)
+    about the axis. ``tip_depth``: initial nose-tip depth (m); None: the body's deepest point
+    just touches the surface."""
 
     speed: float
     obliquity: float = 0.0
