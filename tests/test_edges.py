@@ -441,3 +441,24 @@ def test_a_rear_zone_of_any_accepted_depth_crosses_the_debonded_interface(tmp_pa
     assert [p["stage"] for p in phases][3:5] == ["rear face", "crater"]
     assert phases[4]["end_reason"] == "crater depth reached (macadam)"
     assert phases[-1]["end_depth_m"] == pytest.approx(3.4035, abs=5e-5)
+
+
+def test_a_rerun_into_the_same_folder_leaves_only_its_own_files(tmp_path, capsys):
+    """A run replaces every file its command can write: the first-layer history of a
+    --compare-homogeneous run and the figures of a run with figures went on lying beside a
+    later run's files, two shots in one folder. A file of the user's stays."""
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine\n")
+    assert run(capsys, "trajectory", "--compare-homogeneous", "--obliquity", "20",
+               "--no-figures", "--out", out)[0] == 0
+    assert (out / "history_first_layer_only.csv").exists()
+    assert run(capsys, "trajectory", "--no-figures", "--out", out)[0] == 0
+    assert sorted(p.name for p in out.iterdir()) == ["history_target.csv", "notes.txt",
+                                                     "summary.json"]
+    assert run(capsys, "penetrate", "--out", out)[0] == 0
+    assert (out / "velocity_time.png").exists()  # the other command's files stay
+    assert run(capsys, "penetrate", "--no-figures", "--out", out)[0] == 0
+    assert sorted(p.name for p in out.iterdir()) == [
+        "history_target.csv", "notes.txt", "phases_target.csv", "summary.json",
+        "trajectory_first_layer_only.csv", "trajectory_target.csv"]

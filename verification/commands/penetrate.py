@@ -55,8 +55,13 @@ def run(args, target, projectile):
     job = penetration_job(target, projectile, crater=args.crater, erosion=args.erosion,
                           **settings, **laws)
     job["outputs"] = write_staged(folder,
-                                  lambda stage: write_outputs(job, stage, draw=args.figures))
+                                  lambda stage: write_outputs(job, stage, draw=args.figures),
+                                  replaces=OUTPUTS)
     return job
+
+
+#: every file ``cavex penetrate`` can write (a rerun into the folder replaces them all)
+OUTPUTS = ("trajectory_*.csv", "phases_*.csv", "velocity_time.png", "deceleration_depth.png")
 
 
 def penetration_job(target, projectile, *, resistance="derived", boundary=None,

@@ -323,8 +323,14 @@ def run(args, target, projectile):
         job["estimate"] = estimate_runs(job["runs"])
     summary(job)  # the peaks and rates are finite too, before anything is written
     job["outputs"] = write_staged(folder,
-                                  lambda stage: write_outputs(job, stage, draw=args.figures))
+                                  lambda stage: write_outputs(job, stage, draw=args.figures),
+                                  replaces=OUTPUTS)
     return job
+
+
+#: every file ``cavex trajectory`` can write (a rerun into the folder replaces them all)
+OUTPUTS = ("history_*.csv", "summary.json", "path_side.png", "pitch_time.png", "overload.png",
+           "path_3d.png")
 
 
 def text(job):

@@ -118,7 +118,8 @@ def run(args, target, projectile):
     seconds = time.monotonic() - began
     result["command"] = command_line(shots_path, calibration_paths, out, args.models,
                                      args.erosion, args.cross_validate)
-    written = write_staged(out, lambda stage: write_outputs(result, stage, draw=args.figures))
+    written = write_staged(out, lambda stage: write_outputs(result, stage, draw=args.figures),
+                           replaces=outputs())
     result["seconds"], result["outputs"] = seconds, written
     return result
 
@@ -202,6 +203,19 @@ def summary(result):
 
 
 # --- files ------------------------------------------------------------------------------------
+
+def outputs():
+    """Every file ``cavex validate`` can write at the top of ``--out`` (a rerun replaces them
+    all; ``tables/`` holds FE tables by their keys and is merged)."""
+    from cavex.verification.report.validation_figures import (
+        CROSS_VALIDATION_FIGURE,
+        FIGURES,
+        REGIME_FIGURES,
+    )
+
+    return ("validation.json", "predictions.csv", "report.md", *FIGURES, *REGIME_FIGURES,
+            CROSS_VALIDATION_FIGURE)
+
 
 def write_outputs(result, out, draw=True):
     """Write the JSON, CSV, report, (if ``draw``) the figures and the FE tables the run used

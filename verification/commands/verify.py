@@ -54,11 +54,11 @@ def job(target, projectile, *, config_path=None, quick=False, out_dir=None, sche
     check_execution(workers, scheduler)
     from cavex.verification.report import build  # the numerical libraries, after the checks
 
-    with staged_output(out_dir) as stage:
+    # an old report never mixes with this one: its files are replaced at the commit
+    with staged_output(out_dir, replaces=build.REPORT_FILES + build.OLD_REPORT_FILES) as stage:
         result = build.verify(target, projectile, quick=quick, out_dir=stage,
                               scheduler=scheduler, workers=workers, config_text=config,
                               progress=progress, draw=draw)
-        build.remove_report_files(out_dir)  # an old report never mixes with this one
     return _moved(result, stage, out_dir)
 
 

@@ -152,8 +152,13 @@ def run(args, target, projectile):
     else:
         result = shot_job(target, projectile, speed, args.obliquity, args.attack,
                           args.interfaces)
-    result["outputs"] = write_staged(folder, lambda stage: write_outputs(result, stage))
+    result["outputs"] = write_staged(folder, lambda stage: write_outputs(result, stage),
+                                     replaces=OUTPUTS)
     return result
+
+
+#: every file ``cavex view`` can write (a rerun into the folder replaces them all)
+OUTPUTS = ("fields.png", "shot.png", "view.json")
 
 
 def fields_job(target, projectile, depth, velocity, *, nu=None, stress="deviator",

@@ -110,10 +110,16 @@ def program_ends_at_commit():
 
 
 @contextmanager
-def staged_output(folder, option="out"):
+def staged_output(folder, option="out", replaces=()):
     """Write a command's files into a hidden folder inside ``folder`` (the ``with`` target);
     when the block ends normally, move them into ``folder`` (``os.replace``, with SIGINT and
     SIGTERM held back for the moves), so that ``folder`` gets either every new file or none.
+
+    ``replaces``: glob patterns of every file the command can write. A file of ``folder`` that
+    matches one and that this run did not write (an earlier run's figures before a
+    ``--no-figures`` run, its first-layer history before a run without
+    ``--compare-homogeneous``) is removed with the moves, so ``folder`` never holds two runs'
+    files side by side.
 
     An exception or an interrupt (SIGINT or SIGTERM: :class:`KeyboardInterrupt`, also when the
     exception was swallowed on its way, e.g. in a garbage-collector callback) removes the hidden
@@ -170,8 +176,11 @@ def staged_output(folder, option="out"):
         try:
             if received:  # interrupted before the commit (the exception swallowed on its way)
                 raise KeyboardInterrupt(f"signal {received[0]}")
-            for source, destination in planned_moves(stage, folder, option):
+            moves = planned_moves(stage, folder, option)
+            for source, destination in moves:
                 os.replace(source, destination)
+            remove_earlier_outputs(folder, replaces,
+                                   {Path(d).relative_to(folder).parts[0] for _, d in moves})
             committed = True
             if _ENDS_AT_COMMIT:  # ignoring a blocked signal discards it if pending (POSIX)
                 previous = [signal.SIG_IGN] * len(caught)
@@ -192,6 +201,18 @@ def staged_output(folder, option="out"):
                 pass
     if committed and received and not _ENDS_AT_COMMIT:  # every file is in: then the interrupt
         raise KeyboardInterrupt(f"signal {received[0]}")
+
+
+def remove_earlier_outputs(folder, patterns, written):
+    """Remove the files (or links) of ``folder`` matching ``patterns`` whose names are not in
+    ``written`` (:func:`staged_output`'s ``replaces``)."""
+    for pattern in patterns:
+        for path in Path(folder).glob(pattern):
+            if path.name not in written and (path.is_symlink() or path.is_file()):
+                try:
+                    path.unlink(missing_ok=True)
+                except OSError:  # the moves are done: a file that stays is no reason to fail
+                    pass
 
 
 @contextmanager
@@ -235,10 +256,11 @@ def planned_moves(stage, folder, option="out"):
     return moves
 
 
-def write_staged(folder, write):
+def write_staged(folder, write, replaces=()):
     """``write(stage)`` (writes a command's files into ``stage``, returns their paths) inside
-    :func:`staged_output` of ``folder``; returns the paths the files have in ``folder``."""
+    :func:`staged_output` of ``folder`` (``replaces``: the patterns of every file the command
+    can write); returns the paths the files have in ``folder``."""
     folder = Path(folder)
-    with staged_output(folder) as stage:
+    with staged_output(folder, replaces=replaces) as stage:
         written = write(stage)
     return [str(folder / Path(path).relative_to(stage)) for path in written]
