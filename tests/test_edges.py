@@ -225,6 +225,17 @@ def test_a_strike_slower_than_the_contact_ramp_is_named_as_such(tmp_path, capsys
     assert not (tmp_path / "t").exists()
 
 
+def test_a_symmetric_shot_that_tumbles_is_not_told_to_change_its_attack(tmp_path, capsys):
+    """A normal shot without attack under a law without strength (A = 0) tumbles from
+    round-off; the failure said "use a smaller --attack or one toward the obliquity", which
+    this shot has not."""
+    code, out, err = run(capsys, "trajectory", "--resistance", "law", "--law-A", "0",
+                         "--law-B", "1000", "--no-figures", "--out", tmp_path / "t")
+    assert code == 1 and out == "" and err.count("\n") == 1
+    assert "tail-first" in err and "a shot without attack turns from round-off" in err
+    assert "--attack" not in err
+
+
 def test_a_run_past_the_step_budget_stops_with_a_message(tmp_path, capsys, monkeypatch):
     from cavex.verification.commands import trajectory
 

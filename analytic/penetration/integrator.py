@@ -380,7 +380,7 @@ def integrate(resistance, mass, start, *, stop_depth=None, stop_reason=DEPTH_REA
         raise CavexNumericalError(
             f"the projectile was still moving {MAX_PHASE_DURATION:g} s into a phase (depth "
             f"{sol.y[0, -1]:.4g} m, {sol.y[1, -1]:.4g} m/s): a body this heavy or slender for "
-            "the target is beyond the model")
+            "the target, or a resistance this weak for the body, is beyond the model")
     if sol.status != 1:
         raise CavexNumericalError(f"penetration integration failed at t={sol.t[-1]} s, "
                                   f"depth {sol.y[0, -1]} m: {sol.message}")

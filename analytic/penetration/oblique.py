@@ -195,9 +195,12 @@ class Result:
         where = (f"to the {end['time_s']:g} s time limit ({end['speed_m_s']:.3g} m/s, nose "
                  f"tip {end['nose_tip_m'][2]:.3g} m deep)")
         if float(np.dot(self.model.axis(y), y[7:10])) < 0.0:
+            advice = ("use a smaller --attack or one toward the obliquity"
+                      if self.strike is not None and self.strike.attack > 0.0 else
+                      "a shot without attack turns from round-off where the resistance is too "
+                      "weak to hold the nose ahead (e.g. a law without strength, A = 0)")
             why = ("the body turned tail-first and slid " + where + "; the model loads only "
-                   "surfaces moving into the target (no tail face): use a smaller --attack or "
-                   "one toward the obliquity")
+                   "surfaces moving into the target (no tail face): " + advice)
         elif not self.model.contact_hold and end["speed_m_s"] < self.model.contact_ramp:
             why = (f"the body was still moving nose-first {where}, slower than the contact "
                    f"ramp ({self.model.contact_ramp:g} m/s), within which the target's stress is "
