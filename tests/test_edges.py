@@ -473,3 +473,24 @@ def test_a_rerun_into_the_same_folder_leaves_only_its_own_files(tmp_path, capsys
     assert sorted(p.name for p in out.iterdir()) == [
         "history_target.csv", "notes.txt", "phases_target.csv", "summary.json",
         "trajectory_first_layer_only.csv", "trajectory_target.csv"]
+
+
+def test_calibrate_says_when_a_parameter_sits_on_its_bound(tmp_path, capsys):
+    """Three extreme shots push strength_factor onto its upper bound 20: the fit printed
+    "strength_factor = 20 +- 3.6e+02", an error 18 times the whole range. A parameter on a
+    bound has no standard error (None in the JSON) and the text says why."""
+    shots = tmp_path / "ext.csv"
+    shots.write_text(
+        "id,mass_kg,diameter_m,length_m,crh,V0_m_s,fc_Pa,rho_kg_m3,depth_m\n"
+        "v1,0.904,0.0269,0.2424,2.0,1,32400000.0,2370.0,0.0001\n"
+        "d20,0.904,20,,2.0,800,32400000.0,2370.0,0.0001\n"
+        "fc1e9,0.904,0.0269,,2.0,800,1e9,4000,0.1\n")
+    code, out, err = run(capsys, "calibrate", "--shots", shots, "--out", tmp_path / "c.toml",
+                         "--workers", "1", "--json")
+    document = json.loads(out)
+    assert code == 0 and document["fitted"]["strength_factor"] == 20.0
+    assert document["standard_errors"]["strength_factor"] is None
+    code, out, err = run(capsys, "calibrate", "--shots", shots, "--out", tmp_path / "c.toml",
+                         "--workers", "1")
+    assert ("strength_factor = 20 (no standard error: at its upper bound 20: the shots want it "
+            "beyond, so they determine neither it nor its error)") in out

@@ -383,3 +383,16 @@ def test_quick_report_without_figures(quick_report, tmp_path):
         expected = [report.NOT_DRAWN if x.startswith("![") else x for x in lines]
         assert plain[heading] == expected, heading
     assert sum(x.startswith("![") for lines in drawn.values() for x in lines) == len(PNGS) - 1
+
+
+def test_a_wall_layer_without_fe_results_ranks_no_closed_form():
+    """Every FE cell with concrete at the wall failed (a concrete of E = 1e300): the conclusion
+    named "the closest closed form ... (median error n/a)", a ranking with no data."""
+    from cavex.verification.report.text import conclusions
+
+    target, _ = load_config()
+    grid = xr.Dataset(coords={"velocity": [0.0, 500.0]})
+    stats = {key: {0: {"median": float("nan")}} for key in ("dynamic", "quasi_static", "paper")}
+    (line,) = conclusions(grid, target, stats)
+    assert line == ("**concrete at the wall**: no FE result (every cell failed), so no closed "
+                    "form is ranked there.")

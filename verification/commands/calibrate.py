@@ -139,7 +139,7 @@ def text(job):
     errors = s["standard_errors"]
     why = ("as many shots as parameters" if len(s["shots"]) <= len(s["fitted"])
            else "the shots do not determine it")
-    values = ", ".join(f"{p} = {v:.6g}" + _error(errors.get(p), why)
+    values = ", ".join(f"{p} = {v:.6g}" + _error(errors.get(p), bound_words(p, v) or why)
                        for p, v in s["fitted"].items())
     return "\n".join([
         f"model   {s['model']}, {len(s['shots'])} shots: {', '.join(s['shots'])}",
@@ -151,6 +151,18 @@ def text(job):
         *_outlier_lines(s),
         f"wrote   {s['output']}",
     ])
+
+
+def bound_words(param, value):
+    """Why a parameter fitted onto its bound has no standard error (None: not on one)."""
+    from cavex.verification.validation.calibration import BOUNDS, at_bound
+
+    side = at_bound(param, value)
+    if side is None:
+        return None
+    bound = BOUNDS[param][0 if side == "lower" else 1]
+    return (f"at its {side} bound {bound:g}: the shots want it beyond, so they determine "
+            "neither it nor its error")
 
 
 def _error(se, why):

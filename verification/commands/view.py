@@ -52,18 +52,21 @@ def add_arguments(parser):
     parser.add_argument("--velocity", type=float, help="expansion velocity V (fields, m/s; "
                         "required) or striking speed (shot, m/s; default: the projectile's V0)")
     parser.add_argument("--depth", type=float, help="fields: nose-tip depth L (m; required)")
-    parser.add_argument("--stress", choices=STRESS_CHOICES, default="deviator",
-                        help="fields: the stress the sphere is coloured by (deviator: "
-                        "|sigma_r - sigma_theta|, the von Mises stress of the spherical state)")
-    parser.add_argument("--extent", type=float, default=DEFAULT_EXTENT,
+    parser.add_argument("--stress", choices=STRESS_CHOICES,
+                        help="fields: the stress the sphere is coloured by (deviator, the "
+                        "default: |sigma_r - sigma_theta|, the von Mises stress of the "
+                        "spherical state)")
+    parser.add_argument("--extent", type=float,
                         help="fields: the picture's outer radius in FE plastic radii (in "
-                        f"[{EXTENT_RANGE[0]:g}, {EXTENT_RANGE[1]:g}])")
+                        f"[{EXTENT_RANGE[0]:g}, {EXTENT_RANGE[1]:g}]; default "
+                        f"{DEFAULT_EXTENT:g})")
     parser.add_argument("--nu", type=float, help="fields: Poisson's ratio for every layer "
                         "(default: the file's)")
-    parser.add_argument("--obliquity", type=float, default=0.0,
-                        help="shot: angle of the velocity from the target normal (deg)")
-    parser.add_argument("--attack", type=float, default=0.0,
-                        help="shot: angle of attack in the plane of obliquity (deg)")
+    parser.add_argument("--obliquity", type=float,
+                        help="shot: angle of the velocity from the target normal (deg; "
+                        "default 0)")
+    parser.add_argument("--attack", type=float,
+                        help="shot: angle of attack in the plane of obliquity (deg; default 0)")
     parser.add_argument("--interfaces", choices=BONDINGS, default=None,
                         help="shot: every interface bonded or debonded (default: each layer's "
                         "'bottom' key in the config, bonded)")
@@ -72,13 +75,17 @@ def add_arguments(parser):
 
 
 def check_scene_options(args):
-    """Refuse an option of the other scene (given a value other than its default)."""
+    """Refuse an option of the other scene (given at all: at its default value too, which was
+    let through), then set the scene's own options not given to their defaults."""
     other = SHOT_ONLY if args.scene == "fields" else FIELDS_ONLY
-    for name, default in other.items():
-        if getattr(args, name) != default:
+    for name in other:
+        if getattr(args, name) is not None:
             raise CavexInputError(f"option '--{name}' goes with 'cavex view "
                                   f"{'shot' if args.scene == 'fields' else 'fields'}', not "
                                   f"with 'cavex view {args.scene}'")
+    for name, default in (FIELDS_ONLY if args.scene == "fields" else SHOT_ONLY).items():
+        if getattr(args, name) is None:
+            setattr(args, name, default)
 
 
 def require_pyvista():
@@ -134,6 +141,9 @@ def run(args, target, projectile):
     check_scene_options(args)
     folder = check_output_dir(args.out, "out")
     if args.scene == "fields":
+        from cavex.verification.commands.options import refuse_debonded
+
+        refuse_debonded(target, "view fields")  # the FE's spherical problem is bonded
         require(args.velocity is not None, "velocity", "given for 'cavex view fields' (m/s)",
                 args.velocity)
         require(args.depth is not None, "depth", "given for 'cavex view fields' (m)", args.depth)

@@ -78,8 +78,12 @@ def conclusions(grid, target, stats):
     vmax, vmin = float(grid.velocity.max()), float(grid.velocity.min())
     lines = []
     for index in sorted(next(iter(stats.values()))):
-        best = min(stats, key=lambda k: abs(stats[k][index]["median"])
-                   if math.isfinite(stats[k][index]["median"]) else math.inf)
+        ranked = [k for k in stats if math.isfinite(stats[k][index]["median"])]
+        if not ranked:  # every FE cell of this wall layer failed: nothing to rank
+            lines.append(f"**{names[index]} at the wall**: no FE result (every cell failed), "
+                         "so no closed form is ranked there.")
+            continue
+        best = min(ranked, key=lambda k: abs(stats[k][index]["median"]))
         lines.append(f"**{names[index]} at the wall**: the closest closed form is "
                      f"{LABELS[best]} (median error {pct(stats[best][index]['median'])}).")
         for key, s in ((k, stats[k][index]) for k in stats):

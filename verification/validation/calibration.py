@@ -266,7 +266,27 @@ def _least_squares(shots, model, params, start, tables, progress):
             from None
     values = [round_significant(v, PARAMETER_DIGITS) for v in _to_values(solution.x, params)]
     errors = standard_errors(solution.jac, solution.fun, params, solution.x)
+    # at a bound the linearised error describes no spread (the fit wants the parameter beyond),
+    # and the value is the bound (lam = 4.4e-18 was the round-off of 0)
+    sides = [at_bound(p, v) for p, v in zip(params, values, strict=True)]
+    errors = [None if side else e for side, e in zip(sides, errors, strict=True)]
+    values = [BOUNDS[p][0 if side == "lower" else 1] if side else v
+              for p, v, side in zip(params, values, sides, strict=True)]
     return start.with_values(params, values), count[0], tuple(zip(params, errors, strict=True))
+
+
+def at_bound(param, value):
+    """``"lower"`` or ``"upper"`` if the fitted ``value`` of ``param`` lies on that bound of
+    :data:`BOUNDS` (to 1e-6 of the bounds' span, in ``ln`` for :data:`LOG_PARAMETERS`), else
+    None: the fit wants it beyond, so the shots determine neither it nor its error."""
+    (lower,), (upper,) = _bounds((param,))
+    x = math.log(value) if param in LOG_PARAMETERS else value
+    tolerance = 1e-6 * (upper - lower)
+    if x - lower <= tolerance:
+        return "lower"
+    if upper - x <= tolerance:
+        return "upper"
+    return None
 
 
 def standard_errors(jacobian, residuals, params, x):
