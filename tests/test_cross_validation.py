@@ -181,11 +181,12 @@ def test_the_command_writes_the_cross_validation(capsys, tmp_path):
     (["--cross-validate", "reference", "reference"], ("A", "A", "B", "B"),
      "must be fold names without repeats"),
     (["--cross-validate", "reference"], ("A", "A", "A", "A"),
-     "must be reference: given shots of at least two references"),
+     "must be a family the file can fold ('reference': shots of at least two references"),
     (["--cross-validate", "reference"], ("A", "", "B", "B"),
      "reference needs every shot's reference in the shot file's column 'source' (shot 'X1'"),
     (["--cross-validate", "velocity"], ("A", "A", "B", "B"),
-     "must be velocity: given shots of the kind (V0 > 1000 m/s) and others (got '0 of 4"),
+     "must be a kind of shot the file holds beside others ('velocity': V0 > 1000 m/s) (got "
+     "'0 of 4"),
     (["--cross-validate"], ("A", "A", "A", "A"),
      "must be applicable to the shots"),
 ])

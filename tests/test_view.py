@@ -291,3 +291,17 @@ def test_bad_input_loads_no_numerical_library():
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                           timeout=120, check=True)
     assert done.stdout.splitlines()[-1] == "[2, 2] []"
+
+
+@needs_rendering
+def test_view_says_a_ricochet_above_the_surface_and_warns_on_stderr(tmp_path, capsys,
+                                                                    rendering):
+    """A ricochet ends above the surface: "nose tip 0.0477 m above the surface" (it said
+    "-0.0477 m deep"). A fields run beyond 1200 m/s warns on stderr, as cavex fem does (the
+    warning was a line of the text on stdout)."""
+    code, out, err = run(capsys, "view", "shot", "--obliquity", "80", "--out", tmp_path / "s")
+    assert code == 0 and "end: ricochet, nose tip 0.0477 m above the surface" in out
+    code, out, err = run(capsys, "view", "fields", "--velocity", "1300", "--depth", "0.3",
+                         "--out", tmp_path / "f")
+    assert code == 0 and "warning" not in out
+    assert err.startswith("cavex view: warning: V = 1300 m/s is beyond 1200 m/s")

@@ -333,6 +333,12 @@ OUTPUTS = ("history_*.csv", "summary.json", "path_side.png", "pitch_time.png", "
            "path_3d.png")
 
 
+def degrees(angle):
+    """An angle (deg) to 2 decimals, without the sign of a zero (-0.001 is "0.00")."""
+    words = f"{angle:.2f}"
+    return "0.00" if words == "-0.00" else words
+
+
 def text(job):
     """The settings, each run's phase table, end state and peaks, the files written."""
     document = summary(job)
@@ -343,11 +349,11 @@ def text(job):
                   f"{'phase':<10} {'ends at t (ms)':>14} {'tip z (m)':>10} {'pitch':>8} "
                   f"{'speed':>8}  because"]
         lines += [f"{p['label']:<10} {p['end_time_s'] * 1e3:14.4f} "
-                  f"{p['end_nose_tip_m'][2]:10.4f} {p['end_pitch_deg']:8.2f} "
+                  f"{p['end_nose_tip_m'][2]:10.4f} {degrees(p['end_pitch_deg']):>8} "
                   f"{p['end_speed_m_s']:8.2f}  {p['end_reason']}" for p in s["phases"]]
         tip = ", ".join(f"{c:.4f}".replace("-0.0000", "0.0000") for c in e["nose_tip_m"])
         lines.append(f"end: {e['state']}, nose tip ({tip}) m, pitch "
-                     f"{e['pitch_deg']:.2f} deg; peaks: axial {s['max_axial_g']:.0f} g, "
+                     f"{degrees(e['pitch_deg'])} deg; peaks: axial {s['max_axial_g']:.0f} g, "
                      f"lateral {s['max_lateral_g']:.0f} g")
     if "estimate" in document:
         from cavex.analytic.penetration.refinement import verdict

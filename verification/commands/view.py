@@ -18,6 +18,7 @@ there is no display) with one line saying so; both exit 2 before anything is com
 import importlib.util
 import math
 import os
+import sys
 import tempfile
 import textwrap
 from pathlib import Path
@@ -164,7 +165,15 @@ def run(args, target, projectile):
                           args.interfaces)
     result["outputs"] = write_staged(folder, lambda stage: write_outputs(result, stage),
                                      replaces=OUTPUTS)
+    for warning in result.get("fe", {}).get("warnings", ()):  # on stderr, as cavex fem does
+        print(f"cavex view: warning: {warning}", file=sys.stderr)
     return result
+
+
+def tip_depth_words(z):
+    """The nose tip's depth ``z`` (m) in words: ``m deep``, or ``m above the surface`` for a
+    body that left the target (a ricochet)."""
+    return f"{z:.4f} m deep" if z >= 0.0 else f"{-z:.4f} m above the surface"
 
 
 #: every file ``cavex view`` can write (a rerun into the folder replaces them all)
@@ -296,13 +305,12 @@ def text(result):
                                        for z in document["zones"])]
         if document["beyond_view"]:
             lines.append("beyond the picture: " + "; ".join(document["beyond_view"]))
-        lines += [f"warning: {w}" for w in document["warnings"]]
     else:
         from cavex.verification.report.trajectory_figures import shot_title
 
         end = document["end"]
         lines = [shot_title(document), f"layers: {', '.join(document['layers'])}",
-                 f"end: {end['state']}, nose tip {end['nose_tip_m'][2]:.4f} m deep"]
+                 f"end: {end['state']}, nose tip {tip_depth_words(end['nose_tip_m'][2])}"]
     image = document.get("image", {})
     if image:
         lines.append(f"rendered {image['width_px']} x {image['height_px']} px off screen "

@@ -106,14 +106,14 @@ def check_folds(families, shots):
                 f"'{REFERENCE_COLUMN}' (shot '{missing[0]}' has none)", "cross-validate")
         references = {reference_of(s) for s in shots}
         require(len(references) >= 2, "cross-validate",
-                f"reference: given shots of at least two references (column "
-                f"'{REFERENCE_COLUMN}')", f"{len(references)} reference")
+                f"a family the file can fold ('reference': shots of at least two references, "
+                f"column '{REFERENCE_COLUMN}')", f"{len(references)} reference")
     for name in families:
         if name in KINDS:
             words, member = KINDS[name]
             count = sum(1 for s in shots if member(s))
             require(0 < count < len(shots), "cross-validate",
-                    f"{name}: given shots of the kind ({words}) and others",
+                    f"a kind of shot the file holds beside others ('{name}': {words})",
                     f"{count} of {len(shots)} shots of the kind")
     return families
 
