@@ -180,6 +180,8 @@ def test_the_command_writes_the_cross_validation(capsys, tmp_path):
      "(got 'folds')"),
     (["--cross-validate", "reference", "reference"], ("A", "A", "B", "B"),
      "must be fold names without repeats"),
+    (["--models", "li-chen-2003", "li-chen-2003"], ("A", "A", "B", "B"),  # replaces the first
+     "parameter 'models' must be labels without repeats"),
     (["--cross-validate", "reference"], ("A", "A", "A", "A"),
      "must be a family the file can fold ('reference': shots of at least two references"),
     (["--cross-validate", "reference"], ("A", "", "B", "B"),

@@ -41,7 +41,7 @@ import numpy as np
 from cavex.analytic.models import get, labels, names, parse_label, the
 from cavex.analytic.penetration.nose import nose_rule
 from cavex.concrete import Mapping
-from cavex.errors import CavexInputError, CavexNumericalError, require_choice
+from cavex.errors import CavexInputError, CavexNumericalError, require, require_choice
 from cavex.verification.output.number_format import round_significant
 from cavex.verification.validation.regimes import DEPTH_DIGITS, regime_statistics, rigid_flag
 from cavex.verification.validation.shots import shot_projectile, shot_target
@@ -348,6 +348,7 @@ def check_models(models):
         return offered
     for name in models:
         require_choice(name, offered, "models")
+    require(len(set(models)) == len(models), "models", "labels without repeats", list(models))
     return tuple(m for m in offered if m in models)
 
 
