@@ -494,3 +494,17 @@ def test_calibrate_says_when_a_parameter_sits_on_its_bound(tmp_path, capsys):
                          "--workers", "1")
     assert ("strength_factor = 20 (no standard error: at its upper bound 20: the shots want it "
             "beyond, so they determine neither it nor its error)") in out
+
+
+def test_models_without_the_fe_table_build_no_compressibility_column(tmp_path, capsys):
+    """With a derived-dynamic calibration the FE-table model flies under its mapping (the
+    compressibility column); ``--models derived-dynamic`` leaves the FE tables out, and so that
+    column (it built 17 FE tables, 612 FE cases, for a column not asked for)."""
+    root = Path(__file__).resolve().parents[1]
+    code, out, err = run(capsys, "validate", "--shots", root / "examples" /
+                         "shots_forrestal1994.csv", "--models", "derived-dynamic",
+                         "--calibration", root / "results" / "validation" /
+                         "calibration_derived-dynamic.toml", "--no-figures", "--json",
+                         "--out", tmp_path / "v")
+    assert code == 0 and "FE tables: 0 to build" in err
+    assert json.loads(out)["models"] == ["derived-dynamic", "derived-dynamic calibrated"]

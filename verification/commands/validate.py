@@ -134,14 +134,24 @@ def check_models(models):
 
 def columns_of(calibrations, models=None):
     """Every column :func:`job` fills: the models (default all), the calibrated ones and, with
-    a derived-dynamic calibration, :data:`COMPRESSIBILITY_COLUMN`."""
+    a derived-dynamic calibration and the FE-table model among the models run,
+    :data:`COMPRESSIBILITY_COLUMN`."""
     from cavex.verification.validation.predict import validation_columns
 
     columns = validation_columns(calibrations, models=models)
-    dynamic = [c for c in calibrations if c.model == FE_PARTNER]
+    dynamic = compressibility_calibrations(calibrations, models)
     if dynamic:
         columns[COMPRESSIBILITY_COLUMN] = (FE_MODEL, dynamic[0].mapping)
     return columns
+
+
+def compressibility_calibrations(calibrations, models=None):
+    """The derived-dynamic calibrations whose mapping :data:`COMPRESSIBILITY_COLUMN` flies the
+    FE tables with: none where ``--models`` leaves the FE-table model out (the column built
+    17 FE tables for a run of derived-dynamic alone)."""
+    if models is not None and FE_MODEL not in models:
+        return []
+    return [c for c in calibrations if c.model == FE_PARTNER]
 
 
 def estimate(shots, calibrations, tables, workers, models=None, erosion="none",
@@ -178,7 +188,7 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
     folds = None if cross_validate is None else fold_validator(cross_validate, law)
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
                       progress=progress, models=models, erosion=law, cross_validate=folds)
-    if any(c.model == FE_PARTNER for c in calibrations):
+    if compressibility_calibrations(calibrations, models):
         columns = {COMPRESSIBILITY_COLUMN: columns_of(calibrations)[COMPRESSIBILITY_COLUMN]}
         depths, failures = predictions(shot_file.shots, columns, tables, progress, law)
         for row, depth in zip(result["shots"], depths[COMPRESSIBILITY_COLUMN], strict=True):
