@@ -256,16 +256,15 @@ def fe_only_notes(target, closed, table):
     hydrostat: the realistic concrete, ``concrete = {..., capped = true}``): the closed forms
     ignore them, so the run flown with the closed form ``closed`` (the first layer alone with a
     table, else both runs) is of another material than the FE's (docs/table2.md)."""
-    from cavex.materials import fe_only_parameters
+    from cavex.verification.commands.options import fe_only_layers
 
-    named = [target.layer_name(i) for i, material in enumerate(target.layers)
-             if any(getattr(material, k) is not None for k in fe_only_parameters())]
+    named = fe_only_layers(target)
     if not named:
         return []
     runs = "the first layer alone is" if table else "both runs are"
     return [f"{runs} flown with the {closed} closed form, which ignores the FE-only keys of "
-            f"{', '.join(named)} (cap, tension cut-off, compaction): another material than "
-            "the FE's; an FE table of the target carries them (docs/table2.md)"]
+            f"{'; '.join(named)}: another material than the FE's; an FE table of the target "
+            "carries them (docs/table2.md)"]
 
 
 def phases_as_dicts(trajectory):
