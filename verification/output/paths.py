@@ -130,8 +130,8 @@ def staged_output(folder, option="out", replaces=()):
 
     The moves are the commit. Blocking the signals holds back only those delivered to the main
     thread: a signal another thread (numba's, dask's) receives still runs Python's handler in
-    the main thread, so the handler only records a signal once the commit has begun, and the
-    commit raises nothing midway. What happens to such a signal after the moves:
+    the main thread, so the handler only records a signal once the commit (or the clean-up)
+    has begun, and neither is cut short midway. What happens to such a signal after the moves:
     :func:`program_ends_at_commit`.
 
     A clash (a staged file whose name is a folder in ``folder``, a staged folder whose name
