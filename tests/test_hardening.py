@@ -572,9 +572,10 @@ def test_an_interrupt_during_the_moves_leaves_every_file(tmp_path, monkeypatch, 
     import signal
 
     from cavex.verification.output import paths
+    from cavex.verification.output import program as cavex_program
 
     handlers = [signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)]
-    monkeypatch.setattr(paths, "_ENDS_AT_COMMIT", [True] if program else [])
+    monkeypatch.setattr(cavex_program, "_ENDS_AT_COMMIT", [True] if program else [])
     replace, moved = os.replace, []
 
     def interrupted_replace(source, destination):

@@ -273,9 +273,9 @@ def console():
     :func:`main`, which leaves the collector as it is.
 
     A command's outputs are its last work: once they are moved into ``--out``, SIGINT and
-    SIGTERM are ignored (:func:`cavex.verification.output.paths.program_ends_at_commit`), so
+    SIGTERM are ignored (:func:`cavex.verification.output.program.program_ends_at_commit`), so
     exit code 0 means every new file is there and 130 (or death by SIGTERM) that none is."""
-    from cavex.verification.output.paths import program_ends_at_commit
+    from cavex.verification.output.program import program_ends_at_commit
 
     gc.set_threshold(*GC_THRESHOLDS)
     announce_in_the_program(sys.argv[1:])

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from cavex.errors import CavexInputError, require
 from cavex.verification.output.files import process_alive
+from cavex.verification.output.program import ends_at_commit
 
 
 def check_output_dir(path, option, shown=None):
@@ -93,22 +94,6 @@ def remove_stale_stages(folder):
             shutil.rmtree(stage, ignore_errors=True)
 
 
-#: Set by the cavex program (:func:`program_ends_at_commit`): its command ends when a staged
-#: write has moved its files in, and SIGINT and SIGTERM are ignored from then on.
-_ENDS_AT_COMMIT = []
-
-
-def program_ends_at_commit():
-    """Called by the cavex program before its command runs. Every command's staged write is the
-    last of its work (what follows prints its summary), so once :func:`staged_output` has moved
-    the files in, SIGINT and SIGTERM are ignored for the rest of the process, and one that
-    arrived during the moves is discarded: the exit code then says what ``--out`` holds, 0
-    every new file, 130 (or death by the signal) none of them. Without this call (a library
-    caller, the tests' in-process ``main``) an interrupt during the moves is raised as
-    :class:`KeyboardInterrupt` once they are done, and handlers are restored."""
-    _ENDS_AT_COMMIT.append(True)
-
-
 @contextmanager
 def staged_output(folder, option="out", replaces=()):
     """Write a command's files into a hidden folder inside ``folder`` (the ``with`` target);
@@ -132,7 +117,7 @@ def staged_output(folder, option="out", replaces=()):
     thread: a signal another thread (numba's, dask's) receives still runs Python's handler in
     the main thread, so the handler only records a signal once the commit (or the clean-up)
     has begun, and neither is cut short midway. What happens to such a signal after the moves:
-    :func:`program_ends_at_commit`.
+    :func:`cavex.verification.output.program.program_ends_at_commit`.
 
     A clash (a staged file whose name is a folder in ``folder``, a staged folder whose name
     is a file or a symlink) is found before anything is moved (:func:`planned_moves`): the
@@ -182,7 +167,7 @@ def staged_output(folder, option="out", replaces=()):
             remove_earlier_outputs(folder, replaces,
                                    {Path(d).relative_to(folder).parts[0] for _, d in moves})
             committed = True
-            if _ENDS_AT_COMMIT:  # ignoring a blocked signal discards it if pending (POSIX)
+            if ends_at_commit():  # ignoring a blocked signal discards it if pending (POSIX)
                 previous = [signal.SIG_IGN] * len(caught)
                 for s in caught:
                     signal.signal(s, signal.SIG_IGN)
@@ -199,7 +184,7 @@ def staged_output(folder, option="out", replaces=()):
                 folder.rmdir()  # only if empty: nothing was moved in
             except OSError:
                 pass
-    if committed and received and not _ENDS_AT_COMMIT:  # every file is in: then the interrupt
+    if committed and received and not ends_at_commit():  # every file is in: then the interrupt
         raise KeyboardInterrupt(f"signal {received[0]}")
 
 
