@@ -170,16 +170,25 @@ def unresolved(problem, numerics):
         f"resolves ({THIN_SHELL:g} of the cavity radius, {THIN_SHELL * problem.radius:.3g} m; "
         "docs/fem.md 'Thin wall layer'): take a depth where that layer is gone (the wall "
         "stress is continuous there) or one where its shell is thicker")
-    settings = {"layers": [{f.name: getattr(m, f.name) for f in dataclasses.fields(m)}
-                           for m in problem.layers],
-                "interfaces": [float(h) for h in problem.interfaces],
-                "velocity": float(problem.velocity), "radius": float(problem.radius),
-                "numerics": numerics.as_dict()}
-    stats = {key: 0 for key in ("elements", "dofs", "steps", "newton_iterations", "cutbacks",
-                                "line_search_steps", "residual_evaluations", "refinements")}
-    return ExpansionResult(math.nan, None, math.nan, (), settings, stats={**stats,
-                                                                          "seconds": 0.0},
-                           error=error)
+    stats = {"elements": 0, "dofs": 0, **{name: 0 for name in RUN_COUNTS}, "seconds": 0.0,
+             "refinements": 0}
+    return ExpansionResult(math.nan, None, math.nan, (), run_settings(problem, numerics),
+                           stats=stats, error=error)
+
+
+#: the counts of one run that a result's ``stats`` carries (:class:`RadialSolver`'s per case)
+RUN_COUNTS = ("steps", "newton_iterations", "cutbacks", "line_search_steps",
+              "residual_evaluations")
+
+
+def run_settings(problem, numerics):
+    """Everything that reproduces a run of ``problem`` at ``numerics`` (a result's
+    ``settings``)."""
+    return {"layers": [{f.name: getattr(m, f.name) for f in dataclasses.fields(m)}
+                       for m in problem.layers],
+            "interfaces": [float(h) for h in problem.interfaces],
+            "velocity": float(problem.velocity), "radius": float(problem.radius),
+            "numerics": numerics.as_dict()}
 
 
 # ---------------------------------------------------------------------------------- runs
@@ -240,18 +249,11 @@ def _run_stack(problems, numerics, dynamic, record):
 
 
 def _result(solver, c, problem, vertices, numerics, error, seconds, recorder):
-    layers, interfaces, velocity, radius = problem.as_tuple()
     one = solver.case(c)
     disc = one.disc
-    settings = {"layers": [{f.name: getattr(m, f.name) for f in dataclasses.fields(m)}
-                           for m in layers],
-                "interfaces": [float(h) for h in interfaces],
-                "velocity": float(velocity), "radius": float(radius),
-                "numerics": numerics.as_dict()}
+    settings = run_settings(problem, numerics)
     stats = {"elements": disc.n_elements, "dofs": disc.ndof,
-             **{name: getattr(one, name) for name in ("steps", "newton_iterations", "cutbacks",
-                                                      "line_search_steps",
-                                                      "residual_evaluations")},
+             **{name: getattr(one, name) for name in RUN_COUNTS},
              "seconds": seconds, "refinements": 0}
     if error is not None:
         return ExpansionResult(math.nan, None, math.nan, (), settings, stats=stats, error=error)
