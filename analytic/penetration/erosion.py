@@ -167,7 +167,7 @@ class ErodingNose:
             return self.psi0
         if mass == self._last[0]:
             return self._last[1]
-        volume = self.volume0 - (self.m0 - mass) / self.density
+        volume = self.nose_volume_left(mass)
         psi = HEMISPHERE if volume <= self.blunt_volume else self._solve_psi(volume)
         self._last = (mass, psi)
         return psi
@@ -195,8 +195,13 @@ class ErodingNose:
         setback = nose_length(self.r, self.psi0) - nose_length(self.r, self.psi(mass))
         if not self.law.blunting or mass >= self.m0:
             return setback
-        beyond = self.blunt_volume - (self.volume0 - (self.m0 - mass) / self.density)
+        beyond = self.blunt_volume - self.nose_volume_left(mass)
         return setback + max(beyond, 0.0) / (math.pi * self.r * self.r)
+
+    def nose_volume_left(self, mass):
+        """The original nose's volume less the volume lost at ``mass`` (m^3; below the
+        hemisphere's once the loss reaches the shank)."""
+        return self.volume0 - (self.m0 - mass) / self.density
 
     def forces(self, resistance, depth, velocity, mass):
         """``(F, F_f)``: the axial force on the current nose and the sliding friction (N)."""
