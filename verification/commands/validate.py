@@ -188,8 +188,9 @@ def job(shot_file, calibrations=(), *, tables_dir=None, workers=None, scheduler=
     folds = None if cross_validate is None else fold_validator(cross_validate, law)
     result = validate(shot_file.shots, calibrations=calibrations, tables=tables,
                       progress=progress, models=models, erosion=law, cross_validate=folds)
-    if compressibility_calibrations(calibrations, models):
-        columns = {COMPRESSIBILITY_COLUMN: columns_of(calibrations)[COMPRESSIBILITY_COLUMN]}
+    dynamic = compressibility_calibrations(calibrations, models)
+    if dynamic:
+        columns = {COMPRESSIBILITY_COLUMN: (FE_MODEL, dynamic[0].mapping)}
         depths, failures = predictions(shot_file.shots, columns, tables, progress, law)
         for row, depth in zip(result["shots"], depths[COMPRESSIBILITY_COLUMN], strict=True):
             row["predicted_m"][COMPRESSIBILITY_COLUMN] = depth
