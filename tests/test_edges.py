@@ -433,25 +433,36 @@ def test_stress_notes_the_fe_only_keys_it_ignores(capsys):
     assert code == 0 and "plastic zones" in out and "none mm" not in out
 
 
-@pytest.mark.parametrize("scab", ["1e-3", "1e-8", "1e-13", "1e-15", "1e-300"])
-def test_a_rear_zone_of_any_accepted_depth_crosses_the_debonded_interface(tmp_path, capsys,
-                                                                          scab):
-    """Table 1 with the concrete's bottom debonded: the depth does not depend on how deep the
-    rear zone is (the rear-face stage ends at the interface either way). With a rear zone of
-    1e-8 or 1e-13 m the macadam's crater took the concrete's properties (3.3781 m), at 1e-15 m
-    the interface was never crossed (3.3296 m, a rear-face stage into the soil): a stage
-    started at its event's located depth, within its tolerance on either side of the stop."""
+def debonded_phases(tmp_path, capsys, scab):
+    """The phases of ``cavex penetrate --json`` on Table 1 with the concrete's bottom debonded
+    and its rear zone ``scab`` (m, as written in the file) deep."""
     text = (Path(__file__).resolve().parents[1] / "core" / "data" / "runway.toml").read_text()
-    config = tmp_path / "c.toml"
+    config = tmp_path / f"c{scab}.toml"
     config.write_text(text.replace("thickness = 0.65\n", "thickness = 0.65\nbottom = "
                                    f"\"debonded\"\nscab_depth = {scab}\n", 1))
     code, out, err = run(capsys, "penetrate", "--config", config, "--no-figures", "--json",
-                         "--out", tmp_path / "o")
-    phases = json.loads(out)["phases"]  # the layered target's
+                         "--out", tmp_path / f"o{scab}")
     assert code == 0, err
-    assert [p["stage"] for p in phases][3:5] == ["rear face", "crater"]
-    assert phases[4]["end_reason"] == "crater depth reached (macadam)"
-    assert phases[-1]["end_depth_m"] == pytest.approx(3.4035, abs=5e-5)
+    return json.loads(out)["phases"]  # the layered target's
+
+
+@pytest.mark.parametrize("scab", ["1e-8", "1e-13", "1e-15", "1e-300"])
+def test_a_rear_zone_of_any_accepted_depth_crosses_the_debonded_interface(tmp_path, capsys,
+                                                                          scab):
+    """Table 1 with the concrete's bottom debonded: the depth does not depend on how deep the
+    rear zone is (the rear-face stage ends at the interface either way): the same as with a
+    1 mm rear zone (3.4035 m) to 1e-6 m (measured: 1.1e-10 m apart; the bug's depths were
+    0.025 and 0.074 m off). With a rear zone of 1e-8 or 1e-13 m the macadam's crater took the
+    concrete's properties (3.3781 m), at 1e-15 m the interface was never crossed (3.3296 m, a
+    rear-face stage into the soil): a stage started at its event's located depth, within its
+    tolerance on either side of the stop."""
+    reference = debonded_phases(tmp_path, capsys, "1e-3")
+    assert reference[-1]["end_depth_m"] == pytest.approx(3.4035, abs=5e-5)
+    phases = debonded_phases(tmp_path, capsys, scab)
+    for run_phases in (reference, phases):
+        assert [p["stage"] for p in run_phases][3:5] == ["rear face", "crater"]
+        assert run_phases[4]["end_reason"] == "crater depth reached (macadam)"
+    assert phases[-1]["end_depth_m"] == pytest.approx(reference[-1]["end_depth_m"], abs=1e-6)
 
 
 def test_a_rerun_into_the_same_folder_leaves_only_its_own_files(tmp_path, capsys):
